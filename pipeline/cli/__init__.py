@@ -1,0 +1,63 @@
+"""The ``lookdev`` command line (Typer).
+
+Commands are verbs; each group lives in its own module beside this one and is added in
+:func:`_register`. Bad input anywhere ends in one line on stderr and exit code 2
+(DESIGN.md, Errors): commands raise :class:`~lookdev.materials.errors.LookdevError` and
+:func:`main` turns it into that line.
+"""
+
+from __future__ import annotations
+
+import sys
+from importlib import metadata
+
+import typer
+
+from lookdev.materials.errors import LookdevError
+
+from .common import err_console
+
+app = typer.Typer(
+    name="lookdev",
+    help="Author, blend, export and proof Disney and Pixar materials.",
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    add_completion=False,
+    rich_markup_mode="rich",
+)
+
+
+def _version(value: bool) -> None:
+    if value:
+        typer.echo(f"lookdev {metadata.version('lookdev')}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: bool = typer.Option(
+        False, "--version", callback=_version, is_eager=True, help="Print the version and exit."
+    ),
+) -> None:
+    """lookdev: material presets in, USD networks and Mitsuba proofs out."""
+
+
+def _register() -> None:
+    from . import bench
+
+    app.add_typer(bench.app, name="bench")
+
+
+_register()
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Entry point of the ``lookdev`` script; ``argv`` defaults to ``sys.argv[1:]``."""
+    try:
+        app(args=argv, prog_name="lookdev")
+    except LookdevError as exc:
+        err_console.print(f"lookdev: error: {exc}", markup=False, highlight=False, soft_wrap=True)
+        sys.exit(2)
+    except KeyboardInterrupt:
+        err_console.print("lookdev: interrupted", markup=False)
+        sys.exit(130)

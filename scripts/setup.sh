@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Sets up a fresh machine for lookdev: Debian's libllvm19 (for Mitsuba's fast LLVM
+# variant, where apt is available), a virtual environment in .venv, and the package with
+# its test extras. Safe to run again: it only does what is missing.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+if ! ldconfig -p 2>/dev/null | grep -q 'libLLVM.so.19'; then
+  if command -v apt-get >/dev/null 2>&1; then
+    SUDO=""
+    [ "$(id -u)" -ne 0 ] && command -v sudo >/dev/null 2>&1 && SUDO="sudo"
+    echo "setup: installing libllvm19 for Mitsuba's LLVM variant"
+    if ! { $SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq libllvm19; } >/tmp/lookdev-apt.log 2>&1; then
+      echo "setup: warning: could not install libllvm19 (see /tmp/lookdev-apt.log); renders fall back to scalar_rgb" >&2
+    fi
+  else
+    echo "setup: warning: apt-get not available; renders fall back to Mitsuba's scalar_rgb variant" >&2
+  fi
+fi
+
+PYTHON=${PYTHON:-python3}
+if [ ! -x .venv/bin/python ]; then
+  "$PYTHON" -m venv .venv
+fi
+stamp=.venv/.lookdev-installed
+if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
+  .venv/bin/python -m pip install -q --upgrade pip
+  .venv/bin/python -m pip install -q -e '.[test]'
+  touch "$stamp"
+fi
