@@ -1,0 +1,111 @@
+"""The BSDF contract every reflectance model implements, and its numpy front door.
+
+A model module (``disney``, ``sheen``, ``pixar``) writes its maths once, as four
+backend-generic *core* functions over the array shim (:mod:`.arrays`), and publishes them
+as a :class:`Model`:
+
+``prepare(xp, params, **maps) -> prepared``
+    Everything that depends only on the parameters, computed once: derived colours, α,
+    lobe weights and selection probabilities. ``params`` is the model's pydantic schema
+    (constants, discrete switches such as ``thin``); ``maps`` override single fields with
+    per-element values (texture lookups in Mitsuba, per-texel arrays in analysis). A lobe
+    whose weight is ``xp.known_zero`` is recorded as absent here, and the other core
+    functions then skip it entirely (DESIGN.md: nothing is computed that is not needed).
+``eval(xp, prepared, wi, wo) -> colour``
+    f(wi, wo) *without* the cosine; ``wi`` towards the light, ``wo`` towards the viewer,
+    both pointing away from the surface in the local frame (normal +z).
+``pdf(xp, prepared, wi, wo) -> scalar``
+    Solid-angle density with which ``sample`` produces ``wi`` given ``wo``.
+``sample(xp, prepared, wo, u) -> (wi, weight, pdf)``
+    ``u`` is a vector of three uniforms (``u[0]`` picks the lobe, ``u[1], u[2]`` the
+    direction); ``weight = f·|cos θi| / pdf``; a failed sample has pdf 0 and weight 0.
+
+Vectors and colours are channel-first inside core functions (see :mod:`.arrays`). The
+functions below are the public numpy API: they take ``(..., 3)`` arrays, broadcast, and
+return ``(..., 3)`` / ``(...)`` arrays.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .arrays import NumpyOps, from_channel_first, to_channel_first
+
+
+@dataclass(frozen=True)
+class Model:
+    """A reflectance model: its name, parameter schema and four core functions."""
+
+    name: str
+    params_type: type
+    prepare: Callable[..., Any]
+    eval: Callable[..., Any]
+    pdf: Callable[..., Any]
+    sample: Callable[..., Any]
+
+
+def _flatten_maps(maps: dict[str, Any], lead: tuple[int, ...], dtype: Any) -> dict[str, Any]:
+    """Per-element parameter maps, broadcast to the directions' leading shape, flattened."""
+    flat = {}
+    for name, value in maps.items():
+        a = np.asarray(value, dtype=dtype)
+        if a.ndim > 0 and a.shape[-1] == 3 and a.ndim == len(lead) + 1:
+            flat[name] = np.broadcast_to(a, (*lead, 3)).reshape(-1, 3).T
+        else:
+            flat[name] = np.broadcast_to(a, lead).reshape(-1)
+    return flat
+
+
+def _directions(*vs: Any, dtype: Any) -> tuple[list[np.ndarray], tuple[int, ...]]:
+    arrays = np.broadcast_arrays(*(np.asarray(v, dtype=dtype) for v in vs))
+    out = []
+    lead: tuple[int, ...] = ()
+    for a in arrays:
+        cf, lead = to_channel_first(a, dtype)
+        out.append(cf)
+    return out, lead
+
+
+def evaluate(
+    model: Model, params: Any, wi: Any, wo: Any, *, dtype: Any = np.float64, **maps: Any
+) -> np.ndarray:
+    """f(wi, wo) without the cosine, shape (..., 3)."""
+    xp = NumpyOps(dtype)
+    (wi_, wo_), lead = _directions(wi, wo, dtype=dtype)
+    with np.errstate(all="ignore"):
+        prepared = model.prepare(xp, params, **_flatten_maps(maps, lead, dtype))
+        f = model.eval(xp, prepared, wi_, wo_)
+    return from_channel_first(np.broadcast_to(f, (3, wi_.shape[1])), lead)
+
+
+def density(
+    model: Model, params: Any, wi: Any, wo: Any, *, dtype: Any = np.float64, **maps: Any
+) -> np.ndarray:
+    """pdf of sampling wi given wo (solid angle), shape (...)."""
+    xp = NumpyOps(dtype)
+    (wi_, wo_), lead = _directions(wi, wo, dtype=dtype)
+    with np.errstate(all="ignore"):
+        prepared = model.prepare(xp, params, **_flatten_maps(maps, lead, dtype))
+        p = model.pdf(xp, prepared, wi_, wo_)
+    return from_channel_first(np.broadcast_to(p, (wi_.shape[1],)), lead)
+
+
+def draw(
+    model: Model, params: Any, wo: Any, u: Any, *, dtype: Any = np.float64, **maps: Any
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Sample wi given wo and uniforms u of shape (..., 3): (wi, weight, pdf)."""
+    xp = NumpyOps(dtype)
+    (wo_, u_), lead = _directions(wo, u, dtype=dtype)
+    n = wo_.shape[1]
+    with np.errstate(all="ignore"):
+        prepared = model.prepare(xp, params, **_flatten_maps(maps, lead, dtype))
+        wi, weight, pdf = model.sample(xp, prepared, wo_, u_)
+    return (
+        from_channel_first(np.broadcast_to(wi, (3, n)), lead),
+        from_channel_first(np.broadcast_to(weight, (3, n)), lead),
+        from_channel_first(np.broadcast_to(pdf, (n,)), lead),
+    )

@@ -1,0 +1,1 @@
+"""Analysis: stability sweeps, albedo, plots, error against run time."""

@@ -1,0 +1,1 @@
+"""Blending engine: masks, Disney parameter blending, Pixar lobe compositing."""

@@ -1,0 +1,1 @@
+"""Exporters: USD (UsdShade) for DCCs, Mitsuba scenes for proofs."""

@@ -1,0 +1,1 @@
+"""USD export (usd-core, UsdShade) and import."""

@@ -1,0 +1,1 @@
+"""Proof turntables under several IBLs: scenes, frames, batches, contact sheets."""
