@@ -1,0 +1,235 @@
+"""BRDF-explorer views of materials (Burley 2012 §3.2), computed with the numpy backend.
+
+Each view is a pair: a pure function that computes its numbers (tested against
+independent computations) and a ``draw_*`` function that puts them on a matplotlib axis.
+:func:`figure` lays several materials side by side, one column each, labelled.
+
+* ``slice``  — f(θh, θd) at φd = 90° (Burley Fig. 3): θh to the right (left edge = the
+  specular peak), θd up (top edge = the Fresnel peak, bottom edge = retro-reflection),
+  shown with an exposure control and the sRGB transfer curve.
+* ``albedo`` — directional albedo against incidence angle per channel (Fig. 11/12).
+* ``polar``  — f in the plane of incidence for several incidence angles; the light comes
+  from the left, the mirror direction is on the right.
+* ``sphere`` — a lit sphere under a point light, and under an IBL when one is given.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from lookdev.materials.bsdf import Model, evaluate  # noqa: E402
+
+from .albedo import albedo_monte_carlo, albedo_quadrature, albedo_tabulated  # noqa: E402
+from .sphere import REC709_Y, ibl_sphere, point_light_sphere  # noqa: E402
+
+VIEWS = ("slice", "albedo", "polar", "sphere")
+CHANNEL_COLOURS = ("#d62728", "#2ca02c", "#1f77b4")
+
+
+@dataclass(frozen=True)
+class Subject:
+    """One material to show: its label, model and (uniform) parameters."""
+
+    label: str
+    model: Model
+    params: Any
+
+
+# -- slice ---------------------------------------------------------------------------
+def slice_directions(
+    theta_h: np.ndarray, theta_d: np.ndarray, phi_d: float = math.pi / 2
+) -> tuple[np.ndarray, np.ndarray]:
+    """(wi, wo) for every (θd, θh) pair, shape (len(θd), len(θh), 3).
+
+    Rusinkiewicz's half/difference parametrisation: the half vector at θh in the x-z
+    plane; the difference vector at (θd, φd) in the half vector's frame; wi and wo are
+    the difference vector and its mirror image about h, rotated by θh about y.
+
+    >>> wi, wo = slice_directions(np.array([0.0]), np.array([0.0]))
+    >>> wi[0, 0].round(6).tolist(), wo[0, 0].round(6).tolist()
+    ([0.0, 0.0, 1.0], [0.0, 0.0, 1.0])
+    """
+    th, td = np.meshgrid(theta_h, theta_d)
+    d = np.stack([np.sin(td) * math.cos(phi_d), np.sin(td) * math.sin(phi_d), np.cos(td)], -1)
+    mirrored = d * np.array([-1.0, -1.0, 1.0])
+
+    def rotate_y(v: np.ndarray) -> np.ndarray:
+        c, s = np.cos(th), np.sin(th)
+        return np.stack(
+            [c * v[..., 0] + s * v[..., 2], v[..., 1], -s * v[..., 0] + c * v[..., 2]], -1
+        )
+
+    return rotate_y(d), rotate_y(mirrored)
+
+
+def brdf_slice(model: Model, params: Any, n: int = 128, phi_d: float = math.pi / 2):
+    """(θh, θd, f) with f of shape (n, n, 3): row i is θd[i], column j is θh[j] (radians)."""
+    theta = (np.arange(n) + 0.5) / n * (math.pi / 2)
+    wi, wo = slice_directions(theta, theta, phi_d)
+    f = evaluate(model, params, wi, wo)
+    below = (wi[..., 2] <= 0) | (wo[..., 2] <= 0)
+    return theta, theta, np.where(below[..., None], 0.0, np.nan_to_num(f))
+
+
+def to_display(radiance: np.ndarray, exposure: float = 0.0) -> np.ndarray:
+    """Scene-linear values × 2^exposure, clipped and sRGB-encoded for display.
+
+    >>> to_display(np.array([0.0, 1.0, 4.0]), exposure=-2).round(4).tolist()
+    [0.0, 0.5371, 1.0]
+    """
+    x = np.clip(radiance * 2.0**exposure, 0.0, 1.0)
+    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
+
+
+def draw_slice(ax: Any, subject: Subject, *, exposure: float = 0.0, n: int = 128) -> None:
+    _, _, f = brdf_slice(subject.model, subject.params, n)
+    ax.imshow(to_display(f, exposure), origin="lower", extent=(0, 90, 0, 90))
+    ax.set_xlabel("θh (°)")
+    ax.set_ylabel("θd (°)")
+    ax.set_xticks([0, 30, 60, 90])
+    ax.set_yticks([0, 30, 60, 90])
+
+
+# -- albedo --------------------------------------------------------------------------
+def albedo_curves(subject: Subject, n_theta: int = 46) -> list:
+    """Quadrature, and where they exist the Monte Carlo and tabulated curves, 0..89.5°."""
+    theta = np.radians(np.linspace(0.0, 89.5, n_theta))
+    curves = [albedo_quadrature(subject.model, subject.params, theta, n_mu=96, n_phi=96)]
+    curves.append(albedo_monte_carlo(subject.model, subject.params, theta[::5], n_samples=4096))
+    table = albedo_tabulated(subject.model, subject.params, theta)
+    return curves + ([table] if table is not None else [])
+
+
+def draw_albedo(ax: Any, subject: Subject) -> None:
+    quad, mc, *table = albedo_curves(subject)
+    for c, colour in enumerate(CHANNEL_COLOURS):
+        ax.plot(np.degrees(quad.theta), quad.albedo[:, c], color=colour, lw=1.6, label="RGB"[c])
+        ax.errorbar(
+            np.degrees(mc.theta),
+            mc.albedo[:, c],
+            yerr=2 * mc.stderr[:, c],
+            fmt="o",
+            ms=3,
+            color=colour,
+            alpha=0.7,
+            label="MC ±2σ" if c == 0 else None,
+        )
+        if table:
+            ax.plot(
+                np.degrees(table[0].theta),
+                table[0].albedo[:, c],
+                "--",
+                color=colour,
+                lw=1,
+                label="table" if c == 0 else None,
+            )
+    ax.set_xlim(0, 90)
+    ax.set_ylim(0, max(1.05, float(quad.albedo.max()) * 1.1))
+    ax.set_xlabel("incidence angle θ (°)")
+    ax.set_ylabel("directional albedo")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize="small", loc="lower left")
+
+
+# -- polar ---------------------------------------------------------------------------
+def polar_curves(
+    model: Model, params: Any, incidence_deg: Sequence[float] = (0, 30, 60, 80), n: int = 361
+) -> tuple[np.ndarray, np.ndarray]:
+    """θo in (−90°, 90°) and the Rec.709 luminance of f for each incidence angle, (A, n).
+
+    The light is at −θi in the x-z plane, so the mirror direction is θo = +θi.
+    """
+    theta_o = np.radians(np.linspace(-89.75, 89.75, n))
+    wo = np.stack([np.sin(theta_o), np.zeros_like(theta_o), np.cos(theta_o)], -1)
+    rows = []
+    for ti in np.radians(np.asarray(incidence_deg, dtype=np.float64)):
+        wi = np.array([-math.sin(ti), 0.0, math.cos(ti)])
+        rows.append(np.nan_to_num(evaluate(model, params, wi, wo)) @ REC709_Y)
+    return theta_o, np.array(rows)
+
+
+def draw_polar(ax: Any, subject: Subject, incidence_deg: Sequence[float] = (0, 30, 60, 80)) -> None:
+    theta_o, lum = polar_curves(subject.model, subject.params, incidence_deg)
+    top = float(np.percentile(lum, 99.5)) or 1.0
+    for ti, row in zip(incidence_deg, lum, strict=True):
+        ax.plot(theta_o, np.minimum(row, top * 1.5), lw=1.4, label=f"θi = {ti:g}°")
+    ax.set_theta_zero_location("N")
+    ax.set_theta_direction(-1)
+    ax.set_thetamin(-90)
+    ax.set_thetamax(90)
+    ax.set_rmax(top * 1.5)
+    ax.legend(fontsize="x-small", loc="lower right")
+
+
+# -- sphere --------------------------------------------------------------------------
+def draw_sphere(ax: Any, image: np.ndarray, exposure: float, title: str) -> None:
+    ax.imshow(to_display(image, exposure))
+    ax.set_axis_off()
+    ax.set_title(title, fontsize="small")
+
+
+# -- figure --------------------------------------------------------------------------
+def figure(
+    subjects: Sequence[Subject],
+    view: str,
+    *,
+    exposure: float = 0.0,
+    environment: np.ndarray | None = None,
+    ibl_name: str = "IBL",
+    resolution: int = 128,
+):
+    """A matplotlib figure of one view for several materials side by side."""
+    if view not in VIEWS:
+        raise ValueError(f"view must be one of {', '.join(VIEWS)}")
+    cols = len(subjects)
+    rows = 2 if view == "sphere" and environment is not None else 1
+    polar = view == "polar"
+    fig = plt.figure(figsize=(3.6 * cols, 3.4 * rows + 0.6), layout="constrained")
+    for i, subject in enumerate(subjects):
+        if view == "sphere":
+            img = point_light_sphere(subject.model, subject.params, resolution=resolution)
+            ax = fig.add_subplot(rows, cols, i + 1)
+            draw_sphere(ax, img, exposure, f"{subject.label}\npoint light")
+            if environment is not None:
+                img = ibl_sphere(
+                    subject.model, subject.params, environment, resolution=min(resolution, 96)
+                )
+                ax = fig.add_subplot(rows, cols, cols + i + 1)
+                draw_sphere(ax, img, exposure, f"{subject.label}\n{ibl_name}")
+            continue
+        ax = fig.add_subplot(1, cols, i + 1, projection="polar" if polar else None)
+        if view == "slice":
+            draw_slice(ax, subject, exposure=exposure, n=resolution)
+        elif view == "albedo":
+            draw_albedo(ax, subject)
+        else:
+            draw_polar(ax, subject)
+        ax.set_title(subject.label)
+    suffix = f", exposure {exposure:+g}" if view in ("slice", "sphere") else ""
+    fig.suptitle(f"{view}{suffix}", fontsize="medium")
+    return fig
+
+
+def save_figure(fig: Any, path: str | Path) -> Path:
+    """Write the figure atomically (temporary file, then rename) and close it."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.stem}.tmp{path.suffix}")
+    try:
+        fig.savefig(tmp, dpi=110)
+        tmp.replace(path)
+    finally:
+        plt.close(fig)
+        tmp.unlink(missing_ok=True)
+    return path

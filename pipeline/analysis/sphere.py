@@ -1,0 +1,176 @@
+"""A lit sphere, evaluated directly with the numpy backend (Burley 2012 §3.2, "lit sphere").
+
+An orthographic camera looks down −z at a unit sphere, world y up (Mitsuba's
+convention, so an IBL lights the sphere as it lights the proof renders). Each pixel's
+normal gives a shading frame; light and view are moved into it and the model's own
+``eval``/``sample``/``pdf`` do the rest — no renderer in between, so what the sphere
+shows is exactly the model the other plots describe.
+
+* :func:`point_light_sphere`: one distant light of irradiance ``irradiance`` (at normal
+  incidence): L = f(l, v) · max(N·L, 0) · E. A white Lambertian sphere lit head-on with
+  the default E = π shows 1.0 at its centre.
+* :func:`ibl_sphere`: a lat-long environment, L = ∫ f · cos · L_env dω by Monte Carlo
+  with multiple importance sampling (balance heuristic, Veach 1997 §9.2) of the BSDF's
+  sampler and the environment's luminance, so both a mirror and a diffuse sphere
+  converge with a few dozen samples per pixel.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from lookdev.materials.bsdf import Model, density, draw, evaluate
+
+REC709_Y = np.array([0.2126, 0.7152, 0.0722])
+
+
+def sphere_normals(resolution: int) -> tuple[np.ndarray, np.ndarray]:
+    """World normals (H, W, 3) of the visible hemisphere and the disk mask (H, W).
+
+    Row 0 is the top of the image (+y), pixel centres sample the [-1, 1]² square.
+    """
+    c = (np.arange(resolution) + 0.5) / resolution * 2.0 - 1.0
+    x, y = np.meshgrid(c, -c)
+    r2 = x * x + y * y
+    inside = r2 < 1.0
+    z = np.sqrt(np.clip(1.0 - r2, 0.0, None))
+    return np.stack([x, y, z], axis=-1), inside
+
+
+def shading_frames(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Tangent and bitangent for unit normals (..., 3), branch-free.
+
+    Duff et al. 2017, "Building an Orthonormal Basis, Revisited", Listing 3.
+    """
+    sign = np.where(n[..., 2] >= 0, 1.0, -1.0)
+    a = -1.0 / (sign + n[..., 2])
+    b = n[..., 0] * n[..., 1] * a
+    t = np.stack([1.0 + sign * n[..., 0] ** 2 * a, sign * b, -sign * n[..., 0]], axis=-1)
+    s = np.stack([b, sign + n[..., 1] ** 2 * a, -n[..., 1]], axis=-1)
+    return t, s
+
+
+def to_local(d: np.ndarray, t: np.ndarray, s: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """World direction(s) into the (t, s, n) frame."""
+    return np.stack([(d * t).sum(-1), (d * s).sum(-1), (d * n).sum(-1)], axis=-1)
+
+
+def point_light_sphere(
+    model: Model,
+    params: Any,
+    *,
+    resolution: int = 128,
+    light: tuple[float, float, float] = (-1.0, 1.0, 1.0),
+    irradiance: float = math.pi,
+) -> np.ndarray:
+    """Radiance image (H, W, 3) of the sphere under one distant light; black outside."""
+    n, inside = sphere_normals(resolution)
+    l_world = np.asarray(light, dtype=np.float64)
+    l_world = l_world / np.linalg.norm(l_world)
+    t, s = shading_frames(n[inside])
+    nn = n[inside]
+    wi = to_local(l_world[None, :], t, s, nn)
+    wo = to_local(np.array([[0.0, 0.0, 1.0]]), t, s, nn)
+    f = evaluate(model, params, wi, wo)
+    image = np.zeros((resolution, resolution, 3))
+    image[inside] = np.nan_to_num(f) * np.clip(wi[:, 2:3], 0.0, None) * irradiance
+    return image
+
+
+class LatLong:
+    """A lat-long environment in Mitsuba's convention, with luminance importance sampling.
+
+    Texel (row, col) covers u = (col + ½)/W, v = (row + ½)/H; a direction is
+    (sin φ sin θ, cos θ, −cos φ sin θ) with φ = 2πu, θ = πv (y up, row 0 at the zenith).
+    """
+
+    def __init__(self, pixels: np.ndarray):
+        self.pixels = np.asarray(pixels, dtype=np.float64)[..., :3]
+        h, w = self.pixels.shape[:2]
+        sin_theta = np.sin((np.arange(h) + 0.5) / h * math.pi)
+        weight = np.maximum(self.pixels @ REC709_Y, 0.0) * sin_theta[:, None]
+        # A floor keeps every direction reachable, so MIS stays unbiased.
+        weight = weight + 1e-3 * max(float(weight.mean()), 1e-12) * sin_theta[:, None]
+        self.pmf = (weight / weight.sum()).reshape(-1)
+        self.cdf = np.cumsum(self.pmf)
+        self.shape = (h, w)
+
+    def lookup(self, d: np.ndarray) -> np.ndarray:
+        """Radiance along world directions (..., 3), nearest texel."""
+        h, w = self.shape
+        u = (np.arctan2(d[..., 0], -d[..., 2]) / (2.0 * math.pi)) % 1.0
+        v = np.arccos(np.clip(d[..., 1], -1.0, 1.0)) / math.pi
+        col = np.minimum((u * w).astype(int), w - 1)
+        row = np.minimum((v * h).astype(int), h - 1)
+        return self.pixels[row, col]
+
+    def pdf(self, d: np.ndarray) -> np.ndarray:
+        """Solid-angle density of :meth:`sample` at world directions (..., 3)."""
+        h, w = self.shape
+        u = (np.arctan2(d[..., 0], -d[..., 2]) / (2.0 * math.pi)) % 1.0
+        theta = np.arccos(np.clip(d[..., 1], -1.0, 1.0))
+        col = np.minimum((u * w).astype(int), w - 1)
+        row = np.minimum((theta / math.pi * h).astype(int), h - 1)
+        sin_theta = np.maximum(np.sin(theta), 1e-8)
+        # pdf over uv is pmf · H · W; dω = 2π² sin θ du dv.
+        return self.pmf[row * w + col] * h * w / (2.0 * math.pi**2 * sin_theta)
+
+    def sample(self, u: np.ndarray) -> np.ndarray:
+        """World directions for uniforms u (..., 3): u[0] picks a texel, u[1:] jitter in it."""
+        h, w = self.shape
+        idx = np.minimum(np.searchsorted(self.cdf, u[..., 0] * self.cdf[-1]), h * w - 1)
+        row, col = np.divmod(idx, w)
+        phi = 2.0 * math.pi * (col + u[..., 1]) / w
+        theta = math.pi * (row + u[..., 2]) / h
+        return np.stack(
+            [np.sin(phi) * np.sin(theta), np.cos(theta), -np.cos(phi) * np.sin(theta)], axis=-1
+        )
+
+
+def ibl_sphere(
+    model: Model,
+    params: Any,
+    environment: np.ndarray,
+    *,
+    resolution: int = 96,
+    spp: int = 32,
+    seed: int = 0,
+) -> np.ndarray:
+    """Radiance image (H, W, 3) of the sphere lit by a lat-long environment (H', W', 3).
+
+    Each pixel takes ``spp`` BSDF samples and ``spp`` environment samples, combined with
+    the balance heuristic; the estimate is unbiased for any roughness.
+    """
+    env = LatLong(environment)
+    n, inside = sphere_normals(resolution)
+    nn = n[inside]
+    t, s = shading_frames(nn)
+    wo = to_local(np.array([[0.0, 0.0, 1.0]]), t, s, nn)[:, None, :]
+    rng = np.random.default_rng(seed)
+    m = len(nn)
+    frame = [a[:, None, :] for a in (t, s, nn)]
+
+    # Strategy 1: the BSDF's own sampler.
+    wi, weight, p_bsdf = draw(
+        model, params, np.broadcast_to(wo, (m, spp, 3)), rng.random((m, spp, 3))
+    )
+    world = sum(wi[..., k : k + 1] * frame[k] for k in range(3))
+    p_env = env.pdf(world)
+    mis = np.where(p_bsdf > 0, p_bsdf / (p_bsdf + p_env), 0.0)
+    est = np.nan_to_num(weight * env.lookup(world) * mis[..., None]).sum(axis=1)
+
+    # Strategy 2: the environment's luminance.
+    world = env.sample(rng.random((m, spp, 3)))
+    wi = to_local(world, *frame)
+    f = evaluate(model, params, wi, np.broadcast_to(wo, (m, spp, 3)))
+    p_bsdf = density(model, params, wi, np.broadcast_to(wo, (m, spp, 3)))
+    p_env = env.pdf(world)
+    contrib = f * np.abs(wi[..., 2:3]) * env.lookup(world) / (p_env + p_bsdf)[..., None]
+    est += np.nan_to_num(contrib).sum(axis=1)
+
+    image = np.zeros((resolution, resolution, 3))
+    image[inside] = est / spp
+    return image

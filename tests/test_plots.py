@@ -1,0 +1,137 @@
+"""BRDF-explorer views: each view's numbers against an independent computation."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from _lambert import LAMBERT, PHONG, LambertParams, PhongParams
+
+from lookdev.pipeline.analysis import plots as P
+from lookdev.pipeline.analysis import sphere as S
+
+RHO = np.array([0.8, 0.5, 0.2])
+
+
+# -- slice ---------------------------------------------------------------------------
+def test_slice_directions_have_the_asked_half_and_difference_angles():
+    th = np.radians([0.0, 10.0, 45.0, 89.0])
+    td = np.radians([0.0, 30.0, 89.0])
+    wi, wo = P.slice_directions(th, td)
+    h = wi + wo
+    h /= np.linalg.norm(h, axis=-1, keepdims=True)
+    np.testing.assert_allclose(np.arccos(np.clip(h[..., 2], -1, 1)), np.tile(th, (3, 1)), atol=1e-7)
+    cos_d = np.clip((wi * h).sum(-1), -1, 1)
+    np.testing.assert_allclose(np.arccos(cos_d), np.tile(td[:, None], (1, 4)), atol=1e-7)
+    # φd = 90°: the difference vector is perpendicular to the plane of n and h.
+    np.testing.assert_allclose(wi[..., 0] * h[..., 2] - wi[..., 2] * h[..., 0], 0, atol=1e-12)
+
+
+@pytest.mark.parametrize("phi_d", [math.pi / 2, 0.0])
+def test_lambert_slice_is_flat_where_both_directions_are_above_the_horizon(phi_d):
+    th, td, f = P.brdf_slice(LAMBERT, LambertParams(base_color=tuple(RHO)), n=32, phi_d=phi_d)
+    wi, wo = P.slice_directions(th, td, phi_d)
+    above = (wi[..., 2] > 0) & (wo[..., 2] > 0)
+    np.testing.assert_allclose(f[above], np.tile(RHO / math.pi, (above.sum(), 1)), rtol=1e-12)
+    assert np.all(f[~above] == 0)
+    # Burley Fig. 4: the φd = 90° slice lies wholly above the horizon, others lose a corner.
+    assert above.all() == (phi_d == math.pi / 2)
+
+
+def test_glossy_slice_peaks_at_theta_h_zero():
+    _, _, f = P.brdf_slice(PHONG, PhongParams(exponent=200.0), n=64)
+    assert np.all(np.argmax(f[:48, :, 0], axis=1) == 0)  # rows up to θd ≈ 67°
+
+
+def test_exposure_and_srgb_curve():
+    np.testing.assert_allclose(P.to_display(np.array([0.25]), exposure=2), [1.0])
+    assert P.to_display(np.array([0.5]), exposure=0)[0] == pytest.approx(0.735357, abs=1e-6)
+    assert P.to_display(np.array([-1.0, np.inf]))[0] == 0.0
+
+
+# -- polar ---------------------------------------------------------------------------
+@pytest.mark.parametrize("incidence", [0.0, 30.0, 60.0, 80.0])
+def test_polar_peak_is_at_the_mirror_direction(incidence):
+    theta_o, lum = P.polar_curves(PHONG, PhongParams(exponent=300.0), [incidence], n=721)
+    assert math.degrees(theta_o[np.argmax(lum[0])]) == pytest.approx(incidence, abs=0.25)
+
+
+def test_lambert_polar_is_rho_over_pi_luminance_everywhere():
+    _, lum = P.polar_curves(LAMBERT, LambertParams(base_color=tuple(RHO)), [0, 45, 89.9])
+    np.testing.assert_allclose(lum, RHO @ S.REC709_Y / math.pi, rtol=1e-12)
+
+
+# -- sphere --------------------------------------------------------------------------
+def test_point_lit_lambert_sphere_is_n_dot_l_albedo_over_pi():
+    light = np.array([-1.0, 1.0, 1.0]) / math.sqrt(3.0)
+    img = S.point_light_sphere(
+        LAMBERT,
+        LambertParams(base_color=tuple(RHO)),
+        resolution=48,
+        light=tuple(light),
+        irradiance=1.0,
+    )
+    n, inside = S.sphere_normals(48)
+    expected = np.clip(n @ light, 0, None)[..., None] * RHO / math.pi * inside[..., None]
+    np.testing.assert_allclose(img, expected, atol=1e-15)
+    assert img[~inside].max() == 0
+
+
+def test_shading_frames_are_orthonormal_including_the_poles():
+    n = np.array([[0, 0, 1.0], [0, 0, -1.0], [1.0, 0, 0], [0, 1.0, 0], [0.6, 0, 0.8]])
+    t, s = S.shading_frames(n)
+    for a, b in ((t, s), (t, n), (s, n)):
+        np.testing.assert_allclose((a * b).sum(-1), 0, atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(t, axis=-1), 1)
+    np.testing.assert_allclose(np.cross(t, s), n, atol=1e-12)
+
+
+def test_white_furnace_lambert_sphere_shows_its_albedo():
+    img = S.ibl_sphere(
+        LAMBERT, LambertParams(base_color=tuple(RHO)), np.ones((16, 32, 3)), resolution=24, spp=64
+    )
+    _, inside = S.sphere_normals(24)
+    np.testing.assert_allclose(img[inside].mean(axis=0), RHO, rtol=0.01)
+
+
+def test_ibl_lights_the_sphere_from_the_side_the_environment_is_bright():
+    env = np.zeros((16, 32, 3))
+    env[:3] = 10.0  # a bright zenith (row 0 is +y)
+    img = S.ibl_sphere(LAMBERT, LambertParams(), env, resolution=24, spp=32)
+    assert img[:6].mean() > 20 * img[-6:].mean()
+
+
+def test_lat_long_sampling_density_integrates_to_one():
+    rng = np.random.default_rng(3)
+    env = S.LatLong(rng.random((8, 16, 3)) * 5)
+    d = env.sample(rng.random((20000, 3)))
+    np.testing.assert_allclose(np.linalg.norm(d, axis=-1), 1)
+    # E[1/pdf] over the sampler's own directions is the sphere's area.
+    assert np.mean(1.0 / env.pdf(d)) == pytest.approx(4 * math.pi, rel=0.02)
+
+
+def test_mirror_like_sphere_reflects_the_environment_without_bias():
+    # Phong with a high exponent in a constant sky: radiance = albedo(θ) ≈ cos-weighted.
+    p = PhongParams(exponent=50.0)
+    img = S.ibl_sphere(PHONG, p, np.ones((8, 16, 3)), resolution=9, spp=256, seed=2)
+    from lookdev.pipeline.analysis.albedo import albedo_quadrature
+
+    centre = albedo_quadrature(PHONG, p, [0.0], n_mu=128, n_phi=32).albedo[0, 0]
+    assert img[4, 4, 0] == pytest.approx(centre, rel=0.03)
+
+
+# -- figures -------------------------------------------------------------------------
+@pytest.mark.parametrize("view", P.VIEWS)
+def test_every_view_draws_several_materials_labelled(tmp_path, view):
+    subjects = [
+        P.Subject("lambert", LAMBERT, LambertParams()),
+        P.Subject("phong", PHONG, PhongParams()),
+    ]
+    env = np.ones((8, 16, 3)) if view == "sphere" else None
+    fig = P.figure(subjects, view, environment=env, resolution=24)
+    titles = [ax.get_title() for ax in fig.axes]
+    assert any("lambert" in t for t in titles) and any("phong" in t for t in titles)
+    out = P.save_figure(fig, tmp_path / f"{view}.png")
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert not list(tmp_path.glob(".*tmp*"))
