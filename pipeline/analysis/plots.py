@@ -56,9 +56,9 @@ def slice_directions(
     plane; the difference vector at (θd, φd) in the half vector's frame; wi and wo are
     the difference vector and its mirror image about h, rotated by θh about y.
 
-    >>> wi, wo = slice_directions(np.array([0.0]), np.array([0.0]))
-    >>> wi[0, 0].round(6).tolist(), wo[0, 0].round(6).tolist()
-    ([0.0, 0.0, 1.0], [0.0, 0.0, 1.0])
+    >>> wi, wo = slice_directions(np.array([0.0]), np.array([math.pi / 4]))
+    >>> (wi[0, 0].round(6) + 0.0).tolist(), (wo[0, 0].round(6) + 0.0).tolist()
+    ([0.0, 0.707107, 0.707107], [0.0, -0.707107, 0.707107])
     """
     th, td = np.meshgrid(theta_h, theta_d)
     d = np.stack([np.sin(td) * math.cos(phi_d), np.sin(td) * math.sin(phi_d), np.cos(td)], -1)
