@@ -15,6 +15,7 @@ independent computations) and a ``draw_*`` function that puts them on a matplotl
 
 from __future__ import annotations
 
+import importlib
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -29,6 +30,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from lookdev.materials.bsdf import Model, evaluate  # noqa: E402
+from lookdev.materials.errors import LookdevError  # noqa: E402
 
 from .albedo import albedo_monte_carlo, albedo_quadrature, albedo_tabulated  # noqa: E402
 from .sphere import REC709_Y, ibl_sphere, point_light_sphere  # noqa: E402
@@ -44,6 +46,65 @@ class Subject:
     label: str
     model: Model
     params: Any
+
+
+class PlotError(LookdevError):
+    """A view cannot be made as asked (unknown model, unreadable environment …)."""
+
+
+def model_named(name: str) -> Model:
+    """The :class:`Model` called ``name``, found in ``lookdev.materials.<name>``."""
+    try:
+        module = importlib.import_module(f"lookdev.materials.{name}")
+    except ImportError:
+        module = None
+    for value in vars(module).values() if module else ():
+        if isinstance(value, Model) and value.name == name:
+            return value
+    raise PlotError(f"no reflectance model named {name!r} is installed", field="model")
+
+
+def subject_for(name_or_path: str, library_paths: Sequence[Path] | None = None) -> Subject:
+    """Load a preset (name or file) and make it plottable.
+
+    A layered preset is blended first; views show its parameters at the texture's
+    centre (uv 0.5, 0.5) unless the blend is uniform.
+    """
+    from lookdev.library import Library, load_material
+
+    material = load_material(name_or_path, Library(list(library_paths)) if library_paths else None)
+    if material.model != "layered":
+        return Subject(material.name, model_named(material.model), material.params)
+    from lookdev.pipeline.blend import blend
+
+    blended = blend(material, 64)
+    if not blended.maps:
+        return Subject(material.name, model_named(blended.model), blended.to_params())
+    return Subject(
+        f"{material.name} (uv 0.5, 0.5)", model_named(blended.model), blended.params_at(0.5, 0.5)
+    )
+
+
+def load_environment(name_or_path: str, max_width: int = 256) -> np.ndarray:
+    """A lat-long environment as (H, W, 3) float, box-filtered down to ``max_width``.
+
+    A path to an .exr/.hdr file is read as it is; anything else is a built-in IBL name.
+    """
+    import OpenImageIO as oiio
+
+    path = Path(name_or_path)
+    if not (path.suffix.lower() in (".exr", ".hdr") and path.is_file()):
+        from lookdev.pipeline.proof import ibl
+
+        path = ibl.resolve(name_or_path)
+    buf = oiio.ImageBuf(str(path))
+    if buf.has_error:
+        raise PlotError(f"cannot read environment: {buf.geterror()}", where=str(path))
+    pixels = np.asarray(buf.get_pixels(oiio.FLOAT), dtype=np.float64)
+    pixels = pixels[..., :3] if pixels.shape[-1] >= 3 else np.repeat(pixels[..., :1], 3, -1)
+    k = max(1, pixels.shape[1] // max_width)
+    h, w = (pixels.shape[0] // k) * k, (pixels.shape[1] // k) * k
+    return pixels[:h, :w].reshape(h // k, k, w // k, k, 3).mean(axis=(1, 3))
 
 
 # -- slice ---------------------------------------------------------------------------

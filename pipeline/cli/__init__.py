@@ -43,9 +43,10 @@ def _root(
 
 
 def _register() -> None:
-    from . import bench
+    from . import bench, plot
 
     app.add_typer(bench.app, name="bench")
+    app.command("plot")(plot.plot)
 
 
 _register()
