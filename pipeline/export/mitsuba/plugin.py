@@ -1,0 +1,328 @@
+"""One Mitsuba BSDF plugin class that renders any :class:`~lookdev.materials.bsdf.Model`.
+
+The class adapts the model's four core functions, run on the Dr.Jit backend of the array
+shim (:meth:`DrJitOps.for_mitsuba`), to Mitsuba's BSDF interface, so a proof shows the very
+maths the numpy plots and tests describe (DESIGN.md, One implementation of each model).
+
+Conventions at the boundary, and only here (DESIGN.md, Conventions):
+
+* Mitsuba's ``si.wi`` is the viewer side and its ``wo`` the light side; our core
+  ``eval(xp, prepared, wi=light, wo=viewer)`` is the other way round, so the names swap.
+* Mitsuba's ``eval`` returns f·|cos θ| of the light side; ours returns f: multiply here.
+* Mitsuba's ``sample`` draws the light side from ``sample1`` (lobe choice) and ``sample2``
+  (direction): ``u = (sample1, sample2.x, sample2.y)``, and our sample weight
+  ``f·|cos θi|/pdf`` is exactly Mitsuba's sample value.
+
+Parameters arrive as Mitsuba properties, one per schema field: a constant (float, bool,
+string, ``rgb``) or a texture (``bitmap`` …). Constants are handed to ``prepare`` as Python
+values, so a lobe whose weight is a constant zero is pruned while the kernel is traced;
+textures are evaluated at ``si`` and handed to ``prepare`` as ``maps``. With the boolean
+property ``force_all_lobes`` every numeric constant is handed over as a Dr.Jit array
+instead: no weight is then a *known* zero and every lobe is traced (the benchmark baseline).
+"""
+
+from __future__ import annotations
+
+import functools
+import typing
+from collections.abc import Iterable
+from typing import Any
+
+from lookdev.materials.arrays import DrJitOps
+from lookdev.materials.bsdf import Model
+from lookdev.materials.errors import LookdevError
+
+PLUGIN_PREFIX = "lookdev_"
+FORCE_ALL_LOBES = "force_all_lobes"
+
+
+class MitsubaExportError(LookdevError):
+    """A material cannot become a Mitsuba BSDF or scene as asked."""
+
+
+# How each lobe name a model's ``prepare`` records shows up in Mitsuba's flags. A model
+# records the lobes it kept under ``prepared["lobes"]``; names are the models' own.
+_DIFFUSE_R = "DiffuseReflection"
+_GLOSSY_R = "GlossyReflection"
+_DIFFUSE_T = "DiffuseTransmission"
+_GLOSSY_T = "GlossyTransmission"
+LOBE_KINDS: dict[str, str] = {
+    # Disney (Burley 2012, Schutte 2015)
+    "diffuse": _DIFFUSE_R,
+    "retro": _DIFFUSE_R,
+    "retro_reflection": _DIFFUSE_R,
+    "subsurface": _DIFFUSE_R,
+    "flatness": _DIFFUSE_R,
+    "sheen": _GLOSSY_R,
+    "specular": _GLOSSY_R,
+    "clearcoat": _GLOSSY_R,
+    "spec_trans": _GLOSSY_T,
+    "specular_transmission": _GLOSSY_T,
+    "transmission": _GLOSSY_T,
+    "diff_trans": _DIFFUSE_T,
+    "diffuse_transmission": _DIFFUSE_T,
+    # Pixar (Smits): diffuse, specular, reflection and their transmitted twins
+    "reflection": _GLOSSY_R,
+    "diffuse_t": _DIFFUSE_T,
+    "specular_t": _GLOSSY_T,
+    "reflection_t": _GLOSSY_T,
+    "diff": _DIFFUSE_R,
+    "spec": _GLOSSY_R,
+    "refl": _GLOSSY_R,
+    "diff_t": _DIFFUSE_T,
+    "spec_t": _GLOSSY_T,
+    "refl_t": _GLOSSY_T,
+}
+
+
+def lobes_of(prepared: Any) -> tuple[str, ...]:
+    """The lobe names a prepared material kept (``prepared["lobes"]`` or ``.lobes``)."""
+    lobes = prepared.get("lobes") if isinstance(prepared, dict) else prepared.lobes
+    if lobes is None:
+        raise MitsubaExportError("the model's prepare() does not record its 'lobes'")
+    return tuple(lobes)
+
+
+def lobe_kinds(lobes: Iterable[str], model_name: str) -> set[str]:
+    """Mitsuba flag names of the given lobes; an unknown name is an error, not a guess."""
+    kinds = set()
+    for lobe in lobes:
+        if lobe not in LOBE_KINDS:
+            raise MitsubaExportError(
+                f"lobe {lobe!r} of model {model_name!r} has no Mitsuba flag; "
+                f"known: {', '.join(sorted(LOBE_KINDS))}"
+            )
+        kinds.add(LOBE_KINDS[lobe])
+    return kinds
+
+
+def is_color_field(params_type: type, field: str) -> bool:
+    """True when a schema field holds an RGB triple (its texture is evaluated as colour)."""
+    annotation = params_type.model_fields[field].annotation
+    while typing.get_origin(annotation) is typing.Annotated:
+        annotation = typing.get_args(annotation)[0]
+    return typing.get_origin(annotation) is tuple
+
+
+def plugin_name(model: Model) -> str:
+    """The Mitsuba plugin name of a model: ``lookdev_<model.name>``."""
+    return PLUGIN_PREFIX + model.name
+
+
+def register_model(model: Model) -> str:
+    """Register ``model`` as a Mitsuba BSDF plugin for the current variant; its name."""
+    import mitsuba as mi
+
+    name = plugin_name(model)
+    key = (mi.variant(), name, id(model))
+    if key not in _REGISTERED:
+        cls = _plugin_class(mi.variant())
+        mi.register_bsdf(name, lambda props: cls(props, model))
+        _REGISTERED.add(key)
+    return name
+
+
+_REGISTERED: set[tuple[str, str, int]] = set()
+
+
+@functools.cache
+def _plugin_class(variant: str) -> type:
+    """The adapter class for one Mitsuba variant (``mi.BSDF`` differs per variant)."""
+    import drjit as dr
+    import mitsuba as mi
+
+    flag = mi.BSDFFlags
+
+    class ModelBSDF(mi.BSDF):
+        """A lookdev Model as a Mitsuba BSDF (see the module docstring)."""
+
+        def __init__(self, props: mi.Properties, model: Model):
+            mi.BSDF.__init__(self, props)
+            self.model = model
+            self.xp = DrJitOps.for_mitsuba()
+            fields = model.params_type.model_fields
+            self.force_all_lobes = False
+            self.constants: dict[str, Any] = {}
+            self.textures: dict[str, mi.Texture] = {}
+            for key in props.keys():
+                value = props[key]
+                if key == FORCE_ALL_LOBES:
+                    self.force_all_lobes = bool(value)
+                elif key not in fields:
+                    raise MitsubaExportError(
+                        f"unknown parameter; allowed: {', '.join(fields)}",
+                        where=plugin_name(model),
+                        field=key,
+                    )
+                elif isinstance(value, mi.Texture):
+                    self.textures[key] = value
+                else:
+                    self.constants[key] = _python_value(value)
+            self.traversed = {k: _drjit_value(v) for k, v in self.constants.items()}
+            self._configure()
+
+        # -- parameters ----------------------------------------------------------------
+        def _configure(self) -> None:
+            """Validate the constants and derive flags from the lobes ``prepare`` keeps."""
+            self.params = self.model.params_type.parse(
+                self.constants, where=plugin_name(self.model)
+            )
+            placeholders = {k: self._placeholder(k) for k in self.textures}
+            prepared = self.model.prepare(self.xp, self.params, **self._forced(), **placeholders)
+            kinds = lobe_kinds(lobes_of(prepared), self.model.name)
+            reflect = [getattr(flag, k) for k in sorted(kinds) if "Reflection" in k]
+            transmit = [getattr(flag, k) for k in sorted(kinds) if "Transmission" in k]
+            self.components = [_union(reflect, flag), _union(transmit, flag)]
+            # Mitsuba numbers only the components that exist: reflection first.
+            self.component_index = (0, 1 if reflect else 0)
+            extra = flag.FrontSide | flag.BackSide
+            if self.textures:
+                extra |= flag.SpatiallyVarying
+            if getattr(self.params, "anisotropic", 0):
+                extra |= flag.Anisotropic
+            self.m_components = [c | extra for c in self.components if c != flag.Empty]
+            self.m_flags = functools.reduce(lambda a, b: a | b, self.m_components, flag.Empty)
+
+        def _placeholder(self, field: str) -> Any:
+            # A texture may be non-zero somewhere: an opaque value keeps its lobe alive.
+            if is_color_field(self.model.params_type, field):
+                return self.xp.Array3(dr.opaque(mi.Float, 0.5))
+            return dr.opaque(mi.Float, 0.5)
+
+        def _forced(self) -> dict[str, Any]:
+            """Numeric constants as Dr.Jit arrays when every lobe must be traced."""
+            if not self.force_all_lobes:
+                return {}
+            forced = {}
+            for key, value in self.constants.items():
+                if isinstance(value, tuple):
+                    forced[key] = self.xp.Array3(*(mi.Float(c) for c in value))
+                elif isinstance(value, float):
+                    forced[key] = mi.Float(value)
+            return forced
+
+        def _prepare(self, si: mi.SurfaceInteraction3f, active: mi.Bool) -> Any:
+            maps = self._forced()
+            for key, tex in self.textures.items():
+                if is_color_field(self.model.params_type, key):
+                    maps[key] = self.xp.Array3(tex.eval(si, active))
+                else:
+                    maps[key] = tex.eval_1(si, active)
+            return self.model.prepare(self.xp, self.params, **maps)
+
+        def traverse(self, callback: Any) -> None:
+            for key, value in self.traversed.items():
+                callback.put(key, value, mi.ParamFlags.NonDifferentiable)
+            for key, tex in self.textures.items():
+                callback.put(key, tex, mi.ParamFlags.NonDifferentiable)
+
+        def parameters_changed(self, keys: list[str]) -> None:
+            changed = [k for k in keys if k in self.traversed]
+            for key in changed:
+                self.constants[key] = _from_drjit(self.traversed[key], self.constants[key])
+            if changed:
+                self._configure()
+
+        # -- the BSDF interface --------------------------------------------------------
+        def _hemisphere_mask(
+            self, ctx: mi.BSDFContext, cos_view: mi.Float, cos_light: mi.Float
+        ) -> mi.Bool:
+            """Directions in a hemisphere whose component the context asks for."""
+            same_side = cos_view * cos_light > 0
+            want_r = ctx.is_enabled(self.components[0], 0)
+            want_t = ctx.is_enabled(self.components[1], self.component_index[1])
+            return (same_side & want_r) | (~same_side & want_t)
+
+        def eval(self, ctx, si, wo, active=True):
+            prepared = self._prepare(si, active)
+            f = self.model.eval(self.xp, prepared, wo, si.wi)  # ours: wi = light, wo = viewer
+            ok = active & self._hemisphere_mask(ctx, si.wi.z, wo.z)
+            return dr.select(ok, mi.Spectrum(f) * dr.abs(wo.z), 0.0)
+
+        def pdf(self, ctx, si, wo, active=True):
+            prepared = self._prepare(si, active)
+            pdf = self.model.pdf(self.xp, prepared, wo, si.wi)
+            ok = active & self._hemisphere_mask(ctx, si.wi.z, wo.z)
+            return dr.select(ok, mi.Float(pdf), 0.0)
+
+        def eval_pdf(self, ctx, si, wo, active=True):
+            prepared = self._prepare(si, active)
+            f = self.model.eval(self.xp, prepared, wo, si.wi)
+            pdf = self.model.pdf(self.xp, prepared, wo, si.wi)
+            ok = active & self._hemisphere_mask(ctx, si.wi.z, wo.z)
+            return (
+                dr.select(ok, mi.Spectrum(f) * dr.abs(wo.z), 0.0),
+                dr.select(ok, mi.Float(pdf), 0.0),
+            )
+
+        def sample(self, ctx, si, sample1, sample2, active=True):
+            prepared = self._prepare(si, active)
+            u = self.xp.vec3(sample1, sample2.x, sample2.y)
+            wi, weight, pdf = self.model.sample(self.xp, prepared, si.wi, u)
+            bs = dr.zeros(mi.BSDFSample3f)
+            bs.wo = mi.Vector3f(wi)
+            bs.pdf = mi.Float(pdf)
+            bs.eta = 1.0
+            reflected = si.wi.z * bs.wo.z > 0
+            bs.sampled_component = dr.select(
+                reflected, mi.UInt32(self.component_index[0]), mi.UInt32(self.component_index[1])
+            )
+            bs.sampled_type = dr.select(
+                reflected,
+                mi.UInt32(_leading(self.components[0], flag)),
+                mi.UInt32(_leading(self.components[1], flag)),
+            )
+            ok = active & (bs.pdf > 0) & self._hemisphere_mask(ctx, si.wi.z, bs.wo.z)
+            value = dr.select(ok, mi.Spectrum(weight), 0.0)
+            bs.pdf = dr.select(ok, bs.pdf, 0.0)
+            return bs, value
+
+        def to_string(self) -> str:
+            return f"ModelBSDF[model={self.model.name!r}, lobes={self.m_flags!r}]"
+
+    return ModelBSDF
+
+
+def _union(flags: list[Any], flag: Any) -> Any:
+    return functools.reduce(lambda a, b: a | b, flags, flag.Empty)
+
+
+def _leading(component: Any, flag: Any) -> int:
+    """The sampled type reported for a component: glossy if it has a glossy lobe."""
+    for kind in (flag.GlossyReflection, flag.GlossyTransmission):
+        if component & kind:
+            return int(kind)
+    for kind in (flag.DiffuseReflection, flag.DiffuseTransmission):
+        if component & kind:
+            return int(kind)
+    return 0
+
+
+def _python_value(value: Any) -> Any:
+    """A Mitsuba property as a plain value for the pydantic schema."""
+    if isinstance(value, bool | int | float | str):
+        return float(value) if isinstance(value, int) and not isinstance(value, bool) else value
+    try:
+        return tuple(float(c) for c in value)  # ScalarColor3f / ScalarColor3d
+    except TypeError:
+        return value
+
+
+def _drjit_value(value: Any) -> Any:
+    """A constant as the Dr.Jit value ``mi.traverse`` exposes (str/bool stay as they are)."""
+    import mitsuba as mi
+
+    if isinstance(value, tuple):
+        return mi.Color3f(*value)
+    if isinstance(value, float):
+        return mi.Float(value)
+    return value
+
+
+def _from_drjit(value: Any, old: Any) -> Any:
+    """The updated traversed value back as the constant's Python type."""
+    if isinstance(old, tuple):
+        return tuple(float(value[i][0]) for i in range(3))
+    if isinstance(old, float):
+        return float(value[0])
+    return value
