@@ -30,3 +30,12 @@ def best_time(fn: Callable[[], Any], *, repeat: int = 3, min_time: float = 0.0) 
         if min_time and sum(times) > min_time and len(times) >= 2:
             break
     return min(times)
+
+
+def _register() -> None:
+    from lookdev.pipeline.analysis import error_bench
+
+    app.command("error")(error_bench.command)
+
+
+_register()

@@ -1,0 +1,323 @@
+"""``lookdev bench error``: every approximation's error against its run time, in one run.
+
+Items (see :mod:`.measure` for how each is measured):
+
+========== ==============================================================================
+render     proof renders of a diffuse, glossy metal, clearcoat, sheen and glass preset:
+           relative MSE against a high-sample reference, for a ladder of spp
+albedo     directional albedo by quadrature, Monte Carlo and the shipped table
+lambda     the Conty-Kulla Λ fit against numerical integration
+precision  float32 against float64 evaluation of every model
+========== ==============================================================================
+
+Outputs: a Rich table, ``error_bench.json`` (every row, the settings and the machine)
+and ``error_bench.png`` (log-log error against time, one panel per item) in ``-o DIR``.
+An item that cannot run here (a model or preset missing) is listed with the reason, never
+silently dropped.
+"""
+
+from __future__ import annotations
+
+import json
+import platform
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Annotated, Any
+
+import numpy as np
+import typer
+
+from lookdev.materials.bsdf import Model
+from lookdev.materials.errors import LookdevError
+
+from . import measure
+from .measure import Row
+
+ITEMS = ("render", "albedo", "lambda", "precision")
+MODEL_NAMES = ("disney", "pixar")
+
+# Proof-render cases: label → built-in preset name.
+RENDER_PRESETS: dict[str, str] = {
+    "diffuse": "chalk",
+    "glossy metal": "gold",
+    "clearcoat": "car_paint",
+    "sheen": "velvet",
+    "glass": "glass",
+}
+
+
+@dataclass(frozen=True)
+class Settings:
+    """How far each ladder goes; ``quick()`` is for tests and CI."""
+
+    render_ladder: tuple[int, ...] = (1, 4, 16, 64)
+    render_reference_spp: int = 1024
+    render_resolution: int = 32
+    quadrature: tuple[int, ...] = (8, 16, 32, 64, 128)
+    samples: tuple[int, ...] = (64, 256, 1024, 4096)
+    albedo_reference_nodes: int = 512
+    lambda_nodes: tuple[int, ...] = (8, 16, 32, 64, 128)
+    lambda_reference_nodes: int = 2048
+    precision_pairs: int = 20000
+
+    @classmethod
+    def quick(cls) -> Settings:
+        return cls((1, 4, 16), 128, 16, (8, 16, 32), (64, 256), 128, (8, 32), 512, 2000)
+
+
+@dataclass
+class Report:
+    rows: list[Row] = field(default_factory=list)
+    skipped: dict[str, str] = field(default_factory=dict)  # "item: case" → reason
+
+    def to_json(self, settings: Settings) -> dict[str, Any]:
+        return {
+            "settings": asdict(settings),
+            "machine": {"python": platform.python_version(), "platform": platform.platform()},
+            "rows": [
+                {**asdict(r), "seconds_per_evaluation": r.seconds_per_evaluation} for r in self.rows
+            ],
+            "skipped": self.skipped,
+        }
+
+
+class BenchError(LookdevError):
+    """The error bench cannot run as asked."""
+
+
+# -- what there is to measure --------------------------------------------------------
+def available_models() -> dict[str, Model]:
+    """Every installed reflectance model by name."""
+    from .plots import PlotError, model_named
+
+    found = {}
+    for name in MODEL_NAMES:
+        try:
+            found[name] = model_named(name)
+        except PlotError:
+            continue
+    return found
+
+
+def model_cases(models: dict[str, Model]) -> list[tuple[str, Model, Any]]:
+    """(label, model, params): each model's defaults and its roughness extremes."""
+    cases = []
+    for name, model in models.items():
+        default = model.params_type()
+        cases.append((f"{name} default", model, default))
+        if "roughness" in type(default).model_fields:
+            cases.append((f"{name} roughness 0", model, default.replace(roughness=0.0)))
+            cases.append((f"{name} roughness 1", model, default.replace(roughness=1.0)))
+    return cases
+
+
+def lambda_fit() -> Callable[[np.ndarray, float], np.ndarray] | None:
+    """The shipped Conty-Kulla Λ fit as ``fit(cos_theta, r)``, or None."""
+    try:
+        from lookdev.materials import sheen
+    except ImportError:
+        return None
+    return getattr(sheen, "ck_lambda", None)
+
+
+def render_cases(library: Any = None) -> tuple[list[tuple[str, dict, int]], dict[str, str]]:
+    """(label, Mitsuba BSDF dict, max depth) per render case, and the reasons for gaps."""
+    cases, missing = [], {}
+    try:
+        from lookdev.library import load_material
+        from lookdev.pipeline.export.mitsuba import bsdf_dict, max_depth_for, register_plugins
+    except ImportError as exc:
+        return [], {f"render: {label}": f"not available: {exc}" for label in RENDER_PRESETS}
+    register_plugins()
+    for label, preset in RENDER_PRESETS.items():
+        try:
+            material = load_material(preset, library)
+            cases.append((f"{label} ({preset})", bsdf_dict(material), max_depth_for(material)))
+        except LookdevError as exc:
+            missing[f"render: {label}"] = str(exc)
+    return cases, missing
+
+
+# -- running -------------------------------------------------------------------------
+def run(
+    settings: Settings,
+    items: tuple[str, ...] = ITEMS,
+    *,
+    render: list[tuple[str, dict, int]] | None = None,
+    models: dict[str, Model] | None = None,
+    environment: np.ndarray | None = None,
+    progress: Callable[[str], None] = lambda task: None,
+) -> Report:
+    """Measure every asked item now. ``render``/``models`` override what is discovered."""
+    report = Report()
+    models = available_models() if models is None else models
+    if not models:
+        report.skipped["albedo, precision"] = "no reflectance model is installed"
+    tasks: list[tuple[str, Callable[[], list[Row]]]] = []
+    if "render" in items:
+        from lookdev.pipeline.variant import use_mitsuba
+
+        use_mitsuba()
+        if render is None:
+            render, gaps = render_cases()
+            report.skipped.update(gaps)
+        env = measure.default_environment() if environment is None else environment
+        for label, bsdf, depth in render:
+            tasks.append(
+                (
+                    f"render {label}",
+                    lambda b=bsdf, d=depth, lab=label: measure.bench_render(
+                        lab,
+                        b,
+                        env,
+                        max_depth=d,
+                        ladder=settings.render_ladder,
+                        reference_spp=settings.render_reference_spp,
+                        resolution=settings.render_resolution,
+                    ),
+                )
+            )
+    if "albedo" in items:
+        for label, model, params in model_cases(models):
+            tasks.append(
+                (
+                    f"albedo {label}",
+                    lambda m=model, p=params, lab=label: measure.bench_albedo(
+                        lab,
+                        m,
+                        p,
+                        quadrature=settings.quadrature,
+                        samples=settings.samples,
+                        reference_nodes=settings.albedo_reference_nodes,
+                    ),
+                )
+            )
+    if "lambda" in items:
+        fit = lambda_fit()
+        if fit is None:
+            report.skipped["lambda: fit"] = "lookdev.materials.sheen.ck_lambda is not installed"
+        tasks.append(
+            (
+                "lambda",
+                lambda: measure.bench_lambda(
+                    fit,
+                    nodes=settings.lambda_nodes,
+                    reference_nodes=settings.lambda_reference_nodes,
+                ),
+            )
+        )
+    if "precision" in items:
+        for label, model, params in model_cases(models):
+            tasks.append(
+                (
+                    f"precision {label}",
+                    lambda m=model, p=params, lab=label: measure.bench_precision(
+                        lab, m, p, n=settings.precision_pairs
+                    ),
+                )
+            )
+    for name, task in tasks:
+        progress(name)
+        report.rows.extend(task())
+    return report
+
+
+# -- output ----------------------------------------------------------------------------
+def plot_error_vs_time(report: Report, path: Path) -> Path:
+    """Log-log error against seconds per call, one panel per item, one line per case."""
+    from .plots import plt, save_figure
+
+    items = [i for i in ITEMS if any(r.item == i for r in report.rows)]
+    fig, axes = plt.subplots(
+        1,
+        max(len(items), 1),
+        figsize=(4.2 * max(len(items), 1), 3.8),
+        layout="constrained",
+        squeeze=False,
+    )
+    ylabel = {"render": "relative MSE", "precision": "max relative error"}
+    for ax, item in zip(axes[0], items, strict=False):
+        rows = [r for r in report.rows if r.item == item]
+        for key in dict.fromkeys((r.case, r.method) for r in rows):
+            pts = [r for r in rows if (r.case, r.method) == key and r.error > 0]
+            if pts:
+                ax.loglog(
+                    [r.seconds for r in pts],
+                    [r.error for r in pts],
+                    "o-",
+                    ms=3,
+                    label=f"{key[0]}: {key[1]}",
+                )
+        ax.set_title(item)
+        ax.set_xlabel("seconds per call")
+        ax.set_ylabel(ylabel.get(item, "relative RMS error"))
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize="xx-small")
+    return save_figure(fig, path)
+
+
+def write_outputs(report: Report, settings: Settings, out_dir: Path) -> dict[str, Path]:
+    """``error_bench.json`` and ``error_bench.png`` in ``out_dir``, each written whole."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    js = out_dir / "error_bench.json"
+    tmp = js.with_suffix(".json.tmp")
+    tmp.write_text(json.dumps(report.to_json(settings), indent=2) + "\n")
+    tmp.replace(js)
+    return {"json": js, "plot": plot_error_vs_time(report, out_dir / "error_bench.png")}
+
+
+def command(
+    out_dir: Annotated[
+        Path,
+        typer.Option(
+            "--output", "-o", help="Folder for error_bench.json and .png.", file_okay=False
+        ),
+    ] = Path("error_bench"),
+    item: Annotated[
+        list[str] | None,
+        typer.Option("--item", "-i", help=f"Measure only these items: {', '.join(ITEMS)}."),
+    ] = None,
+    quick: Annotated[bool, typer.Option("--quick", help="Short ladders (CI, tests).")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+) -> None:
+    """Error against run time of every approximation lookdev makes, measured now.
+
+    Proof renders (relMSE vs spp and time), directional albedo (quadrature, Monte Carlo,
+    table), the Conty-Kulla Λ fit vs numerical integration, and float32 vs float64
+    evaluation of every model. Writes a table, error_bench.json and a log-log plot.
+    """
+    from rich.progress import Progress
+
+    from lookdev.pipeline.cli.common import console, print_json, table
+
+    items = tuple(item or ITEMS)
+    unknown = [i for i in items if i not in ITEMS]
+    if unknown:
+        raise BenchError(f"unknown item {unknown[0]!r}; allowed {', '.join(ITEMS)}", field="--item")
+    settings = Settings.quick() if quick else Settings()
+    start = time.perf_counter()
+    with Progress(console=console, transient=True, disable=as_json) as bar:
+        task = bar.add_task("measuring", total=None)
+        report = run(settings, items, progress=lambda name: bar.update(task, description=name))
+    paths = write_outputs(report, settings, out_dir)
+    if as_json:
+        print_json({**report.to_json(settings), "outputs": {k: str(v) for k, v in paths.items()}})
+        return
+    rows = [
+        [r.item, r.case, r.method, r.setting, r.error, r.seconds, r.seconds_per_evaluation]
+        for r in report.rows
+    ]
+    console.print(
+        table(
+            "error against run time",
+            ["item", "case", "method", "setting", "error", "s/call", "s/eval"],
+            rows,
+        )
+    )
+    for what, why in report.skipped.items():
+        console.print(f"[yellow]skipped[/] {what}: {why}")
+    console.print(
+        f"wrote {paths['json']} and {paths['plot']} in {time.perf_counter() - start:.1f} s"
+    )

@@ -1,0 +1,323 @@
+"""Measurements behind ``lookdev bench error``: each approximation against its reference.
+
+* proof renders — relative MSE against a high-sample reference, for a ladder of samples
+  per pixel, against render time;
+* directional albedo — quadrature, Monte Carlo with the model's own importance sampling,
+  and a shipped table, against a converged quadrature;
+* the Conty-Kulla Λ fit (2017, eq. 3, Table 1) against numerical integration of the
+  projected area of their D (eq. 2), per evaluation;
+* float32 against float64 evaluation of a model.
+
+Each function returns :class:`Row` s measured when it is called: errors are relative and
+dimensionless; ``seconds`` is the best of a few calls after a warm-up.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from lookdev.materials.bsdf import Model, evaluate
+
+from .albedo import albedo_monte_carlo, albedo_quadrature, albedo_tabulated
+
+
+@dataclass(frozen=True)
+class Row:
+    """One measurement: ``case`` computed by ``method`` at ``setting``."""
+
+    item: str
+    case: str
+    method: str
+    setting: str
+    error: float
+    seconds: float
+    evaluations: int = 1
+
+    @property
+    def seconds_per_evaluation(self) -> float:
+        return self.seconds / max(self.evaluations, 1)
+
+
+def timed(fn: Callable[[], Any], repeat: int = 3) -> tuple[Any, float]:
+    """(result, best wall time of ``repeat`` calls after a warm-up)."""
+    from lookdev.pipeline.cli.bench import best_time
+
+    result = fn()
+    return result, best_time(fn, repeat=repeat, min_time=2.0)
+
+
+def relative_rms(estimate: np.ndarray, reference: np.ndarray, floor: float = 1e-3) -> float:
+    """√mean(((x − ref) / max(|ref|, floor))²) over every element.
+
+    >>> relative_rms(np.array([1.1, 2.0]), np.array([1.0, 2.0])).round(6).item()
+    0.070711
+    """
+    rel = (estimate - reference) / np.maximum(np.abs(reference), floor)
+    return float(np.sqrt(np.mean(rel * rel)))
+
+
+# -- albedo ----------------------------------------------------------------------------
+ALBEDO_ANGLES = np.radians([0.0, 20.0, 40.0, 60.0, 75.0, 85.0])
+
+
+def bench_albedo(
+    case: str,
+    model: Model,
+    params: Any,
+    *,
+    quadrature: Sequence[int] = (8, 16, 32, 64, 128),
+    samples: Sequence[int] = (64, 256, 1024, 4096),
+    reference_nodes: int = 512,
+) -> list[Row]:
+    """Error against time of each albedo estimator for one material."""
+    theta = ALBEDO_ANGLES
+    reference = albedo_quadrature(
+        model, params, theta, n_mu=reference_nodes, n_phi=reference_nodes
+    ).albedo
+    rows = []
+    for n in quadrature:
+        curve, t = timed(lambda n=n: albedo_quadrature(model, params, theta, n_mu=n, n_phi=n))
+        rows.append(
+            Row(
+                "albedo",
+                case,
+                "quadrature",
+                f"{n}×{n}",
+                relative_rms(curve.albedo, reference),
+                t,
+                n * n * len(theta),
+            )
+        )
+    for n in samples:
+        curve, t = timed(lambda n=n: albedo_monte_carlo(model, params, theta, n_samples=n))
+        rows.append(
+            Row(
+                "albedo",
+                case,
+                "monte carlo",
+                f"{n} spp",
+                relative_rms(curve.albedo, reference),
+                t,
+                n * len(theta),
+            )
+        )
+    table, t = timed(lambda: albedo_tabulated(model, params, theta))
+    if table is not None:
+        rows.append(
+            Row(
+                "albedo",
+                case,
+                "table",
+                "shipped",
+                relative_rms(table.albedo, reference),
+                t,
+                len(theta),
+            )
+        )
+    return rows
+
+
+# -- Conty-Kulla Λ -------------------------------------------------------------------
+def projected_area(cos_theta: np.ndarray, r: float, nodes: int, split: bool = True) -> np.ndarray:
+    """∫ ⟨ω·m⟩ D(m) dm for Conty-Kulla's D (eq. 2), by Gauss-Legendre over θm.
+
+    The φm integral is closed-form: ∫ max(0, a cos φ + b) dφ = 2(a sin φ0 + b φ0) with
+    cos φ0 = −b/a clamped, where a = sin θ sin θm and b = cos θ cos θm. Its kink at
+    θm = π/2 − θ is where Gauss-Legendre converges slowly; ``split`` integrates either
+    side of it separately, which is how the reference converges to machine precision.
+    Then Λ(θ) = projected_area / cos θ − 1 (Heitz 2014, eq. 17).
+    """
+    ct = np.atleast_1d(np.asarray(cos_theta, dtype=np.float64))[:, None]
+    st = np.sqrt(np.clip(1.0 - ct * ct, 0.0, 1.0))
+    x, w = np.polynomial.legendre.leggauss(nodes)
+    kink = np.clip(math.pi / 2 - np.arccos(ct), 0.0, math.pi / 2) if split else None
+    pieces = (
+        [(np.zeros_like(ct), kink), (kink, np.full_like(ct, math.pi / 2))]
+        if split
+        else [(np.zeros_like(ct), np.full_like(ct, math.pi / 2))]
+    )
+    total = np.zeros(ct.shape[0])
+    for lo, hi in pieces:
+        tm = lo + (hi - lo) * 0.5 * (x + 1.0)
+        a, b = st * np.sin(tm), ct * np.cos(tm)
+        phi0 = np.arccos(np.clip(-b / np.where(a > 0, a, 1.0), -1.0, 1.0))
+        phi0 = np.where(a > 0, phi0, np.where(b > 0, math.pi, 0.0))
+        ring = 2.0 * (a * np.sin(phi0) + b * phi0)
+        d = (2.0 + 1.0 / r) * np.power(np.sin(tm), 1.0 / r) / (2.0 * math.pi)
+        total += (hi - lo)[:, 0] * 0.5 * ((ring * d * np.sin(tm)) @ w)
+    return total
+
+
+def lambda_numerical(cos_theta: np.ndarray, r: float, nodes: int, split: bool = True) -> np.ndarray:
+    """Λ(θ) of Conty-Kulla's D from the projected-area identity, numerically."""
+    ct = np.atleast_1d(np.asarray(cos_theta, dtype=np.float64))
+    return projected_area(ct, r, nodes, split) / ct - 1.0
+
+
+LAMBDA_COS = np.linspace(0.02, 1.0, 50)
+LAMBDA_ROUGHNESS = (0.1, 0.3, 0.5, 1.0)
+
+
+def bench_lambda(
+    fit: Callable[[np.ndarray, float], np.ndarray] | None,
+    *,
+    nodes: Sequence[int] = (8, 16, 32, 64, 128),
+    reference_nodes: int = 2048,
+) -> list[Row]:
+    """The Λ fit and plain Gauss-Legendre against the split, converged integral."""
+    rows = []
+    n_eval = len(LAMBDA_COS)
+    for r in LAMBDA_ROUGHNESS:
+        ref = lambda_numerical(LAMBDA_COS, r, reference_nodes)
+        case = f"r = {r:g}"
+        if fit is not None:
+            value, t = timed(lambda r=r: np.asarray(fit(LAMBDA_COS, r), dtype=np.float64))
+            rows.append(
+                Row("lambda", case, "fit (eq. 3)", "Table 1", relative_rms(value, ref), t, n_eval)
+            )
+        for n in nodes:
+            value, t = timed(lambda n=n, r=r: lambda_numerical(LAMBDA_COS, r, n, split=False))
+            rows.append(
+                Row("lambda", case, "numerical", f"{n} nodes", relative_rms(value, ref), t, n_eval)
+            )
+    return rows
+
+
+# -- float32 against float64 -----------------------------------------------------------
+def direction_pairs(n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Random (wi, wo) pairs over both hemispheres, plus the edge cases DESIGN.md lists:
+    normal incidence, grazing (cos θ = 1e-4), retro-reflection and wi = −wo."""
+    rng = np.random.default_rng(seed)
+    v = rng.normal(size=(2, n, 3))
+    v /= np.linalg.norm(v, axis=-1, keepdims=True)
+    v[..., 2] = np.abs(v[..., 2])
+    v[1, : n // 10, 2] *= -1  # transmission pairs
+    g = math.sqrt(1.0 - 1e-8)
+    edges = np.array(
+        [
+            [[0, 0, 1.0], [0, 0, 1.0]],
+            [[g, 0, 1e-4], [0, 0, 1.0]],
+            [[g, 0, 1e-4], [-g, 0, 1e-4]],
+            [[0.6, 0, 0.8], [0.6, 0, 0.8]],
+            [[0.6, 0, 0.8], [-0.6, 0, -0.8]],
+        ]
+    ).transpose(1, 0, 2)
+    out = np.concatenate([v, edges], axis=1)
+    return out[0], out[1]
+
+
+def bench_precision(case: str, model: Model, params: Any, n: int = 20000) -> list[Row]:
+    """Relative difference of float32 evaluation against float64, and both times."""
+    wi, wo = direction_pairs(n)
+    f64, t64 = timed(lambda: evaluate(model, params, wi, wo, dtype=np.float64))
+    f32, t32 = timed(lambda: evaluate(model, params, wi, wo, dtype=np.float32))
+    finite = np.isfinite(f64)
+    scale = np.maximum(np.abs(f64), 1e-6 * max(float(np.abs(f64[finite]).max(initial=0)), 1e-30))
+    rel = np.where(finite, np.abs(f32.astype(np.float64) - f64) / scale, np.inf)
+    bad32 = int((~np.isfinite(f32)).sum())
+    note = f"{n + 5} pairs" + (f", {bad32} non-finite" if bad32 else "")
+    return [
+        Row("precision", case, "float64", note, 0.0, t64, n + 5),
+        Row(
+            "precision", case, "float32", note, float(np.max(rel[finite], initial=0.0)), t32, n + 5
+        ),
+    ]
+
+
+# -- proof renders ---------------------------------------------------------------------
+def relative_mse(image: np.ndarray, reference: np.ndarray, eps: float = 1e-2) -> float:
+    """mean((x − ref)² / (ref² + ε)): relMSE as in Rousselle et al. 2011, §6.
+
+    >>> relative_mse(np.full(4, 1.1), np.ones(4), eps=0.0).round(6).item()
+    0.01
+    """
+    return float(np.mean((image - reference) ** 2 / (reference**2 + eps)))
+
+
+def default_environment(width: int = 64) -> np.ndarray:
+    """A small lat-long studio for benchmarking: dim floor, graded sky, one soft box."""
+    h = width // 2
+    v = (np.arange(h) + 0.5) / h
+    u = (np.arange(width) + 0.5) / width
+    sky = np.where(v < 0.5, 0.6 + 0.8 * (0.5 - v), 0.15)[:, None, None] * np.ones((1, width, 3))
+    box = (np.abs(v[:, None] - 0.3) < 0.08) & (np.abs(u[None, :] - 0.45) < 0.06)
+    return sky + 12.0 * box[..., None] * np.array([1.0, 0.95, 0.9])
+
+
+def proof_scene(bsdf: dict, environment: np.ndarray, resolution: int, max_depth: int) -> Any:
+    """A sphere on black, lit by ``environment``, seen by a perspective camera.
+
+    The environment is hidden from the camera and alpha is kept, so the error is taken
+    over the material's pixels only, not diluted by a noiseless background.
+    """
+    import mitsuba as mi
+
+    return mi.load_dict(
+        {
+            "type": "scene",
+            "integrator": {"type": "path", "max_depth": max_depth, "hide_emitters": True},
+            "sensor": {
+                "type": "perspective",
+                "fov": 30,
+                "to_world": mi.ScalarTransform4f().look_at(
+                    origin=[0, 0, 4.2], target=[0, 0, 0], up=[0, 1, 0]
+                ),
+                "film": {
+                    "type": "hdrfilm",
+                    "width": resolution,
+                    "height": resolution,
+                    "pixel_format": "rgba",
+                    "rfilter": {"type": "box"},
+                },
+                "sampler": {"type": "independent"},
+            },
+            "emitter": {
+                "type": "envmap",
+                "bitmap": mi.Bitmap(np.ascontiguousarray(environment, dtype=np.float32)),
+            },
+            "shape": {"type": "sphere", "bsdf": bsdf},
+        }
+    )
+
+
+def bench_render(
+    case: str,
+    bsdf: dict,
+    environment: np.ndarray,
+    *,
+    max_depth: int = 8,
+    ladder: Sequence[int] = (1, 4, 16, 64),
+    reference_spp: int = 1024,
+    resolution: int = 32,
+) -> list[Row]:
+    """relMSE against a ``reference_spp`` render, and render time, for each rung."""
+    import mitsuba as mi
+
+    scene = proof_scene(bsdf, environment, resolution, max_depth)
+
+    def render(spp: int, seed: int) -> np.ndarray:
+        return np.array(mi.render(scene, spp=spp, seed=seed), dtype=np.float64)
+
+    reference = render(reference_spp, seed=10_000)
+    covered = reference[..., 3] > 0.5
+    reference = reference[covered, :3]
+    rows = []
+    for k, spp in enumerate(ladder):
+        image, t = timed(lambda spp=spp, k=k: render(spp, seed=k + 1), repeat=2)
+        rows.append(
+            Row(
+                "render",
+                case,
+                "path tracer",
+                f"{spp} spp",
+                relative_mse(image[covered, :3], reference),
+                t,
+                resolution * resolution * spp,
+            )
+        )
+    return rows

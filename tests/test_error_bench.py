@@ -1,0 +1,128 @@
+"""``lookdev bench error`` with tiny settings: every item measured, outputs written."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from _lambert import LAMBERT, PHONG
+
+from lookdev.pipeline.analysis import error_bench as E
+from lookdev.pipeline.analysis import measure as M
+
+TINY = E.Settings((1, 4, 16), 128, 12, (8, 32), (64, 1024), 128, (8, 32), 512, 500)
+
+
+def test_numerical_lambda_matches_an_independent_double_integral():
+    integrate = pytest.importorskip("scipy.integrate")
+    r, ct = 0.3, 0.5
+    st = math.sqrt(1 - ct * ct)
+
+    def integrand(phi, tm):
+        d = (2 + 1 / r) * math.sin(tm) ** (1 / r) / (2 * math.pi)  # Conty-Kulla eq. 2
+        return max(0.0, st * math.sin(tm) * math.cos(phi) + ct * math.cos(tm)) * d * math.sin(tm)
+
+    area, _ = integrate.dblquad(integrand, 0, math.pi / 2, -math.pi, math.pi, epsabs=1e-11)
+    assert M.lambda_numerical([ct], r, 512)[0] == pytest.approx(area / ct - 1, rel=1e-8)
+
+
+@pytest.mark.parametrize("r", [0.05, 0.5, 1.0])
+def test_lambda_is_zero_at_normal_incidence_and_grows_to_grazing(r):
+    lam = M.lambda_numerical(np.array([1.0, 0.7, 0.3, 1e-3]), r, 256)
+    assert abs(lam[0]) < 1e-10  # the projected area of a normalised D at θ = 0 is 1
+    assert np.all(np.diff(lam) > 0)
+
+
+def test_unsplit_quadrature_converges_to_the_split_reference():
+    rows = M.bench_lambda(None, nodes=(4, 16, 64), reference_nodes=1024)
+    for r in M.LAMBDA_ROUGHNESS:
+        errs = [row.error for row in rows if row.case == f"r = {r:g}"]
+        assert errs == sorted(errs, reverse=True) and errs[-1] < 1e-3
+
+
+def test_a_fit_is_measured_against_the_integral():
+    exact = lambda c, r: M.lambda_numerical(c, r, 1024)  # noqa: E731 - a perfect "fit"
+    rows = M.bench_lambda(exact, nodes=(8,), reference_nodes=1024)
+    fits = [row for row in rows if row.method.startswith("fit")]
+    assert len(fits) == len(M.LAMBDA_ROUGHNESS)
+    assert all(row.error < 1e-12 and row.seconds > 0 for row in fits)
+
+
+def test_albedo_rows_compare_each_estimator_with_the_converged_quadrature():
+    rows = M.bench_albedo(
+        "phong",
+        PHONG,
+        PHONG.params_type(exponent=30.0),
+        quadrature=(8, 64),
+        samples=(64, 4096),
+        reference_nodes=256,
+    )
+    by = {(r.method, r.setting): r for r in rows}
+    assert by[("quadrature", "64×64")].error < by[("quadrature", "8×8")].error
+    assert by[("monte carlo", "4096 spp")].error < by[("monte carlo", "64 spp")].error
+    assert all(r.seconds > 0 and r.evaluations > 0 for r in rows)
+
+
+def test_float32_against_float64_of_lambert_is_within_float32_precision():
+    rows = M.bench_precision("lambert", LAMBERT, LAMBERT.params_type(), n=1000)
+    f32 = next(r for r in rows if r.method == "float32")
+    assert 0 < f32.error < 1e-6
+
+
+def test_direction_pairs_cover_the_edges():
+    wi, wo = M.direction_pairs(100)
+    np.testing.assert_allclose(np.linalg.norm(wi, axis=-1), 1, atol=1e-12)
+    assert (wo[:, 2] < 0).any()  # transmission
+    assert np.any(np.all(wi == -wo, axis=-1))  # wi = −wo
+    assert (np.abs(wi[:, 2]) <= 1.0001e-4).any()  # grazing
+
+
+@pytest.mark.render
+def test_render_error_falls_like_one_over_spp():
+    from lookdev.pipeline.variant import use_mitsuba
+
+    use_mitsuba()
+    rows = M.bench_render(
+        "diffuse",
+        {"type": "diffuse"},
+        M.default_environment(32),
+        ladder=(1, 16),
+        reference_spp=512,
+        resolution=16,
+    )
+    e1, e16 = (r.error for r in rows)
+    assert 6 < e1 / e16 < 40  # 16× the samples: relMSE ÷ ~16 (Monte Carlo variance)
+
+
+def test_run_measures_every_item_and_writes_outputs(tmp_path):
+    from lookdev.pipeline.variant import use_mitsuba
+
+    use_mitsuba()
+    report = E.run(
+        TINY,
+        render=[("diffuse", {"type": "diffuse"}, 2)],
+        models={"lambert": LAMBERT, "phong": PHONG},
+    )
+    assert {r.item for r in report.rows} == set(E.ITEMS)
+    paths = E.write_outputs(report, TINY, tmp_path)
+    data = json.loads(paths["json"].read_text())
+    assert len(data["rows"]) == len(report.rows)
+    assert data["settings"]["render_ladder"] == [1, 4, 16]
+    assert paths["plot"].read_bytes()[:4] == b"\x89PNG"
+
+
+def test_cli_prints_one_json_object(cli, tmp_path):
+    res = cli("bench", "error", "--quick", "--item", "lambda", "-o", str(tmp_path), "--json")
+    assert res.code == 0, res.err
+    data = json.loads(res.out)
+    assert {r["item"] for r in data["rows"]} == {"lambda"}
+    assert (tmp_path / "error_bench.json").exists() and (tmp_path / "error_bench.png").exists()
+
+
+def test_cli_rejects_an_unknown_item_in_one_line(cli, tmp_path):
+    res = cli("bench", "error", "--item", "speed", "-o", str(tmp_path))
+    assert res.code == 2
+    assert "allowed render, albedo, lambda, precision" in res.err
+    assert "Traceback" not in res.err
