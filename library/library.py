@@ -1,0 +1,293 @@
+"""Preset libraries: a search path of folders, lookup with "did you mean", safe edits.
+
+The search path is, in order: the folders given to :class:`Library` (``--library``),
+then those in ``LOOKDEV_LIBRARY_PATH`` (``os.pathsep``-separated), then the built-in
+``presets/``. A name defined in several folders resolves to the first; the others are
+shadowed (``lookdev presets show`` names them). Presets are ``NAME.toml`` files anywhere
+below a folder; hidden files and folders are ignored.
+
+Writes go to one user folder (the first on the path unless another is named) and never
+to the built-in library; see :mod:`lookdev.library.store` for how they stay safe.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import Any
+
+import lookdev.presets
+
+from . import store
+from .errors import LibraryError, PresetError, PresetNotFoundError, did_you_mean
+from .index import SUFFIX, Header, scan_folder
+from .material import Material, resolve
+from .preset import METADATA, PresetFile, build_preset, check_name, dump_preset, parse_preset
+
+ENV_PATH = "LOOKDEV_LIBRARY_PATH"
+
+
+def builtin_folder() -> Path:
+    """The built-in ``presets/`` folder, from a checkout or an installed wheel."""
+    for entry in lookdev.presets.__path__:
+        if Path(entry).is_dir():
+            return Path(entry)
+    raise LibraryError("the built-in presets folder is missing from this installation")
+
+
+def read_preset(path: Path) -> PresetFile:
+    """Parse one preset file (its name must match the file name)."""
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise PresetError(f"cannot read ({exc.strerror or exc})", where=str(path)) from None
+    return parse_preset(data, where=str(path), stem=path.name.removesuffix(SUFFIX))
+
+
+class Library:
+    """The preset search path: user folders first, the built-in library last."""
+
+    def __init__(
+        self,
+        paths: Iterable[str | Path] | None = None,
+        *,
+        use_env: bool = True,
+        builtin: bool = True,
+    ):
+        user = [Path(p).expanduser() for p in paths or ()]
+        if use_env:
+            user += [
+                Path(p).expanduser() for p in os.environ.get(ENV_PATH, "").split(os.pathsep) if p
+            ]
+        self.user_folders: list[Path] = list(dict.fromkeys(user))
+        self.builtin = builtin_folder() if builtin else None
+        self.folders = [*self.user_folders, *([self.builtin] if self.builtin else [])]
+        self._builtin_headers: list[Header] | None = None
+
+    # -- reading -----------------------------------------------------------------------
+
+    def headers(self) -> list[Header]:
+        """Every preset file on the path, in search order (shadowed ones included)."""
+        out: list[Header] = []
+        for folder in self.folders:
+            if not folder.is_dir():
+                raise LibraryError("library folder does not exist", where=str(folder))
+            try:
+                out += self._scan(folder)
+            except OSError as exc:
+                raise LibraryError(
+                    f"cannot read ({exc.strerror or exc})", where=str(folder)
+                ) from None
+        return out
+
+    def entries(self) -> list[Header]:
+        """The preset each name resolves to (first on the path), sorted by name.
+
+        A header whose ``model`` is inherited through ``extends`` gets its parent's.
+        """
+        winners: dict[str, Header] = {}
+        for h in self.headers():
+            winners.setdefault(h.name, h)
+        return [_with_model(winners[n], winners) for n in sorted(winners)]
+
+    def _scan(self, folder: Path) -> list[Header]:
+        if folder != self.builtin:
+            return scan_folder(folder)
+        # Read-only and small: scanned once per Library, never indexed on disk.
+        if self._builtin_headers is None:
+            self._builtin_headers = scan_folder(folder, cache=False)
+        return self._builtin_headers
+
+    def _find_in(self, folder: Path, name: str) -> Path | None:
+        """The file defining ``name`` in one library folder, or None."""
+        direct = folder / f"{name}{SUFFIX}"
+        if direct.is_file():
+            return direct
+        if not folder.is_dir():
+            return None
+        return next((h.path for h in self._scan(folder) if h.name == name), None)
+
+    def names(self) -> list[str]:
+        """All preset names on the path, sorted."""
+        return [h.name for h in self.entries()]
+
+    def definitions(self, name: str) -> list[Path]:
+        """Every file defining ``name``, the winner first; ``[]`` when none does."""
+        return [h.path for h in self.headers() if h.name == name]
+
+    def find(self, name: str) -> Path:
+        """The file that ``name`` resolves to, or an error with "did you mean"."""
+        check_name(name, field=None)
+        for folder in self.folders:
+            hit = self._find_in(folder, name)
+            if hit is not None:
+                return hit
+        raise PresetNotFoundError(
+            f"{name!r} not found in {self._where()}{did_you_mean(name, self.names())}"
+        )
+
+    def read(self, name: str) -> tuple[PresetFile, Path]:
+        """The parsed file that ``name`` resolves to, and its path."""
+        path = self.find(name)
+        return read_preset(path), path
+
+    def load(self, name: str) -> Material:
+        """The resolved material ``name`` (extends chains and layer references followed)."""
+        return resolve(name, self.read)
+
+    def load_file(self, path: Path) -> Material:
+        """Resolve a preset file that need not be on the path; its parents are looked up."""
+        preset = read_preset(path)
+        return resolve(preset.name, self._lookup_with(preset, path))
+
+    # -- writing -----------------------------------------------------------------------
+
+    def target(self, folder: str | Path | None = None) -> Path:
+        """The folder a write goes to: ``folder``, else the first user library."""
+        if folder is not None:
+            return Path(folder).expanduser()
+        if not self.user_folders:
+            raise LibraryError(
+                "no user library to write to (the built-in one is read-only); "
+                f"pass --library DIR or set {ENV_PATH}"
+            )
+        return self.user_folders[0]
+
+    def save(
+        self, preset: PresetFile, *, folder: str | Path | None = None, force: bool = False
+    ) -> Path:
+        """Write ``preset`` into a user library, checked to resolve first.
+
+        An existing preset of that name in that folder is replaced only with ``force``.
+        """
+        check_name(preset.name)
+        target = self.target(folder)
+        self._refuse_builtin(target, preset.name)
+        store.make_folder(target)
+        with store.locked(target):
+            path = self._find_in(target, preset.name)
+            if path is not None and not force:
+                raise LibraryError(
+                    f"preset {preset.name!r} already exists ({path}); pass --force to replace it",
+                    where=str(target),
+                )
+            path = path or target / f"{preset.name}{SUFFIX}"
+            self._write(preset, path)
+        return path
+
+    def update(self, name: str, changes: dict[str, Any]) -> Path:
+        """Change some fields of the preset ``name`` where it is defined (``presets set``).
+
+        Keys in :data:`~lookdev.library.preset.METADATA` set those fields; any other key is
+        a parameter. A value of ``None`` removes the key, so it is inherited again.
+        """
+        path = self.find(name)
+        self._refuse_builtin(path, name)
+        with store.locked(_library_root(path, self.user_folders)):
+            preset = read_preset(path)
+            self._write(apply_changes(preset, changes, where=str(path)), path)
+        return path
+
+    def remove(self, name: str, *, force: bool = False) -> Path:
+        """Delete the preset ``name`` resolves to; presets that build on it block this."""
+        path = self.find(name)
+        self._refuse_builtin(path, name)
+        users = self.dependants(name) if len(self.definitions(name)) == 1 else []
+        if users and not force:
+            raise LibraryError(
+                f"{', '.join(users)} build on {name!r}; pass --force to remove it anyway",
+                where=str(path),
+            )
+        with store.locked(_library_root(path, self.user_folders)):
+            store.remove(path)
+        return path
+
+    def dependants(self, name: str) -> list[str]:
+        """Names of presets that extend ``name`` or use it as a layer."""
+        out = []
+        for h in self.entries():
+            if h.extends == name:
+                out.append(h.name)
+            elif h.model == "layered" and h.error is None and _layer_refs(h.path, name):
+                out.append(h.name)
+        return out
+
+    def _write(self, preset: PresetFile, path: Path) -> None:
+        """Check that ``preset`` resolves in place at ``path``, then write it atomically."""
+        resolve(preset.name, self._lookup_with(preset, path))
+        store.atomic_write(path, dump_preset(preset).encode("utf-8"))
+
+    def _lookup_with(self, preset: PresetFile, path: Path):
+        def lookup(name: str) -> tuple[PresetFile, Path]:
+            return (preset, path) if name == preset.name else self.read(name)
+
+        return lookup
+
+    def _refuse_builtin(self, path: Path, name: str) -> None:
+        if self.builtin is not None and path.resolve().is_relative_to(self.builtin.resolve()):
+            raise LibraryError(
+                f"{name!r} is a built-in preset and read-only; make your own with "
+                f"`lookdev presets new my_{name} --from {name} --library DIR`",
+                where=str(path),
+            )
+
+    def _where(self) -> str:
+        return ", ".join(str(f) for f in self.folders) or "no library"
+
+
+def load_material(name_or_path: str | Path, library: Library | None = None) -> Material:
+    """A resolved material from a preset name, or from a ``.toml`` file's path."""
+    library = library or Library()
+    text = str(name_or_path)
+    if isinstance(name_or_path, Path) or text.endswith(SUFFIX) or os.sep in text or "/" in text:
+        return library.load_file(Path(name_or_path))
+    return library.load(text)
+
+
+def apply_changes(preset: PresetFile, changes: dict[str, Any], *, where: str) -> PresetFile:
+    """``preset`` with ``--set``-style changes; keys outside METADATA are parameters.
+
+    A value of ``None`` removes the key (a parameter is then inherited again).
+    """
+    data = preset.model_dump(mode="json", exclude_defaults=True)
+    data["name"] = preset.name
+    params = dict(preset.params)
+    for key, value in changes.items():
+        if key in ("name", "model", "layers"):
+            raise PresetError(
+                f"{key!r} cannot be set; use `presets new` for a new name or model",
+                where=where,
+                field=key,
+            )
+        bucket, field = (data, key) if key in METADATA else (params, key.removeprefix("params."))
+        if value is None:
+            bucket.pop(field, None)
+        else:
+            bucket[field] = value
+    data["params"] = params
+    return build_preset(data, where=where)
+
+
+def _with_model(h: Header, winners: dict[str, Header]) -> Header:
+    seen = {h.name}
+    parent = h
+    while parent.model is None and parent.extends in winners and parent.extends not in seen:
+        seen.add(parent.extends)
+        parent = winners[parent.extends]
+    if parent is h:
+        return h
+    return Header(h.name, h.path, parent.model, h.description, h.tags, h.extends, h.error)
+
+
+def _library_root(path: Path, folders: Sequence[Path]) -> Path:
+    resolved = path.resolve()
+    return next((f for f in folders if resolved.is_relative_to(f.resolve())), path.parent)
+
+
+def _layer_refs(path: Path, name: str) -> bool:
+    try:
+        preset = read_preset(path)
+    except PresetError:
+        return False
+    return any(getattr(layer, "preset", None) == name for layer in preset.layers)

@@ -1,0 +1,235 @@
+"""Resolved materials: ``extends`` chains followed, layer references loaded, all validated.
+
+A :class:`Material` is what the rest of the pipeline consumes (blending, export, proofs):
+a disney or pixar material with validated parameters, or a layered one whose layers are
+resolved non-layered materials under masks (Burley §5.7: "a material can be picked from
+the library and added … as an additional layer and then blended in with a mask").
+
+Resolution rules (documented for preset authors in ``lookdev presets --help``):
+
+- ``extends``: the parent's parameters, then the child's over them. ``specular`` and
+  ``ior`` spell one parameter two ways, so a child giving one drops the parent's other.
+  ``description``, ``tags`` and ``source`` are inherited unless the child gives its own;
+  ``layers`` likewise (a child's list replaces the parent's whole).
+- A layer naming a layered preset contributes that preset's layers, each under the
+  product of its own mask and the referencing layer's mask (presence multiplies too).
+- All layers of one material share one model: Disney layers blend parameters, Pixar
+  layers composite lobe weights, and the two do not mix.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from functools import partial
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from lookdev.materials.layers import CombineMask, ConstantMask, Mask, TextureMask, map_textures
+
+from .errors import PresetError, PresetNotFoundError
+from .preset import MODELS, PresetFile, check_params
+
+Lookup = Callable[[str], tuple[PresetFile, Path]]
+"""Finds a preset by name: its parsed file and where it lives."""
+
+
+class Material(BaseModel):
+    """A resolved preset, ready for blending, export and proofing."""
+
+    model_config = ConfigDict(frozen=True, arbitrary_types_allowed=True)
+
+    name: str
+    model: Literal["disney", "pixar", "layered"]
+    description: str = ""
+    tags: list[str] = Field(default_factory=list)
+    params: Any = None  # the model's Params instance; None for layered materials
+    layers: list[Layer] = Field(default_factory=list)
+    source: Path | None = None
+    citation: str | None = Field(None, description="The preset's `source` note (measurements).")
+    chain: list[Path] = Field(default_factory=list, description="Files merged, child first.")
+
+
+class Layer(BaseModel):
+    """One layer of a layered material: a resolved material under a mask."""
+
+    model_config = ConfigDict(frozen=True, arbitrary_types_allowed=True)
+
+    material: Material
+    mask: Mask = Field(default_factory=ConstantMask)
+    presence: float = 1.0
+    normal_map: TextureMask | None = None
+    specular_normal_map: TextureMask | None = None
+    name: str | None = None
+
+
+Material.model_rebuild()
+
+
+def resolve(name: str, lookup: Lookup) -> Material:
+    """The material ``name`` with its ``extends`` chain and layer references resolved."""
+    return _resolve(name, lookup, ())
+
+
+def _resolve(name: str, lookup: Lookup, seen: tuple[str, ...]) -> Material:
+    preset, paths = _merge_chain(name, lookup, seen)
+    where = str(paths[0])
+    common = {
+        "name": name,
+        "model": preset.model,
+        "description": preset.description,
+        "tags": list(preset.tags),
+        "source": paths[0],
+        "citation": preset.source,
+        "chain": paths,
+    }
+    if preset.model in MODELS:
+        params = check_params(preset.model, preset.params, where=where)
+        return Material(params=params, **common)
+    return Material(layers=_layers(preset, paths[0], lookup, (*seen, name)), **common)
+
+
+def _merge_chain(name: str, lookup: Lookup, seen: tuple[str, ...]) -> tuple[PresetFile, list[Path]]:
+    """Follow ``extends`` from ``name`` to its root and merge child over parent."""
+    chain: list[tuple[PresetFile, Path]] = []
+    current: str | None = name
+    while current is not None:
+        names = [*seen, *(p.name for p, _ in chain)]
+        if current in names:
+            cycle = " → ".join([*names[names.index(current) :], current])
+            where = str(chain[-1][1]) if chain else None
+            raise PresetError(f"cycle of presets: {cycle}", where=where, field="extends")
+        chain.append(_find_parent(current, lookup, chain))
+        current = chain[-1][0].extends
+    preset = chain[-1][0]
+    for child, path in reversed(chain[:-1]):
+        preset = _override(preset, child, where=str(path))
+    return preset, [p for _, p in chain]
+
+
+def _find_parent(name: str, lookup: Lookup, chain: list[tuple[PresetFile, Path]]):
+    try:
+        return lookup(name)
+    except PresetNotFoundError as exc:
+        if not chain:
+            raise
+        names = " → ".join([*(p.name for p, _ in chain), name])
+        raise PresetNotFoundError(
+            f"parent {exc.message} (chain {names})", where=str(chain[-1][1]), field="extends"
+        ) from None
+
+
+def _override(parent: PresetFile, child: PresetFile, *, where: str) -> PresetFile:
+    """``child`` over ``parent``: parameters merged, other given fields replaced."""
+    if child.model is not None and child.model != parent.model:
+        raise PresetError(
+            f"model {child.model!r} differs from its parent {parent.name!r} ({parent.model}); "
+            "a preset extends one of its own model",
+            where=where,
+            field="model",
+        )
+    given = child.model_fields_set
+    update: dict[str, Any] = {
+        k: getattr(child, k) for k in ("description", "tags", "source", "layers") if k in given
+    }
+    update["params"] = merge_params(parent.params, child.params)
+    if parent.model in MODELS:
+        check_params(parent.model, update["params"], where=where)
+    return parent.model_copy(update={**update, "name": child.name, "extends": None})
+
+
+def merge_params(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
+    """``over`` on top of ``base``; giving ``specular`` or ``ior`` drops the other.
+
+    >>> merge_params({"specular": 0.5, "roughness": 0.2}, {"ior": 1.33})
+    {'roughness': 0.2, 'ior': 1.33}
+    """
+    spellings = {"specular": "ior", "ior": "specular"}
+    dropped = {spellings[k] for k in over if k in spellings}
+    return {**{k: v for k, v in base.items() if k not in dropped}, **over}
+
+
+def _layers(preset: PresetFile, path: Path, lookup: Lookup, seen: tuple[str, ...]) -> list[Layer]:
+    """The resolved layers of a layered preset, bottom to top, texture paths made absolute."""
+    where = str(path)
+    out: list[Layer] = []
+    for i, spec in enumerate(preset.layers):
+        field = f"layers[{i}]"
+        absolute = partial(_absolute_texture, folder=path.parent)
+        common = {
+            "mask": map_textures(spec.mask, absolute),
+            "presence": spec.presence,
+            "normal_map": spec.normal_map and absolute(spec.normal_map),
+            "specular_normal_map": spec.specular_normal_map and absolute(spec.specular_normal_map),
+        }
+        if spec.preset is None:
+            params = check_params(spec.model, spec.params, where=where, prefix=f"{field}.params")
+            name = spec.name or f"{preset.name}.{field}"
+            material = Material(name=name, model=spec.model, params=params, source=path)
+            out.append(Layer(material=material, name=name, **common))
+            continue
+        inner = _resolve_layer(spec.preset, lookup, seen, where=where, field=f"{field}.preset")
+        if inner.model == "layered":
+            if spec.params:
+                raise PresetError(
+                    f"{spec.preset!r} is layered; params overrides apply to disney or pixar "
+                    "layers only",
+                    where=where,
+                    field=f"{field}.params",
+                )
+            out += [_nest(sub, spec.name or spec.preset, common) for sub in inner.layers]
+            continue
+        if spec.params:
+            merged = merge_params(inner.params.model_dump(exclude_unset=True), spec.params)
+            params = check_params(inner.model, merged, where=where, prefix=f"{field}.params")
+            inner = inner.model_copy(update={"params": params})
+        out.append(Layer(material=inner, name=spec.name or spec.preset, **common))
+    models = sorted({layer.material.model for layer in out})
+    if len(models) > 1:
+        raise PresetError(
+            f"layers mix the models {' and '.join(models)}; all layers of a preset share one "
+            "(disney layers blend parameters, pixar layers composite lobes)",
+            where=where,
+            field="layers",
+        )
+    return out
+
+
+def _resolve_layer(name: str, lookup: Lookup, seen, *, where: str, field: str) -> Material:
+    try:
+        return _resolve(name, lookup, seen)
+    except PresetNotFoundError as exc:
+        if exc.where is not None:
+            raise
+        raise PresetNotFoundError(f"layer {exc.message}", where=where, field=field) from None
+
+
+def _nest(sub: Layer, outer_name: str, outer: dict[str, Any]) -> Layer:
+    """A layer of a layered preset used as one layer: masks and presences multiply."""
+    return Layer(
+        material=sub.material,
+        mask=multiply_masks(outer["mask"], sub.mask),
+        presence=outer["presence"] * sub.presence,
+        normal_map=sub.normal_map or outer["normal_map"],
+        specular_normal_map=sub.specular_normal_map or outer["specular_normal_map"],
+        name=f"{outer_name}/{sub.name}",
+    )
+
+
+def multiply_masks(a: Mask, b: Mask) -> Mask:
+    """The product of two masks, leaving out a factor that is constant 1.
+
+    >>> multiply_masks(ConstantMask(value=1.0), ConstantMask(value=0.5)).value
+    0.5
+    """
+    if isinstance(a, ConstantMask) and a.value == 1.0:
+        return b
+    if isinstance(b, ConstantMask) and b.value == 1.0:
+        return a
+    return CombineMask(kind="multiply", inputs=[a, b])
+
+
+def _absolute_texture(texture: TextureMask, *, folder: Path) -> TextureMask:
+    """Texture paths in a preset are relative to its file; consumers get absolute ones."""
+    return texture.model_copy(update={"path": (folder / texture.path.expanduser()).resolve()})

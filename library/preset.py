@@ -1,0 +1,228 @@
+"""One preset file: its schema, strict parsing into one-line errors, and TOML output.
+
+A preset file is small TOML (issue 4)::
+
+    name = "brushed_steel"
+    model = "disney"                      # or "pixar", or "layered"
+    description = "Steel brushed along the tangent."
+    tags = ["metal", "anisotropic"]
+    source = "F0 of iron: Hoffman 2015, Physics and Math of Shading, table of F0 values"
+    extends = "iron"                      # optional: inherit, then override
+    [params]
+    roughness = 0.35
+    anisotropic = 0.8
+
+What is checked here is what one file can know: TOML syntax, the fields, their types,
+and each given parameter against its model's schema. What needs other files (``extends``
+chains, layer references) is resolved in :mod:`lookdev.library.material`.
+"""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from typing import Any, Literal
+
+import tomli_w
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+
+from lookdev.materials.errors import ParameterError
+from lookdev.materials.layers import LayerSpec
+from lookdev.materials.params import DisneyParams, Params
+
+from .errors import PresetError
+
+# TEMPORARY until the Pixar module lands (issue interfaces); then a plain import.
+try:
+    from lookdev.materials.pixar import PixarParams
+
+    MODELS: dict[str, type[Params]] = {"disney": DisneyParams, "pixar": PixarParams}
+except ImportError:
+    MODELS = {"disney": DisneyParams}
+"""Parameter schema of each reflectance model a preset may name."""
+
+MAX_BYTES = 1 << 20  # presets are hand-written text; anything larger is not one
+NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,99}$")
+METADATA = ("description", "tags", "source", "extends")
+"""Top-level fields that ``--set`` may change (everything else it sets is a parameter)."""
+
+
+def check_name(name: str, *, where: str | None = None, field: str | None = "name") -> str:
+    """``name`` if it is a safe preset name: a file name in its library and nothing more.
+
+    Letters, digits, ``_`` and ``-``; no path separators, no ``..``, not absolute.
+
+    >>> check_name("gold_leaf")
+    'gold_leaf'
+    """
+    if not isinstance(name, str) or not NAME_RE.match(name):
+        raise PresetError(
+            f"preset name {_short(name)} is not allowed; use 1-100 letters, digits, '_' or '-' "
+            "(no path separators, no '..')",
+            where=where,
+            field=field,
+        )
+    return name
+
+
+class PresetFile(BaseModel):
+    """The fields of one preset file, as written (before ``extends`` is resolved)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, title="lookdev preset")
+
+    name: str = Field(description="Preset name; must equal the file name without '.toml'.")
+    model: Literal["disney", "pixar", "layered"] | None = Field(
+        None, description="Reflectance model; may be left out when 'extends' names the parent."
+    )
+    description: str = Field("", description="One sentence for people browsing the library.")
+    tags: list[str] = Field(default_factory=list, description="Keywords for `presets list --tag`.")
+    source: str | None = Field(
+        None, description="Where the values come from: the published measurement or reference."
+    )
+    extends: str | None = Field(None, description="Parent preset: inherit, then override.")
+    params: dict[str, Any] = Field(
+        default_factory=dict, description="Model parameters (disney or pixar presets)."
+    )
+    layers: list[LayerSpec] = Field(
+        default_factory=list, description="Layered presets: layers from bottom to top."
+    )
+
+    @field_validator("name", "extends")
+    @classmethod
+    def _safe_name(cls, value: str | None) -> str | None:
+        if value is not None and not NAME_RE.match(value):
+            raise ValueError(
+                f"{_short(value)} is not a preset name; use 1-100 letters, digits, '_' or '-'"
+            )
+        return value
+
+    @model_validator(mode="after")
+    def _fields_fit_the_model(self) -> PresetFile:
+        if self.model is None and self.extends is None:
+            raise ValueError(
+                "'model' is required (disney, pixar or layered) unless 'extends' is given"
+            )
+        if self.model == "layered" and self.params:
+            raise ValueError("a layered preset has no [params]; give each layer its own")
+        if self.model in MODELS and self.layers:
+            raise ValueError(f'a {self.model} preset has no [[layers]]; use model = "layered"')
+        if self.model == "layered" and not self.layers and self.extends is None:
+            raise ValueError("a layered preset needs at least one [[layers]] entry")
+        return self
+
+
+def parse_preset(data: bytes, *, where: str, stem: str | None = None) -> PresetFile:
+    """Parse and check one preset file's bytes; every problem is one :class:`PresetError`.
+
+    ``where`` names the file in messages; ``stem``, when given, is the file name the
+    preset's ``name`` must equal.
+    """
+    return build_preset(parse_toml(data, where=where), where=where, stem=stem)
+
+
+def build_preset(doc: dict[str, Any], *, where: str, stem: str | None = None) -> PresetFile:
+    """Check a preset document (a parsed TOML table) as :func:`parse_preset` does."""
+    preset = _validate(doc, where=where)
+    if stem is not None and preset.name != stem:
+        raise PresetError(
+            f"name {preset.name!r} differs from the file name {stem!r}; they must agree",
+            where=where,
+            field="name",
+        )
+    if preset.model in MODELS:
+        check_params(preset.model, preset.params, where=where)
+    for i, layer in enumerate(preset.layers):
+        if layer.model is not None:
+            check_params(layer.model, layer.params, where=where, prefix=f"layers[{i}].params")
+    return preset
+
+
+def parse_toml(data: bytes, *, where: str) -> dict[str, Any]:
+    """The TOML document in ``data``, or a :class:`PresetError` naming the line."""
+    if len(data) > MAX_BYTES:
+        raise PresetError(
+            f"file is {len(data)} bytes; a preset is a small text file (at most {MAX_BYTES})",
+            where=where,
+        )
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise PresetError(f"not UTF-8 text (bad byte at offset {exc.start})", where=where) from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise PresetError(f"malformed TOML: {exc}", where=where) from None
+    except RecursionError:
+        raise PresetError("malformed TOML: values nested too deeply", where=where) from None
+
+
+def check_params(model: str, params: dict[str, Any], *, where: str | None, prefix: str = "params"):
+    """Validate ``params`` against ``model``'s schema; errors name ``prefix.field``."""
+    try:
+        return MODELS[model].parse(params)
+    except ParameterError as exc:
+        field = f"{prefix}.{exc.field}" if exc.field else prefix
+        raise ParameterError(exc.message, where=where, field=field) from None
+
+
+def _validate(doc: dict[str, Any], *, where: str) -> PresetFile:
+    try:
+        return PresetFile.model_validate(doc)
+    except ValidationError as exc:
+        raise _one_line(exc, where=where) from None
+
+
+def _one_line(exc: ValidationError, *, where: str) -> PresetError:
+    """The first pydantic error of a preset file as one line: field and what is allowed."""
+    err = exc.errors(include_url=False)[0]
+    loc = err["loc"]
+    field = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in loc).lstrip(".") or None
+    kind = err["type"]
+    if kind == "extra_forbidden" and len(loc) == 1:
+        allowed = ", ".join(PresetFile.model_fields)
+        msg = f"unknown field; allowed: {allowed}"
+    elif kind == "extra_forbidden":
+        msg = "unknown field"
+    elif kind == "missing":
+        msg = "required field is missing"
+    elif kind == "value_error":
+        msg = str((err.get("ctx") or {}).get("error", err["msg"]))
+    else:
+        msg = f"{err['msg']} (got {_short(err.get('input'))})"
+    return PresetError(msg, where=where, field=field)
+
+
+def _short(value: Any, limit: int = 60) -> str:
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def dump_preset(preset: PresetFile) -> str:
+    """The preset as TOML, fields in the documented order, empty fields left out.
+
+    >>> print(dump_preset(PresetFile(name="a", model="disney", params={"roughness": 0.3})))
+    name = "a"
+    model = "disney"
+    <BLANKLINE>
+    [params]
+    roughness = 0.3
+    <BLANKLINE>
+    """
+    data = preset.model_dump(mode="json", exclude_none=True, exclude_defaults=True)
+    data["name"] = preset.name
+    ordered = {k: data[k] for k in PresetFile.model_fields if k in data}
+    return tomli_w.dumps(ordered)
+
+
+def parse_value(text: str) -> Any:
+    """A ``--set`` value: any TOML value, or else the text itself as a string.
+
+    >>> parse_value("0.3"), parse_value('"#aa8844"'), parse_value("[0.9, 0.6, 0.2]")
+    (0.3, '#aa8844', [0.9, 0.6, 0.2])
+    >>> parse_value("conty_kulla")
+    'conty_kulla'
+    """
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
