@@ -1,8 +1,7 @@
 """The generic Mitsuba BSDF plugin (pipeline/export/mitsuba/plugin.py).
 
-First against a tiny two-lobe model defined here (a Lambertian reflector with a diffuse
-transmission lobe whose value also depends on the viewer, so swapping Mitsuba's direction
-names wrongly would show), then against the shipped models as they exist.
+First against a tiny two-lobe model (tests/_mitsuba_tiny.py), then against the shipped
+models.
 """
 
 from __future__ import annotations
@@ -11,57 +10,12 @@ import math
 
 import numpy as np
 import pytest
-from pydantic import Field
+from _mitsuba_tiny import TINY, TinyParams
 
-from lookdev.materials.bsdf import Model, draw, evaluate
+from lookdev.materials.bsdf import draw, evaluate
 from lookdev.materials.errors import LookdevError
-from lookdev.materials.params import Color, Params
 
 pytestmark = pytest.mark.render
-
-
-class TinyParams(Params):
-    base_color: Color = (0.8, 0.5, 0.2)
-    translucency: float = Field(0.0, ge=0.0, le=1.0)
-
-
-def _lobe_weight(xp, p, wi, wo):
-    same = wi[2] * wo[2] > 0
-    if "diff_trans" not in p["lobes"]:
-        return xp.select(same, 1.0, 0.0)
-    return xp.select(same, 1.0 - p["t"], p["t"])
-
-
-def _prepare(xp, params, **maps):
-    t = maps.get("translucency", params.translucency)
-    lobes = ("diffuse",) if xp.known_zero(t) else ("diffuse", "diff_trans")
-    return {"rho": xp.color(maps.get("base_color", params.base_color)), "t": t, "lobes": lobes}
-
-
-def _view_factor(xp, wo):
-    # Depends on the viewer only: non-reciprocal on purpose.
-    return 0.5 + 0.5 * xp.abs(wo[2])
-
-
-def _eval(xp, p, wi, wo):
-    return p["rho"] * (_lobe_weight(xp, p, wi, wo) * _view_factor(xp, wo) / math.pi)
-
-
-def _pdf(xp, p, wi, wo):
-    return _lobe_weight(xp, p, wi, wo) * xp.abs(wi[2]) / math.pi
-
-
-def _sample(xp, p, wo, u):
-    r = xp.sqrt(u[1])
-    phi = 2.0 * math.pi * u[2]
-    side = xp.select(wo[2] >= 0, 1.0, -1.0)
-    if "diff_trans" in p["lobes"]:
-        side = xp.select(u[0] < p["t"], -side, side)
-    wi = xp.vec3(r * xp.cos(phi), r * xp.sin(phi), xp.safe_sqrt(1.0 - u[1]) * side)
-    return wi, p["rho"] * _view_factor(xp, wo), _pdf(xp, p, wi, wo)
-
-
-TINY = Model("tiny_test", TinyParams, _prepare, _eval, _pdf, _sample)
 
 
 @pytest.fixture(scope="module")

@@ -1,1 +1,21 @@
-"""Mitsuba 3: BSDF plugins on the Dr.Jit backend of the shared model code, and scenes."""
+"""Mitsuba 3: BSDF plugins on the Dr.Jit backend of the shared model code, and scenes.
+
+>>> import lookdev.pipeline.export.mitsuba as m
+>>> sorted(m.__all__)[:3]
+['MitsubaExportError', 'bsdf_dict', 'export_scene']
+"""
+
+from .plugin import MitsubaExportError, register_model
+from .scene import bsdf_dict, max_depth_for, register_plugins, scene_dict
+from .xml import export_scene, write_xml
+
+__all__ = [
+    "MitsubaExportError",
+    "bsdf_dict",
+    "export_scene",
+    "max_depth_for",
+    "register_model",
+    "register_plugins",
+    "scene_dict",
+    "write_xml",
+]

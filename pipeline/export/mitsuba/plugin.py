@@ -17,8 +17,9 @@ Parameters arrive as Mitsuba properties, one per schema field: a constant (float
 string, ``rgb``) or a texture (``bitmap`` …). Constants are handed to ``prepare`` as Python
 values, so a lobe whose weight is a constant zero is pruned while the kernel is traced;
 textures are evaluated at ``si`` and handed to ``prepare`` as ``maps``. With the boolean
-property ``force_all_lobes`` every numeric constant is handed over as a Dr.Jit array
-instead: no weight is then a *known* zero and every lobe is traced (the benchmark baseline).
+property ``force_all_lobes`` every parameter that is exactly zero is handed over as a Dr.Jit
+array instead: no weight is then a *known* zero and every lobe is traced (the benchmark
+baseline).
 """
 
 from __future__ import annotations
@@ -190,15 +191,21 @@ def _plugin_class(variant: str) -> type:
             return dr.opaque(mi.Float, 0.5)
 
         def _forced(self) -> dict[str, Any]:
-            """Numeric constants as Dr.Jit arrays when every lobe must be traced."""
+            """Zero parameters as Dr.Jit arrays when every lobe must be traced.
+
+            Only a value that is exactly zero can make ``prepare`` prune a lobe, so only
+            those are handed over as arrays (which ``known_zero`` cannot see through).
+            """
             if not self.force_all_lobes:
                 return {}
             forced = {}
-            for key, value in self.constants.items():
-                if isinstance(value, tuple):
-                    forced[key] = self.xp.Array3(*(mi.Float(c) for c in value))
-                elif isinstance(value, float):
-                    forced[key] = mi.Float(value)
+            for key, value in self.params.model_dump().items():
+                if key in self.textures or isinstance(value, bool):
+                    continue
+                if isinstance(value, float) and value == 0.0:
+                    forced[key] = dr.opaque(mi.Float, 0.0)
+                elif isinstance(value, tuple) and not any(value):
+                    forced[key] = self.xp.Array3(*(dr.opaque(mi.Float, 0.0) for _ in value))
             return forced
 
         def _prepare(self, si: mi.SurfaceInteraction3f, active: mi.Bool) -> Any:

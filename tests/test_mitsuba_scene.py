@@ -1,0 +1,182 @@
+"""Mitsuba BSDF dicts, scenes and XML (pipeline/export/mitsuba/scene.py, xml.py)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from _mitsuba_tiny import TinyParams
+
+from lookdev.materials.errors import LookdevError
+
+pytestmark = pytest.mark.render
+
+
+@pytest.fixture(scope="module")
+def mi():
+    from lookdev.pipeline.variant import use_mitsuba
+
+    use_mitsuba()
+    import mitsuba
+
+    return mitsuba
+
+
+@pytest.fixture
+def m(mi, monkeypatch):
+    """The export module with the tiny test model known as model 'tiny_test'."""
+    from lookdev.pipeline.export.mitsuba import scene
+
+    monkeypatch.setitem(scene.MODEL_MODULES, "tiny_test", "_mitsuba_tiny")
+    return scene
+
+
+def _blended(name="tiled", **maps):
+    """A BlendedMaterial-shaped object (the blending engine's interface)."""
+    from types import SimpleNamespace
+
+    return SimpleNamespace(
+        name=name,
+        model="tiny_test",
+        constants={"base_color": (0.5, 0.5, 0.5)},
+        maps=maps,
+        normal_map=None,
+        specular_normal_map=None,
+    )
+
+
+def _render(mi, scene, seed=0):
+    return np.array(mi.render(mi.load_dict(scene) if isinstance(scene, dict) else scene, seed=seed))
+
+
+def test_bsdf_dict_of_params_uses_our_plugin(mi, m):
+    d = m.bsdf_dict(TinyParams(translucency=0.25, base_color=(0.1, 0.2, 0.3)))
+    assert d["type"] == "lookdev_tiny_test"
+    assert d["translucency"] == 0.25
+    assert d["base_color"] == {"type": "rgb", "value": [0.1, 0.2, 0.3]}
+    assert mi.load_dict(d).flags() & mi.BSDFFlags.DiffuseTransmission
+
+
+def test_given_parameters_only(mi, m):
+    assert m.bsdf_dict(TinyParams()) == {"type": "lookdev_tiny_test"}
+
+
+def test_bad_parameters_are_one_line_errors(m):
+    with pytest.raises(LookdevError, match="translucency"):
+        m.bsdf_dict(_bad())
+
+
+def _bad():
+    from types import SimpleNamespace
+
+    return SimpleNamespace(
+        name="bad", model="tiny_test", constants={"translucency": 2.0}, maps={}, normal_map=None
+    )
+
+
+def test_maps_become_bitmaps_in_memory_and_in_files(mi, m, tmp_path):
+    h, w = 4, 8
+    trans = np.zeros((h, w), np.float32)
+    trans[:, w // 2 :] = 1.0  # right half of UV space transmits everything
+    color = np.broadcast_to(np.array([0.9, 0.3, 0.1], np.float32), (h, w, 3)).copy()
+    blended = _blended(translucency=trans, base_color=color)
+    in_memory = mi.load_dict(m.bsdf_dict(blended))
+    on_disk_dict = m.bsdf_dict(blended, tmp_path / "tex")
+    files = sorted(p.name for p in (tmp_path / "tex").iterdir())
+    assert files == ["tiled_base_color.exr", "tiled_translucency.exr"]
+    on_disk = mi.load_dict(on_disk_dict)
+    import drjit as dr
+
+    si = dr.zeros(mi.SurfaceInteraction3f, 2)
+    si.wi = mi.Vector3f(0, 0, 1)
+    si.uv = mi.Point2f([0.25, 0.75], [0.5, 0.5])
+    below = mi.Vector3f(0, 0, -1)
+    for bsdf in (in_memory, on_disk):
+        value = np.array(bsdf.eval(mi.BSDFContext(), si, below))
+        np.testing.assert_allclose(value[:, 0], 0.0)
+        np.testing.assert_allclose(value[:, 1], np.array([0.9, 0.3, 0.1]) / np.pi, rtol=1e-5)
+
+
+def test_map_rows_follow_v(mi, m):
+    """Row 0 of a map is v = 0 (BlendedMaterial's texel (0, 0) = UV (0, 0))."""
+    import drjit as dr
+
+    trans = np.zeros((2, 1), np.float32)
+    trans[0] = 1.0
+    bsdf = mi.load_dict(m.bsdf_dict(_blended(translucency=trans)))
+    si = dr.zeros(mi.SurfaceInteraction3f, 2)
+    si.wi = mi.Vector3f(0, 0, 1)
+    si.uv = mi.Point2f([0.5, 0.5], [0.25, 0.75])  # the two texel centres
+    value = np.array(bsdf.eval(mi.BSDFContext(), si, mi.Vector3f(0, 0, -1)))
+    np.testing.assert_allclose(value[:, 0], 0.5 / np.pi, rtol=1e-5)
+    assert np.all(value[:, 1] == 0)
+
+
+def test_max_depth_follows_the_material(m):
+    assert m.max_depth_for(TinyParams()) == m.DEPTH_OPAQUE
+    assert m.max_depth_for(TinyParams(translucency=0.5)) == m.DEPTH_THIN_TRANSMISSION
+    zero = _blended(translucency=np.zeros((4, 4), np.float32))
+    assert m.max_depth_for(zero) == m.DEPTH_OPAQUE
+    some = np.zeros((4, 4), np.float32)
+    some[3, 3] = 0.01
+    assert m.max_depth_for(_blended(translucency=some)) == m.DEPTH_THIN_TRANSMISSION
+    assert m.DEPTH_OPAQUE < m.DEPTH_THIN_TRANSMISSION < m.DEPTH_SOLID_TRANSMISSION
+
+
+def test_force_all_lobes_is_passed_to_the_plugin(mi, m):
+    d = m.bsdf_dict(TinyParams(), force_all_lobes=True)
+    assert d["force_all_lobes"] is True
+    assert mi.load_dict(d).flags() & mi.BSDFFlags.DiffuseTransmission
+
+
+def test_white_furnace_sphere_shows_the_model(mi, m):
+    """Centre of a sphere under a constant white sky, single scattering: its albedo."""
+    params = TinyParams(base_color=(0.8, 0.5, 0.2))
+    scene = m.scene_dict(params, resolution=(32, 32), spp=256, max_depth=2)
+    image = _render(mi, scene)
+    centre = image[14:18, 14:18].reshape(-1, 3)
+    # Tiny model at normal view: albedo = ρ · (0.5 + 0.5·1) = ρ.
+    np.testing.assert_allclose(centre.mean(axis=0), [0.8, 0.5, 0.2], rtol=0.02)
+
+
+def test_xml_loads_and_renders_like_the_dict(mi, m, tmp_path):
+    from lookdev.pipeline.export.mitsuba import xml
+
+    trans = np.zeros((4, 4), np.float32)
+    trans[:2] = 0.5
+    blended = _blended(translucency=trans)
+    path = xml.export_scene(blended, tmp_path / "out" / "scene.xml", resolution=(16, 16), spp=8)
+    text = path.read_text()
+    first = text.splitlines()[0]
+    assert first.startswith("<!--") and "register_plugins()" in first and first.endswith("-->")
+    assert 'value="scene_textures/tiled_translucency.exr"' in text
+    assert sorted(p.name for p in path.parent.iterdir()) == ["scene.xml", "scene_textures"]
+    loaded = mi.load_file(str(path))
+    same = m.scene_dict(blended, resolution=(16, 16), spp=8)
+    np.testing.assert_allclose(_render(mi, loaded), _render(mi, same), rtol=1e-5, atol=1e-6)
+
+
+def test_xml_without_our_plugins_has_no_hint(mi):
+    from lookdev.pipeline.export.mitsuba import xml
+
+    text = xml.to_xml({"type": "scene", "s": {"type": "sphere", "bsdf": {"type": "diffuse"}}})
+    assert text.startswith("<scene")
+    assert '<bsdf type="diffuse" name="bsdf"' in text
+
+
+def test_unwritable_folder_is_one_line_and_leaves_nothing(mi, m, tmp_path):
+    from lookdev.pipeline.export.mitsuba import xml
+
+    blocker = tmp_path / "a-file"
+    blocker.write_text("not a folder")
+    with pytest.raises(LookdevError, match="cannot create the folder") as info:
+        xml.export_scene(TinyParams(), blocker / "scene.xml")
+    assert "\n" not in str(info.value)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a-file"]
+
+
+def test_in_memory_textures_cannot_go_to_xml(mi, m):
+    from lookdev.pipeline.export.mitsuba import xml
+
+    scene = m.scene_dict(_blended(translucency=np.ones((2, 2), np.float32)))
+    with pytest.raises(LookdevError, match="texture folder"):
+        xml.to_xml(scene)
