@@ -93,8 +93,3 @@ def _phong_sample(xp, prepared, wo, u):
 
 
 PHONG = Model("phong", PhongParams, _phong_prepare, _phong_eval, _phong_pdf, _phong_sample)
-
-
-def grey_table(params, cos_theta):
-    """A stand-in albedo table: one grey value per angle, E = cos θ."""
-    return cos_theta

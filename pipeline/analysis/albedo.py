@@ -25,7 +25,6 @@ Directions are in the shading frame (normal +z); ``wo`` lies in the x-z plane at
 
 from __future__ import annotations
 
-import importlib
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -149,25 +148,30 @@ def _stratified_uniforms(rng: np.random.Generator, n: int) -> np.ndarray:
     return u
 
 
-# A model that ships an albedo table names it here: model name → (module, function).
-# The function takes (params, cos_theta array) and returns albedo of shape (..., 3).
-_TABLES: dict[str, tuple[str, str]] = {}
+def sheen_table(params: Any, cos_theta: np.ndarray) -> np.ndarray:
+    """Conty-Kulla sheen: its shipped E(μ, r) table (F = 1) times the sheen colour F.
+
+    The table is made with the terminator softening on (eq. 4); with it off the
+    difference is the table's error, which the error bench measures.
+    """
+    from lookdev.materials import sheen
+
+    e = sheen.albedo(cos_theta, params.roughness)
+    return e[..., None] * np.asarray(params.color, dtype=np.float64)
 
 
-def register_table(model_name: str, module: str, function: str) -> None:
-    """Declare that ``module.function(params, cos_theta)`` is ``model_name``'s albedo table."""
-    _TABLES[model_name] = (module, function)
+# Albedo tables that models ship, by model name: fn(params, cos_theta) → (..., 3) or (...).
+_TABLES: dict[str, Callable[[Any, np.ndarray], np.ndarray]] = {"sheen": sheen_table}
+
+
+def register_table(model_name: str, fn: Callable[[Any, np.ndarray], np.ndarray]) -> None:
+    """Declare ``fn(params, cos_theta)`` as the albedo table of the model ``model_name``."""
+    _TABLES[model_name] = fn
 
 
 def table_for(model: Model) -> Callable[[Any, np.ndarray], np.ndarray] | None:
     """The tabulated-albedo function a model ships, or None."""
-    entry = _TABLES.get(model.name)
-    if entry is None:
-        return None
-    try:
-        return getattr(importlib.import_module(entry[0]), entry[1])
-    except (ImportError, AttributeError):
-        return None
+    return _TABLES.get(model.name)
 
 
 def albedo_tabulated(model: Model, params: Any, theta: Any) -> AlbedoCurve | None:

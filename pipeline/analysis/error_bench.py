@@ -36,7 +36,7 @@ from . import measure
 from .measure import Row
 
 ITEMS = ("render", "albedo", "lambda", "precision")
-MODEL_NAMES = ("disney", "pixar")
+MODEL_NAMES = ("disney", "pixar", "sheen")
 
 # Proof-render cases: label → built-in preset name.
 RENDER_PRESETS: dict[str, str] = {
@@ -119,7 +119,7 @@ def lambda_fit() -> Callable[[np.ndarray, float], np.ndarray] | None:
         from lookdev.materials import sheen
     except ImportError:
         return None
-    return getattr(sheen, "ck_lambda", None)
+    return getattr(sheen, "lambda_fit", None)
 
 
 def render_cases(library: Any = None) -> tuple[list[tuple[str, dict, int]], dict[str, str]]:
@@ -197,7 +197,7 @@ def run(
     if "lambda" in items:
         fit = lambda_fit()
         if fit is None:
-            report.skipped["lambda: fit"] = "lookdev.materials.sheen.ck_lambda is not installed"
+            report.skipped["lambda: fit"] = "lookdev.materials.sheen.lambda_fit is not installed"
         tasks.append(
             (
                 "lambda",
