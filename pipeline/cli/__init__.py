@@ -43,9 +43,10 @@ def _root(
 
 
 def _register() -> None:
-    from . import bench, plot
+    from . import bench, export, plot
 
     app.add_typer(bench.app, name="bench")
+    app.add_typer(export.app, name="export")
     app.command("plot")(plot.plot)
 
 

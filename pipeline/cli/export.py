@@ -1,0 +1,132 @@
+"""``lookdev export …``: presets out to other tools, one sub-command per target."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from lookdev.materials.errors import LookdevError
+
+from .common import console, print_json
+
+app = typer.Typer(
+    help="Write presets for other tools: Mitsuba scenes, USD shading networks.",
+    no_args_is_help=True,
+)
+
+
+class IBLNotFoundError(LookdevError):
+    """The environment light named for an export does not exist."""
+
+
+def _environment(name_or_path: str | None) -> Path | None:
+    """An IBL name (built-in, via the proof package) or an image file; None = white sky."""
+    if name_or_path is None:
+        return None
+    path = Path(name_or_path).expanduser()
+    if path.suffix.lower() in (".exr", ".hdr") or path.exists():
+        if not path.is_file():
+            raise IBLNotFoundError("no such environment image", where=str(path))
+        return path.resolve()
+    try:
+        from lookdev.pipeline.proof import ibl
+    except ImportError:
+        raise IBLNotFoundError(
+            "not an .exr/.hdr file, and built-in IBLs are not available", where=name_or_path
+        ) from None
+    return Path(ibl.resolve(name_or_path))
+
+
+@app.command("mitsuba")
+def mitsuba(
+    preset: Annotated[str, typer.Argument(help="Preset name or .toml file.")],
+    output: Annotated[
+        Path,
+        typer.Option("--output", "-o", help="Scene XML to write.", dir_okay=False),
+    ],
+    resolution: Annotated[
+        tuple[int, int], typer.Option("--resolution", help="Film width and height in pixels.")
+    ] = (512, 512),
+    spp: Annotated[int, typer.Option("--spp", min=1, help="Samples per pixel.")] = 128,
+    environment: Annotated[
+        str | None,
+        typer.Option(
+            "--ibl",
+            help="Environment light: a built-in IBL name or an .exr/.hdr file "
+            "(default: a constant white sky, the white-furnace set-up).",
+        ),
+    ] = None,
+    map_resolution: Annotated[
+        int,
+        typer.Option(
+            "--map-resolution", min=1, max=16384, help="Texels a side of layered presets' maps."
+        ),
+    ] = 512,
+    force_all_lobes: Annotated[
+        bool,
+        typer.Option(
+            "--force-all-lobes",
+            help="Trace every lobe, zero weights included (a baseline for measuring pruning).",
+        ),
+    ] = False,
+    library: Annotated[
+        list[Path] | None,
+        typer.Option("--library", "-L", help="Extra preset folders searched before the built-ins."),
+    ] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+) -> None:
+    """Write PRESET as a Mitsuba 3 scene: the material on a sphere under an environment.
+
+    The material renders through lookdev's own BSDF plugins (the same model code as the
+    plots and tests); the first line of the XML says how to load them. Untextured metals
+    use Mitsuba's built-in principled BSDF, measured equal. Layered presets are blended
+    and their varying parameters written as EXR maps beside the scene.
+
+    Examples:
+
+      lookdev export mitsuba gold -o gold.xml
+
+      lookdev export mitsuba rusty_iron -o rust/scene.xml --ibl studio --spp 64
+    """
+    from lookdev.library import Library, load_material
+    from lookdev.pipeline.export.mitsuba import MitsubaExportError, export_scene, max_depth_for
+    from lookdev.pipeline.export.mitsuba.scene import flatten
+
+    if min(resolution) < 1:
+        raise MitsubaExportError(
+            f"{resolution[0]} {resolution[1]}: width and height must be at least 1",
+            field="--resolution",
+        )
+    material = load_material(preset, Library(library or None))
+    env = _environment(environment)
+    with console.status(f"exporting {material.name}…", spinner="dots"):
+        flat = flatten(material, map_resolution)
+        path = export_scene(
+            flat,
+            output,
+            resolution=resolution,
+            spp=spp,
+            environment=env,
+            force_all_lobes=force_all_lobes,
+        )
+    written = sorted(str(p) for p in (path.parent / f"{path.stem}_textures").glob("*.exr"))
+    with path.open(encoding="utf-8") as handle:
+        uses_plugins = "register_plugins()" in handle.readline()
+    summary = {
+        "preset": material.name,
+        "scene": str(path),
+        "textures": written,
+        "max_depth": max_depth_for(flat),
+        "plugins": uses_plugins,
+    }
+    if as_json:
+        print_json(summary)
+        return
+    console.print(f"wrote [bold]{path}[/] ({len(written)} maps, max_depth {summary['max_depth']})")
+    if summary["plugins"]:
+        console.print(
+            "load it after: import lookdev.pipeline.export.mitsuba as m; m.register_plugins()",
+            highlight=False,
+        )
