@@ -211,7 +211,25 @@ def dump_preset(preset: PresetFile) -> str:
     data = preset.model_dump(mode="json", exclude_none=True, exclude_defaults=True)
     data["name"] = preset.name
     ordered = {k: data[k] for k in PresetFile.model_fields if k in data}
-    return tomli_w.dumps(ordered)
+    return _compact_arrays(tomli_w.dumps(ordered))
+
+
+_SCALAR_ARRAY = re.compile(r"\[\n((?:[ ]+[^\[\]{}\n]+,\n)+)[ ]*\]")
+
+
+def _compact_arrays(text: str) -> str:
+    """Arrays of scalars on one line (``base_color = [1.0, 0.78, 0.34]``), as people write them.
+
+    tomli_w writes every array one item per line; the rewrite is kept only if the
+    document still parses to the same values.
+    """
+
+    def one_line(m: re.Match[str]) -> str:
+        items = [line.strip().removesuffix(",") for line in m.group(1).splitlines()]
+        return "[" + ", ".join(items) + "]"
+
+    compact = _SCALAR_ARRAY.sub(one_line, text)
+    return compact if tomllib.loads(compact) == tomllib.loads(text) else text
 
 
 def parse_value(text: str) -> Any:

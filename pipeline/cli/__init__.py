@@ -43,10 +43,11 @@ def _root(
 
 
 def _register() -> None:
-    from . import bench, export, plot
+    from . import bench, export, plot, presets
 
     app.add_typer(bench.app, name="bench")
     app.add_typer(export.app, name="export")
+    app.add_typer(presets.app, name="presets")
     app.command("plot")(plot.plot)
 
 

@@ -1,0 +1,405 @@
+"""``lookdev presets …``: browse, inspect, create, edit, validate and remove presets."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.syntax import Syntax
+
+from lookdev.library import Library, Material, PresetError, read_preset
+from lookdev.library.index import Header
+from lookdev.library.library import apply_changes
+from lookdev.library.preset import PresetFile, check_name, parse_value
+from lookdev.library.schema import preset_schema
+from lookdev.materials.errors import LookdevError
+
+from .common import console, err_console, print_json, table
+
+app = typer.Typer(
+    help="Browse and edit material presets. Presets are TOML files found, in order, in each "
+    "--library folder, then in LOOKDEV_LIBRARY_PATH (os.pathsep-separated), then in the "
+    "built-in library; the first definition of a name wins. Writes go to the first user "
+    "library; the built-in one is read-only.",
+    no_args_is_help=True,
+)
+
+LibraryOpt = Annotated[
+    list[Path] | None,
+    typer.Option(
+        "--library",
+        "-L",
+        help="Preset folder searched before LOOKDEV_LIBRARY_PATH and the built-ins; repeatable. "
+        "The first one receives writes.",
+        file_okay=False,
+    ),
+]
+JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON document for scripts.")]
+
+
+@app.command("list")
+def list_(
+    tag: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--tag", "-t", help="Only presets with this tag; repeatable (all must match)."
+        ),
+    ] = None,
+    model: Annotated[
+        str | None, typer.Option("--model", "-m", help="Only this model: disney, pixar or layered.")
+    ] = None,
+    library: LibraryOpt = None,
+    as_json: JsonOpt = False,
+) -> None:
+    """List the presets each name resolves to.
+
+    Examples:
+
+      lookdev presets list --tag metal
+
+      lookdev presets list -L ~/looks --model layered --json
+    """
+    if model is not None and model not in ("disney", "pixar", "layered"):
+        raise PresetError(
+            f"unknown model {model!r}; allowed: disney, pixar, layered", field="--model"
+        )
+    lib = Library(library)
+    entries = lib.entries()
+    broken = [h for h in entries if h.error]
+    shown = [h for h in entries if not h.error and _matches(h, tag or [], model)]
+    for h in broken:
+        err_console.print(
+            f"lookdev: warning: {h.error}", markup=False, highlight=False, soft_wrap=True
+        )
+    if as_json:
+        print_json([_header_json(h, lib) for h in shown])
+        return
+    rows = [
+        [h.name, h.model or "?", ", ".join(h.tags), h.description, _origin(h.path, lib)]
+        for h in shown
+    ]
+    console.print(
+        table(f"{len(shown)} presets", ["name", "model", "tags", "description", "library"], rows)
+    )
+
+
+@app.command()
+def show(
+    name: Annotated[str, typer.Argument(help="Preset name (or a path to a .toml file).")],
+    resolved: Annotated[
+        bool,
+        typer.Option(
+            "--resolved",
+            "-r",
+            help="Show every parameter after extends and defaults, with the file that set it.",
+        ),
+    ] = False,
+    library: LibraryOpt = None,
+    as_json: JsonOpt = False,
+) -> None:
+    """Show a preset as written, or --resolved; says which file won when several define NAME.
+
+    Examples:
+
+      lookdev presets show gold
+
+      lookdev presets show brushed_steel --resolved
+    """
+    lib = Library(library)
+    path = Path(name) if name.endswith(".toml") else lib.find(name)
+    preset = read_preset(path)
+    explicit = name.endswith(".toml")
+    others = [] if explicit else [p for p in lib.definitions(preset.name) if p != path]
+    material = lib.load_file(path) if resolved else None
+    if as_json:
+        doc: dict[str, Any] = {
+            "name": preset.name,
+            "file": str(path),
+            "shadows": [str(p) for p in others],
+        }
+        doc["preset"] = preset.model_dump(mode="json", exclude_defaults=True)
+        if material is not None:
+            doc["resolved"] = _material_json(material)
+        print_json(doc)
+        return
+    console.print(f"[bold]{preset.name}[/] from {path}", highlight=False)
+    for p in others:
+        console.print(f"  shadows {p}", style="dim", highlight=False)
+    if material is None:
+        text = path.read_text(encoding="utf-8")
+        console.print(Syntax(text, "toml", theme="ansi_dark", word_wrap=True))
+    else:
+        _print_resolved(material)
+
+
+@app.command()
+def new(
+    name: Annotated[str, typer.Argument(help="Name of the new preset (letters, digits, _ and -).")],
+    parent: Annotated[
+        str | None, typer.Option("--from", "-f", help="Preset to extend; its values are inherited.")
+    ] = None,
+    model: Annotated[
+        str | None, typer.Option("--model", "-m", help="Model when not extending: disney or pixar.")
+    ] = None,
+    assignments: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--set",
+            "-s",
+            help='KEY=VALUE, VALUE in TOML (0.3, "#aa8844", [0.9, 0.6, 0.2]); repeatable.',
+        ),
+    ] = None,
+    library: LibraryOpt = None,
+    force: Annotated[
+        bool, typer.Option("--force", help="Replace a preset of that name in the target library.")
+    ] = False,
+    as_json: JsonOpt = False,
+) -> None:
+    """Create preset NAME in the first --library folder, extending --from PARENT.
+
+    Examples:
+
+      lookdev presets new worn_gold --from gold --set roughness=0.45 -L ~/looks
+
+      lookdev presets new teal_plastic --model disney --set base_color='"#2a8c8c"' -L ~/looks
+    """
+    check_name(name, field="NAME")
+    if (parent is None) == (model is None):
+        raise PresetError(
+            "give exactly one of --from PARENT or --model disney|pixar", field="--from"
+        )
+    lib = Library(library)
+    if parent is not None:
+        lib.find(parent)
+    where = str(lib.target() / f"{name}.toml")
+    base = PresetFile.model_construct(name=name, model=model, extends=parent, params={})
+    preset = apply_changes(base, parse_assignments(assignments or []), where=where)
+    path = lib.save(preset, force=force)
+    _report("created", preset.name, path, as_json)
+
+
+@app.command("set")
+def set_(
+    name: Annotated[str, typer.Argument(help="Preset to change, in a user library.")],
+    assignments: Annotated[
+        list[str],
+        typer.Argument(
+            metavar="KEY=VALUE…",
+            help="Parameter or description/tags/source/extends; VALUE is TOML; an empty VALUE "
+            "removes the key so it is inherited again.",
+        ),
+    ],
+    library: LibraryOpt = None,
+    as_json: JsonOpt = False,
+) -> None:
+    """Change values of preset NAME in place (atomically, under the library's lock).
+
+    Examples:
+
+      lookdev presets set worn_gold roughness=0.5 'tags=["metal", "worn"]' -L ~/looks
+
+      lookdev presets set worn_gold roughness= -L ~/looks
+    """
+    path = Library(library).update(name, parse_assignments(assignments))
+    _report("updated", name, path, as_json)
+
+
+@app.command()
+def validate(
+    paths: Annotated[
+        list[Path] | None,
+        typer.Argument(
+            metavar="[PATH…]", help="Preset files or folders; default: every library on the path."
+        ),
+    ] = None,
+    library: LibraryOpt = None,
+    as_json: JsonOpt = False,
+) -> None:
+    """Check preset files parse and resolve; exit 2 if any does not.
+
+    Examples:
+
+      lookdev presets validate
+
+      lookdev presets validate ~/looks/worn_gold.toml
+    """
+    # Folders named here join the search path, so their presets' parents are found.
+    lib = Library([*[p if p.is_dir() else p.parent for p in paths or []], *(library or [])])
+    files = _files(paths) if paths else [h.path for h in lib.headers()]
+    results = [(f, _problem(lib, f)) for f in files]
+    bad = [(f, e) for f, e in results if e]
+    if as_json:
+        print_json([{"file": str(f), "ok": e is None, "error": e} for f, e in results])
+    else:
+        for _, e in bad:
+            err_console.print(f"lookdev: error: {e}", markup=False, highlight=False, soft_wrap=True)
+        console.print(
+            f"{len(files) - len(bad)} of {len(files)} preset files valid", highlight=False
+        )
+    if bad:
+        raise typer.Exit(2)
+
+
+@app.command()
+def rm(
+    name: Annotated[str, typer.Argument(help="Preset to delete from its user library.")],
+    library: LibraryOpt = None,
+    force: Annotated[
+        bool, typer.Option("--force", help="Delete even if other presets build on it.")
+    ] = False,
+    as_json: JsonOpt = False,
+) -> None:
+    """Delete preset NAME (never a built-in one; refuses while others extend or layer it)."""
+    path = Library(library).remove(name, force=force)
+    _report("removed", name, path, as_json)
+
+
+@app.command()
+def schema(
+    output: Annotated[
+        Path | None,
+        typer.Option(
+            "--output", "-o", help="Write to this file instead of stdout.", dir_okay=False
+        ),
+    ] = None,
+) -> None:
+    """Print the JSON Schema of preset files, for editor validation and completion.
+
+    Example (Taplo / Even Better TOML): lookdev presets schema -o preset.schema.json, then
+    start a preset with the line  #:schema ./preset.schema.json
+    """
+    import json
+
+    text = json.dumps(preset_schema(), indent=2) + "\n"
+    if output is None:
+        typer.echo(text, nl=False)
+        return
+    from lookdev.library import store
+
+    store.atomic_write(output, text.encode("utf-8"))
+    console.print(f"wrote {output}", highlight=False)
+
+
+def parse_assignments(items: list[str]) -> dict[str, Any]:
+    """``["roughness=0.3", "sheen_model=conty_kulla"]`` → a dict; ``"k="`` maps k to None."""
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise PresetError(f"{item!r} is not KEY=VALUE (e.g. roughness=0.3)", field="--set")
+        out[key] = parse_value(value.strip()) if value.strip() else None
+    return out
+
+
+def _matches(h: Header, tags: list[str], model: str | None) -> bool:
+    return all(t in h.tags for t in tags) and (model is None or h.model == model)
+
+
+def _origin(path: Path, lib: Library) -> str:
+    if lib.builtin is not None and path.is_relative_to(lib.builtin):
+        return "built-in"
+    return str(next((f for f in lib.user_folders if path.is_relative_to(f)), path.parent))
+
+
+def _header_json(h: Header, lib: Library) -> dict[str, Any]:
+    return {
+        "name": h.name,
+        "model": h.model,
+        "description": h.description,
+        "tags": list(h.tags),
+        "extends": h.extends,
+        "file": str(h.path),
+        "library": _origin(h.path, lib),
+    }
+
+
+def _material_json(m: Material) -> dict[str, Any]:
+    doc = m.model_dump(mode="json", exclude={"layers", "params"})
+    doc["params"] = m.params.model_dump(mode="json") if m.params is not None else None
+    doc["layers"] = [
+        {
+            **layer.model_dump(mode="json", exclude={"material"}),
+            "material": _material_json(layer.material),
+        }
+        for layer in m.layers
+    ]
+    return doc
+
+
+def _print_resolved(m: Material) -> None:
+    if m.params is not None:
+        rows = [[k, _value(v), _set_by(m, k)] for k, v in m.params.model_dump().items()]
+        console.print(
+            table(f"{m.name} ({m.model}, resolved)", ["parameter", "value", "set by"], rows)
+        )
+        return
+    rows = [
+        [
+            i,
+            layer.name,
+            layer.material.name,
+            layer.material.model,
+            _mask_text(layer.mask),
+            layer.presence,
+        ]
+        for i, layer in enumerate(m.layers)
+    ]
+    console.print(
+        table(
+            f"{m.name} (layered, bottom to top)",
+            ["#", "layer", "material", "model", "mask", "presence"],
+            rows,
+        )
+    )
+
+
+def _set_by(m: Material, key: str) -> str:
+    """The first file of the extends chain (child first) that gives ``key``, or 'default'."""
+    for path in m.chain:
+        if key in read_preset(path).params:
+            return path.name
+    return "default"
+
+
+def _value(v: Any) -> str:
+    if isinstance(v, tuple | list):
+        return "[" + ", ".join(f"{x:.4g}" for x in v) + "]"
+    return f"{v:.4g}" if isinstance(v, float) else str(v)
+
+
+def _mask_text(mask: Any) -> str:
+    data = mask.model_dump(mode="json", exclude_defaults=True)
+    return ", ".join(f"{k}={v}" for k, v in data.items()) or mask.kind
+
+
+def _files(paths: list[Path]) -> list[Path]:
+    out: list[Path] = []
+    for p in paths:
+        if p.is_dir():
+            out += sorted(
+                f
+                for f in p.rglob("*.toml")
+                if not any(part.startswith(".") for part in f.relative_to(p).parts)
+            )
+        elif p.exists():
+            out.append(p)
+        else:
+            raise PresetError("no such file or folder", where=str(p))
+    return out
+
+
+def _problem(lib: Library, path: Path) -> str | None:
+    try:
+        lib.load_file(path)
+    except LookdevError as exc:
+        return str(exc)
+    return None
+
+
+def _report(verb: str, name: str, path: Path, as_json: bool) -> None:
+    if as_json:
+        print_json({verb: name, "file": str(path)})
+    else:
+        console.print(f"{verb} {name}: {path}", highlight=False)
