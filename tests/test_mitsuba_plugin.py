@@ -178,3 +178,160 @@ def test_context_type_mask_selects_a_hemisphere(mi, tiny):
 def test_unknown_parameter_is_one_line_error(mi, tiny):
     with pytest.raises(Exception, match="roughnes.*allowed: base_color, translucency"):
         tiny(roughnes=0.5)
+
+
+# -- the shipped models ------------------------------------------------------------------
+# (model, parameters, id): the grid of the issue, extremes included.
+CASES = [
+    ("sheen", {"roughness": 0.0}, "sheen-r0"),
+    ("sheen", {"roughness": 0.3, "color": [0.9, 0.5, 0.3]}, "sheen-r0.3"),
+    ("sheen", {"roughness": 1.0, "terminator_softening": False}, "sheen-r1-reciprocal"),
+    ("disney", {"roughness": 0.0}, "disney-r0"),
+    ("disney", {"roughness": 1.0}, "disney-r1"),
+    ("disney", {"roughness": 0.3, "anisotropic": 1.0}, "disney-aniso1"),
+    ("disney", {"metallic": 1.0, "roughness": 0.2}, "disney-metal"),
+    ("disney", {"metallic": 0.0, "roughness": 0.5, "specular_tint": 1.0}, "disney-dielectric"),
+    ("disney", {"clearcoat": 1.0, "clearcoat_gloss": 1.0, "roughness": 0.6}, "disney-clearcoat1"),
+    ("disney", {"spec_trans": 1.0, "roughness": 0.1, "ior": 1.5}, "disney-glass"),
+    ("disney", {"spec_trans": 1.0, "roughness": 0.3, "thin": True}, "disney-thin-glass"),
+    ("disney", {"diff_trans": 0.7, "thin": True, "flatness": 0.5}, "disney-leaf"),
+    ("disney", {"sheen": 1.0, "sheen_tint": 0.5, "subsurface": 1.0}, "disney-sheen"),
+    (
+        "disney",
+        {"sheen": 1.0, "sheen_model": "conty_kulla", "sheen_roughness": 0.5},
+        "disney-ck-sheen",
+    ),
+]
+# Views: normal incidence, 60°, nearly grazing (85°), and from below for transmitters.
+VIEWS = {
+    "normal": (0.0, 0.0, 1.0),
+    "60deg": (math.sin(math.radians(60)), 0.0, math.cos(math.radians(60))),
+    "85deg": (math.sin(math.radians(85)), 0.0, math.cos(math.radians(85))),
+    "below": (0.3, 0.2, -0.93),
+}
+
+
+def _case_params(model_name, values):
+    from lookdev.pipeline.export.mitsuba.plugin import MitsubaExportError
+    from lookdev.pipeline.export.mitsuba.scene import model_for
+
+    try:
+        model = model_for(model_name)
+    except MitsubaExportError as exc:
+        pytest.skip(str(exc))
+    return model, model.params_type.parse(values)
+
+
+def _plugin(mi, params):
+    from lookdev.pipeline.export.mitsuba.scene import bsdf_dict
+
+    d = bsdf_dict(params, allow_principled=False)
+    assert d["type"].startswith("lookdev_")
+    return d
+
+
+CHI2_CASES = [
+    pytest.param(model, values, view, id=f"{name}-{view}")
+    for model, values, name in CASES
+    for view in VIEWS
+    if view != "below" or values.get("spec_trans") or values.get("diff_trans")
+]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("model_name", "values", "view"), CHI2_CASES)
+def test_chi2_shipped_models(mi, model_name, values, view):
+    from mitsuba.chi2 import BSDFAdapter, ChiSquareTest, SphericalDomain
+
+    _, params = _case_params(model_name, values)
+    d = _plugin(mi, params)
+    sample, pdf = BSDFAdapter(d["type"], d, wi=_unit(VIEWS[view]).tolist())
+    test = ChiSquareTest(
+        domain=SphericalDomain(),
+        sample_func=sample,
+        pdf_func=pdf,
+        sample_dim=3,
+        sample_count=200_000,
+        res=61,
+    )
+    assert test.run(), test.messages
+
+
+@pytest.mark.parametrize(
+    ("model_name", "values"), [c[:2] for c in CASES], ids=[c[2] for c in CASES]
+)
+def test_drjit_eval_equals_numpy_eval(mi, model_name, values):
+    model, params = _case_params(model_name, values)
+    rng = np.random.default_rng(7)
+    view = _unit(rng.normal(size=(2048, 3)))
+    light = _unit(rng.normal(size=(2048, 3)))
+    view[:64, 2] = np.abs(view[:64, 2]) * 1e-3  # grazing
+    view = _unit(view)
+    bsdf = mi.load_dict(_plugin(mi, params))
+    si = _interaction(mi, view)
+    got = np.array(bsdf.eval(mi.BSDFContext(), si, mi.Vector3f(light.astype(np.float32).T))).T
+    view32, light32 = np.array(si.wi).T.astype(np.float64), light.astype(np.float32)
+    want = evaluate(model, params, light32.astype(np.float64), view32) * np.abs(light32[:, 2:3])
+    assert np.all(np.isfinite(got))
+    scale = max(float(np.max(np.abs(want))), 1e-6)
+    np.testing.assert_allclose(got, want, rtol=2e-4, atol=2e-5 * scale)
+
+
+FURNACE_CASES = [
+    ("disney", {"roughness": 0.5, "base_color": [0.8, 0.4, 0.2]}, "disney-plastic"),
+    ("disney", {"metallic": 1.0, "roughness": 0.2}, "disney-metal"),
+    ("disney", {"clearcoat": 1.0, "roughness": 0.7, "base_color": [0.2, 0.3, 0.8]}, "disney-coat"),
+    ("disney", {"spec_trans": 1.0, "roughness": 0.0, "ior": 1.5}, "disney-glass"),
+    ("sheen", {"roughness": 0.3, "color": [0.9, 0.5, 0.3]}, "sheen"),
+]
+
+
+def _pixel_view_angles(scene, rows, cols):
+    """View angle θ of the sphere's surface seen through each pixel centre (pinhole)."""
+    film = scene["sensor"]["film"]
+    width, height = film["width"], film["height"]
+    matrix = np.array(scene["sensor"]["to_world"].matrix, dtype=np.float64)
+    origin = matrix[:3, 3]
+    half = math.tan(math.radians(scene["sensor"]["fov"]) / 2)  # fov along x
+    x = (1 - 2 * (cols + 0.5) / width) * half  # Mitsuba's image x runs opposite world x
+    y = (1 - 2 * (rows + 0.5) / height) * half * height / width
+    d = _unit(np.stack([x, y, -np.ones_like(x)], axis=-1))
+    b = (d * origin).sum(-1)
+    t = -b - np.sqrt(b * b - (origin @ origin - 1.0))
+    normal = origin + t[..., None] * d
+    return np.arccos(np.clip(-(d * normal).sum(-1), -1, 1))
+
+
+@pytest.mark.parametrize(
+    ("model_name", "values"), [c[:2] for c in FURNACE_CASES], ids=[c[2] for c in FURNACE_CASES]
+)
+def test_white_furnace_sphere_matches_numpy_albedo(mi, model_name, values):
+    """Single scattering on a convex sphere under a white sky: radiance = albedo(θ)."""
+    from lookdev.pipeline.analysis.albedo import albedo_monte_carlo
+    from lookdev.pipeline.export.mitsuba.scene import scene_dict
+
+    model, params = _case_params(model_name, values)
+    scene = scene_dict(params, resolution=(32, 32), spp=512, max_depth=2)
+    scene["ball"]["bsdf"] = _plugin(mi, params)
+    image = np.array(mi.render(mi.load_dict(scene), seed=1))
+    rows, cols = np.mgrid[14:18, 14:18]
+    theta = _pixel_view_angles(scene, rows, cols).ravel()
+    expected = albedo_monte_carlo(model, params, theta, n_samples=65536).albedo.mean(axis=0)
+    got = image[14:18, 14:18].reshape(-1, 3).mean(axis=0)
+    np.testing.assert_allclose(got, expected, rtol=0.02, atol=2e-3)
+
+
+def test_furnace_view_angles_off_centre(mi, monkeypatch):
+    """The pixel-angle helper, checked where the tiny model's albedo ρ(1 + cos θ)/2 varies."""
+    from lookdev.pipeline.export.mitsuba import scene as export
+
+    monkeypatch.setitem(export.MODEL_MODULES, "tiny_test", "_mitsuba_tiny")
+    params = TinyParams(base_color=(0.8, 0.5, 0.2))
+    scene = export.scene_dict(params, resolution=(32, 32), spp=512, max_depth=2)
+    image = np.array(mi.render(mi.load_dict(scene), seed=2))
+    rows, cols = np.mgrid[15:17, 24:26]
+    theta = _pixel_view_angles(scene, rows, cols)
+    assert 0.6 < theta.mean() < 1.2  # well off the normal
+    expected = np.array([0.8, 0.5, 0.2]) * (0.5 + 0.5 * np.cos(theta)).mean()
+    got = image[15:17, 24:26].reshape(-1, 3).mean(axis=0)
+    np.testing.assert_allclose(got, expected, rtol=0.02)

@@ -66,8 +66,10 @@ def model_for(name: str) -> Model:
         )
     try:
         return importlib.import_module(module).MODEL
-    except (ImportError, AttributeError):
-        raise MitsubaExportError(f"model {name!r} is not available ({module}.MODEL)") from None
+    except (ImportError, AttributeError) as exc:
+        raise MitsubaExportError(
+            f"model {name!r} is not available ({module}.MODEL: {exc})"
+        ) from None
 
 
 def register_plugins() -> dict[str, str]:
