@@ -180,3 +180,100 @@ def test_in_memory_textures_cannot_go_to_xml(mi, m):
     scene = m.scene_dict(_blended(translucency=np.ones((2, 2), np.float32)))
     with pytest.raises(LookdevError, match="texture folder"):
         xml.to_xml(scene)
+
+
+# -- with the Disney model and the library ------------------------------------------------
+@pytest.fixture
+def disney():
+    return pytest.importorskip("lookdev.materials.disney")
+
+
+def _principled_vs_plugin(mi, m, params, n=4096, seed=0):
+    """Max relative difference of principled and our plugin on random direction pairs."""
+    import drjit as dr
+
+    flat = m.flatten(params)
+    fast = m.principled_equivalent(flat)
+    assert fast is not None
+    ours = mi.load_dict(m.bsdf_dict(params, allow_principled=False))
+    theirs = mi.load_dict(fast)
+    rng = np.random.default_rng(seed)
+    view = rng.normal(size=(n, 3))
+    view[:, 2] = np.abs(view[:, 2])
+    light = rng.normal(size=(n, 3))
+    light[:, 2] = np.abs(light[:, 2])
+    si = dr.zeros(mi.SurfaceInteraction3f, n)
+    si.wi = mi.Vector3f((view / np.linalg.norm(view, axis=1, keepdims=True)).T)
+    si.sh_frame = mi.Frame3f(mi.Vector3f(0, 0, 1))
+    wo = mi.Vector3f((light / np.linalg.norm(light, axis=1, keepdims=True)).T)
+    a = np.array(ours.eval(mi.BSDFContext(), si, wo))
+    b = np.array(theirs.eval(mi.BSDFContext(), si, wo))
+    return float(np.max(np.abs(a - b) / np.maximum(np.abs(b), 1e-3)))
+
+
+@pytest.mark.parametrize("roughness", [0.0, 0.05, 0.5, 1.0])
+@pytest.mark.parametrize("anisotropic", [0.0, 1.0])
+def test_principled_fast_path_equals_our_metal(mi, m, disney, roughness, anisotropic):
+    from lookdev.materials.params import DisneyParams
+
+    params = DisneyParams(
+        metallic=1.0, base_color=(0.95, 0.64, 0.54), roughness=roughness, anisotropic=anisotropic
+    )
+    assert _principled_vs_plugin(mi, m, params) < 1e-4
+
+
+def test_fast_path_only_where_measured(m, disney):
+    from lookdev.materials.params import DisneyParams
+
+    def fast(**kw):
+        return m.principled_equivalent(m.flatten(DisneyParams(**kw)))
+
+    assert fast(metallic=1.0, roughness=0.3) == {
+        "type": "principled",
+        "metallic": 1.0,
+        "roughness": 0.3,
+        "base_color": {"type": "rgb", "value": list(DisneyParams().base_color)},
+    }
+    assert fast(metallic=0.99) is None  # dielectric Fresnel part differs
+    assert fast(metallic=1.0, clearcoat=0.5) is None  # clearcoat normalisation differs
+    assert m.bsdf_dict(DisneyParams(metallic=1.0), force_all_lobes=True)["type"] == "lookdev_disney"
+
+
+def test_depth_for_disney(m, disney):
+    from lookdev.materials.params import DisneyParams
+
+    assert m.max_depth_for(DisneyParams()) == m.DEPTH_OPAQUE
+    assert m.max_depth_for(DisneyParams(spec_trans=1.0, thin=True)) == m.DEPTH_THIN_TRANSMISSION
+    assert m.max_depth_for(DisneyParams(spec_trans=1.0, ior=1.5)) == m.DEPTH_SOLID_TRANSMISSION
+
+
+def test_cli_export_mitsuba(mi, cli, disney, tmp_path):
+    import json
+
+    out = tmp_path / "gold" / "gold.xml"
+    result = cli(
+        "export",
+        "mitsuba",
+        "gold",
+        "-o",
+        str(out),
+        "--resolution",
+        "16",
+        "16",
+        "--spp",
+        "4",
+        "--json",
+    )
+    assert result.code == 0, result.err
+    summary = json.loads(result.out)
+    assert summary["scene"] == str(out) and summary["max_depth"] == 4
+    assert np.all(np.isfinite(np.array(mi.render(mi.load_file(str(out))))))
+
+
+def test_cli_bad_input_exits_2_with_one_line(cli, tmp_path):
+    out = tmp_path / "x.xml"
+    for args in (["no_such_preset"], ["gold", "--ibl", str(tmp_path / "missing.exr")]):
+        result = cli("export", "mitsuba", *args, "-o", str(out))
+        assert result.code == 2
+        assert result.err.startswith("lookdev: error:") and result.err.count("\n") == 1
+        assert not out.exists()
