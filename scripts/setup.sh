@@ -18,6 +18,16 @@ if ! ldconfig -p 2>/dev/null | grep -q 'libLLVM.so.19'; then
   fi
 fi
 
+# Headless Chromium opens the proof review page in tests/test_report.py.
+if ! command -v chromium >/dev/null 2>&1 && command -v apt-get >/dev/null 2>&1; then
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && command -v sudo >/dev/null 2>&1 && SUDO="sudo"
+  echo "setup: installing chromium for the review-page test"
+  if ! { $SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq chromium; } >/tmp/lookdev-apt-chromium.log 2>&1; then
+    echo "setup: warning: could not install chromium (see /tmp/lookdev-apt-chromium.log); the review-page browser test will be skipped" >&2
+  fi
+fi
+
 PYTHON=${PYTHON:-python3}
 if [ ! -x .venv/bin/python ]; then
   "$PYTHON" -m venv .venv

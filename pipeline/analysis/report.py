@@ -1,0 +1,256 @@
+"""The review page of a proof batch: ``index.html``, static, opens from disk, no network.
+
+:func:`write_report` reads every ``manifest.json`` under a batch folder (one per material
+× IBL, written by :mod:`lookdev.pipeline.proof`) and writes ``index.html`` beside them
+with, in this order: the contact sheets; the time/noise table built from the manifests;
+then per material its BRDF-explorer plots (slice, albedo, polar, lit sphere) and, per IBL,
+its turntable frames.
+
+Everything the page shows lives under the batch folder and is linked relatively, so the
+folder can be moved, zipped or served as it is. Browsers cannot show EXR, so EXR frames
+get sRGB PNG thumbnails in ``report/``; plots go there too. Images are only linked once
+they exist on disk: the page has no broken images by construction, and the test opens it
+in headless Chromium to make sure.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import os
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lookdev.materials.errors import LookdevError
+
+REPORT_DIR = "report"
+WEB_IMAGES = (".png", ".jpg", ".jpeg", ".gif", ".webp", ".svg")
+PLOT_VIEWS = ("slice", "albedo", "polar", "sphere")
+
+
+class ReportError(LookdevError):
+    """A batch folder cannot be turned into a review page."""
+
+
+@dataclass
+class Entry:
+    """One manifest: a material under one IBL."""
+
+    path: Path
+    data: dict[str, Any]
+    material: str
+    ibl: str
+    frames: list[Path] = field(default_factory=list)
+
+
+# -- reading a batch -----------------------------------------------------------------
+def read_manifests(batch_dir: Path) -> list[Entry]:
+    """Every ``manifest.json`` under ``batch_dir`` (recursively), sorted by material, IBL."""
+    entries = []
+    for path in sorted(batch_dir.rglob("manifest.json")):
+        try:
+            data = json.loads(path.read_text())
+        except (OSError, json.JSONDecodeError) as exc:
+            raise ReportError(f"unreadable manifest: {exc}", where=str(path)) from None
+        if not isinstance(data, dict):
+            raise ReportError("a manifest must be a JSON object", where=str(path))
+        material = str(data.get("material") or data.get("name") or path.parent.parent.name)
+        ibl = str(data.get("ibl") or path.parent.name)
+        entries.append(Entry(path, data, material, ibl, _frames(path.parent, data)))
+    return sorted(entries, key=lambda e: (e.material, e.ibl))
+
+
+def _frames(folder: Path, data: dict[str, Any]) -> list[Path]:
+    """Frame files a manifest lists (any key holding paths), else the images beside it."""
+    listed = []
+    for key, value in data.items():
+        if "frame" in key and isinstance(value, list):
+            for item in value:
+                p = item.get("path") if isinstance(item, dict) else item
+                if isinstance(p, str):
+                    listed.append(p if Path(p).is_absolute() else folder / p)
+    paths = [Path(p) for p in listed] or sorted(
+        p for p in folder.iterdir() if p.suffix.lower() in (*WEB_IMAGES, ".exr")
+    )
+    return [p for p in paths if p.is_file() and "contact" not in p.name]
+
+
+def contact_sheets(batch_dir: Path) -> list[Path]:
+    """Images named ``*contact*`` anywhere in the batch, outside ``report/``."""
+    return sorted(
+        p
+        for p in batch_dir.rglob("*contact*")
+        if p.suffix.lower() in (*WEB_IMAGES, ".exr")
+        and REPORT_DIR not in p.relative_to(batch_dir).parts
+    )
+
+
+# -- the time/noise table ------------------------------------------------------------
+def table_rows(entries: Iterable[Entry]) -> tuple[list[str], list[list[str]]]:
+    """Columns and rows: material, IBL, then every scalar field the manifests carry."""
+    entries = list(entries)
+    keys: dict[str, None] = {}
+    for e in entries:
+        for k in _scalars(e.data):
+            if k not in ("material", "name", "ibl"):
+                keys.setdefault(k)
+    columns = ["material", "ibl", *keys]
+    rows = []
+    for e in entries:
+        flat = _scalars(e.data)
+        rows.append([e.material, e.ibl, *(_fmt(flat.get(k)) for k in keys)])
+    return columns, rows
+
+
+def _scalars(data: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    """Numbers, strings and booleans of a manifest, nested keys joined with dots."""
+    out: dict[str, Any] = {}
+    for k, v in data.items():
+        name = f"{prefix}{k}"
+        if isinstance(v, dict):
+            out.update(_scalars(v, f"{name}."))
+        elif isinstance(v, bool | int | float) or (isinstance(v, str) and len(v) < 60):
+            out[name] = v
+    return out
+
+
+def _fmt(v: Any) -> str:
+    if v is None:
+        return ""
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    return str(v)
+
+
+# -- images ---------------------------------------------------------------------------
+def web_image(src: Path, out_dir: Path, exposure: float = 0.0) -> Path:
+    """A browser-viewable version of ``src``: itself, or an sRGB PNG of an EXR."""
+    if src.suffix.lower() in WEB_IMAGES:
+        return src
+    import OpenImageIO as oiio
+
+    from .plots import to_display
+
+    try:  # named after its place in the batch, so material/ibl/frame_000 stay apart
+        parts = src.relative_to(out_dir.parent).with_suffix("").parts
+    except ValueError:
+        parts = src.with_suffix("").parts[-3:]
+    dst = out_dir / "frames" / ("_".join(parts) + ".png")
+    if dst.exists() and dst.stat().st_mtime >= src.stat().st_mtime:
+        return dst
+    buf = oiio.ImageBuf(str(src))
+    pixels = np.asarray(buf.get_pixels(oiio.FLOAT))
+    if buf.has_error or pixels.ndim != 3:
+        raise ReportError(f"cannot read frame: {buf.geterror()}", where=str(src))
+    rgb = pixels[..., :3] if pixels.shape[-1] >= 3 else np.repeat(pixels[..., :1], 3, -1)
+    img = (to_display(rgb, exposure) * 255 + 0.5).astype(np.uint8)
+    dst.parent.mkdir(parents=True, exist_ok=True)
+    out = oiio.ImageBuf(oiio.ImageSpec(img.shape[1], img.shape[0], 3, oiio.UINT8))
+    out.set_pixels(oiio.ROI(), img)
+    tmp = dst.with_name(f".{dst.name}")
+    if not out.write(str(tmp)):
+        raise ReportError(f"cannot write thumbnail: {out.geterror()}", where=str(dst))
+    tmp.replace(dst)
+    return dst
+
+
+def material_plots(materials: Iterable[str], out_dir: Path, library: Any = None) -> dict:
+    """``{material: {view: png}}``; a material that cannot be loaded gets no plots."""
+    from .plots import figure, save_figure, subject_for
+
+    result: dict[str, dict[str, Path]] = {}
+    for name in materials:
+        try:
+            subject = subject_for(name, library)
+        except LookdevError:
+            continue
+        result[name] = {
+            view: save_figure(
+                figure([subject], view, resolution=64), out_dir / "plots" / f"{name}_{view}.png"
+            )
+            for view in PLOT_VIEWS
+        }
+    return result
+
+
+# -- the page -------------------------------------------------------------------------
+CSS = """
+body{font:14px/1.4 system-ui,sans-serif;margin:24px;background:#1e1e1e;color:#ddd}
+h1,h2,h3{font-weight:600}h2{border-bottom:1px solid #444;padding-bottom:4px;margin-top:32px}
+table{border-collapse:collapse;font-variant-numeric:tabular-nums}
+th,td{padding:3px 10px;border-bottom:1px solid #333;text-align:right}
+th:first-child,td:first-child,th:nth-child(2),td:nth-child(2){text-align:left}
+.strip{display:flex;flex-wrap:wrap;gap:6px}.strip img{height:128px;background:#000}
+.plots img{height:260px;background:#fff;margin:4px}
+figure{margin:0}figcaption{font-size:12px;color:#999}
+img.sheet{max-width:100%}
+"""
+
+
+def _img(src: Path, base: Path, alt: str, cls: str = "") -> str:
+    rel = Path(os.path.relpath(src, base)).as_posix()
+    c = f' class="{cls}"' if cls else ""
+    return f'<img{c} src="{html.escape(rel)}" alt="{html.escape(alt)}">'
+
+
+def render_page(batch_dir: Path, entries: list[Entry], sheets: list[Path], plots: dict) -> str:
+    """The HTML text of the review page."""
+    out = batch_dir / REPORT_DIR
+    esc = html.escape
+    parts = [
+        "<!doctype html><html lang=en><head><meta charset=utf-8>",
+        f"<title>lookdev proof: {esc(batch_dir.name)}</title><style>{CSS}</style></head><body>",
+        f"<h1>lookdev proof — {esc(batch_dir.name)}</h1>",
+        f"<p>{len({e.material for e in entries})} material(s), {len(entries)} proof(s).</p>",
+    ]
+    if sheets:
+        parts.append("<h2>Contact sheets</h2>")
+        for s in sheets:
+            parts.append(
+                f"<figure>{_img(web_image(s, out), batch_dir, s.stem, 'sheet')}"
+                f"<figcaption>{esc(s.relative_to(batch_dir).as_posix())}</figcaption></figure>"
+            )
+    columns, rows = table_rows(entries)
+    parts.append("<h2>Time and noise</h2><table><thead><tr>")
+    parts += [f"<th>{esc(c)}</th>" for c in columns]
+    parts.append("</tr></thead><tbody>")
+    for row in rows:
+        parts.append("<tr>" + "".join(f"<td>{esc(v)}</td>" for v in row) + "</tr>")
+    parts.append("</tbody></table>")
+    for material in dict.fromkeys(e.material for e in entries):
+        parts.append(f'<h2 id="{esc(material)}">{esc(material)}</h2>')
+        if material in plots:
+            parts.append('<div class="plots">')
+            parts += [_img(p, batch_dir, f"{material} {v}") for v, p in plots[material].items()]
+            parts.append("</div>")
+        for e in (e for e in entries if e.material == material):
+            parts.append(f"<h3>{esc(e.ibl)}</h3><div class=strip>")
+            parts += [
+                _img(web_image(f, out), batch_dir, f"{material} {e.ibl} {f.stem}") for f in e.frames
+            ]
+            parts.append("</div>")
+    parts.append("</body></html>")
+    return "\n".join(parts)
+
+
+def write_report(batch_dir: str | Path, *, library: Any = None, plots: bool = True) -> Path:
+    """Write ``batch_dir/index.html`` (and its thumbnails and plots); return its path."""
+    batch_dir = Path(batch_dir).resolve()
+    if not batch_dir.is_dir():
+        raise ReportError("no such batch folder", where=str(batch_dir))
+    entries = read_manifests(batch_dir)
+    if not entries:
+        raise ReportError("no manifest.json found: is this a proof batch?", where=str(batch_dir))
+    out = batch_dir / REPORT_DIR
+    out.mkdir(exist_ok=True)
+    made = material_plots(dict.fromkeys(e.material for e in entries), out, library) if plots else {}
+    page = render_page(batch_dir, entries, contact_sheets(batch_dir), made)
+    index = batch_dir / "index.html"
+    tmp = index.with_name(".index.html.tmp")
+    tmp.write_text(page, encoding="utf-8")
+    tmp.replace(index)
+    return index
