@@ -40,11 +40,11 @@ MODEL_NAMES = ("disney", "pixar", "sheen")
 
 # Proof-render cases: label → built-in preset name.
 RENDER_PRESETS: dict[str, str] = {
-    "diffuse": "chalk",
+    "diffuse": "plaster",
     "glossy metal": "gold",
-    "clearcoat": "car_paint",
+    "clearcoat": "car_paint_red",
     "sheen": "velvet",
-    "glass": "glass",
+    "glass": "glass_clear",
 }
 
 
