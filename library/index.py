@@ -57,14 +57,15 @@ class _Stat:
     mtime_ns: int
 
 
-def scan_folder(folder: Path, *, cache: bool = True) -> list[Header]:
+def scan_folder(folder: Path, *, cache: bool = True, skip: tuple[str, ...] = ()) -> list[Header]:
     """Headers of every preset file under ``folder``, sorted by relative path.
 
     Hidden files and folders (``.name``) are skipped: they are temporaries and caches.
     ``cache=False`` neither reads nor writes the index (the built-in library, which is
-    small and must not grow files inside a checkout or an installed package).
+    small and must not grow files inside a checkout or an installed package). ``skip``
+    names top-level sub-folders that hold other data (the built-in ``ibl/``).
     """
-    stats = _walk(folder)
+    stats = _walk(folder, skip)
     cached = _read_index(folder) if cache else {}
     headers, fresh, misses = [], {}, 0
     for s in stats:
@@ -128,14 +129,14 @@ def _header_from_doc(doc: dict[str, Any], name: str, path: Path) -> Header:
     return Header(name, path, got["model"], description, tuple(tags), got["extends"])
 
 
-def _walk(folder: Path) -> list[_Stat]:
+def _walk(folder: Path, skip: tuple[str, ...] = ()) -> list[_Stat]:
     out: list[_Stat] = []
     stack = [(folder, "")]
     while stack:
         here, prefix = stack.pop()
         with os.scandir(here) as it:
             for e in it:
-                if e.name.startswith("."):
+                if e.name.startswith(".") or (not prefix and e.name in skip):
                     continue
                 if e.is_dir():
                     stack.append((Path(e.path), f"{prefix}{e.name}/"))

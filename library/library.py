@@ -26,6 +26,8 @@ from .material import Material, resolve
 from .preset import METADATA, PresetFile, build_preset, check_name, dump_preset, parse_preset
 
 ENV_PATH = "LOOKDEV_LIBRARY_PATH"
+BUILTIN_OTHER_DATA = ("ibl",)
+"""Sub-folders of the built-in ``presets/`` that hold other data, not material presets."""
 
 
 def builtin_folder() -> Path:
@@ -96,7 +98,7 @@ class Library:
             return scan_folder(folder)
         # Read-only and small: scanned once per Library, never indexed on disk.
         if self._builtin_headers is None:
-            self._builtin_headers = scan_folder(folder, cache=False)
+            self._builtin_headers = scan_folder(folder, cache=False, skip=BUILTIN_OTHER_DATA)
         return self._builtin_headers
 
     def _find_in(self, folder: Path, name: str) -> Path | None:

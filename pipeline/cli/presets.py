@@ -14,6 +14,7 @@ from lookdev.library.library import apply_changes
 from lookdev.library.preset import PresetFile, check_name, parse_value
 from lookdev.library.schema import preset_schema
 from lookdev.materials.errors import LookdevError
+from lookdev.materials.layers import children
 
 from .common import console, err_console, print_json, table
 
@@ -370,8 +371,14 @@ def _value(v: Any) -> str:
 
 
 def _mask_text(mask: Any) -> str:
-    data = mask.model_dump(mode="json", exclude_defaults=True)
-    return ", ".join(f"{k}={v}" for k, v in data.items()) or mask.kind
+    """A mask tree as a call expression: ``levels(noise(scale=6.0, seed=7), low=0.42)``."""
+    fields = mask.model_dump(
+        mode="json", exclude_defaults=True, exclude={"kind", "input", "inputs"}
+    )
+    if "path" in fields:
+        fields["path"] = Path(fields["path"]).name
+    args = [_mask_text(c) for c in children(mask)] + [f"{k}={v}" for k, v in fields.items()]
+    return f"{mask.kind}({', '.join(args)})"
 
 
 def _files(paths: list[Path]) -> list[Path]:
