@@ -335,3 +335,27 @@ def test_furnace_view_angles_off_centre(mi, monkeypatch):
     expected = np.array([0.8, 0.5, 0.2]) * (0.5 + 0.5 * np.cos(theta)).mean()
     got = image[15:17, 24:26].reshape(-1, 3).mean(axis=0)
     np.testing.assert_allclose(got, expected, rtol=0.02)
+
+
+def test_chi2_rejects_a_pdf_that_does_not_match_sampling(mi):
+    """Negative control: the same chi2 set-up catches a model whose pdf is wrong."""
+    import dataclasses
+
+    from mitsuba.chi2 import BSDFAdapter, ChiSquareTest, SphericalDomain
+
+    from lookdev.pipeline.export.mitsuba.plugin import register_model
+
+    def uniform_pdf(xp, p, wi, wo):  # sampling is cosine-weighted: this pdf is wrong
+        return xp.select(wi[2] * wo[2] > 0, 1.0 / (2.0 * math.pi), 0.0)
+
+    name = register_model(dataclasses.replace(TINY, name="tiny_broken", pdf=uniform_pdf))
+    sample, pdf = BSDFAdapter(name, {"type": name}, wi=[0.0, 0.0, 1.0])
+    test = ChiSquareTest(
+        domain=SphericalDomain(),
+        sample_func=sample,
+        pdf_func=pdf,
+        sample_dim=3,
+        sample_count=200_000,
+        res=61,
+    )
+    assert not test.run()

@@ -176,10 +176,10 @@ def _plugin_class(variant: str) -> type:
             self.components = [_union(reflect, flag), _union(transmit, flag)]
             # Mitsuba numbers only the components that exist: reflection first.
             self.component_index = (0, 1 if reflect else 0)
-            extra = flag.FrontSide | flag.BackSide
+            extra = flag.FrontSide | (flag.BackSide if transmit else flag.Empty)
             if self.textures:
                 extra |= flag.SpatiallyVarying
-            if getattr(self.params, "anisotropic", 0):
+            if getattr(self.params, "anisotropic", 0) or "anisotropic" in self.textures:
                 extra |= flag.Anisotropic
             self.m_components = [c | extra for c in self.components if c != flag.Empty]
             self.m_flags = functools.reduce(lambda a, b: a | b, self.m_components, flag.Empty)
