@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -135,3 +136,39 @@ def test_every_view_draws_several_materials_labelled(tmp_path, view):
     out = P.save_figure(fig, tmp_path / f"{view}.png")
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert not list(tmp_path.glob(".*tmp*"))
+
+
+# -- lookdev plot ----------------------------------------------------------------------
+def test_cli_rejects_an_unknown_output_format_in_one_line(cli, tmp_path):
+    res = cli("plot", "gold", "-o", str(tmp_path / "a.jpg"))
+    assert res.code == 2
+    assert "allowed .png, .pdf, .svg" in res.err and "Traceback" not in res.err
+    assert not list(tmp_path.iterdir())
+
+
+def test_cli_names_a_missing_preset(cli, tmp_path):
+    res = cli("plot", "no_such_preset", "-o", str(tmp_path / "a.png"))
+    assert res.code == 2 and "no_such_preset" in res.err
+    assert not list(tmp_path.iterdir())
+
+
+def test_cli_ibl_only_with_sphere(cli, tmp_path):
+    pytest.importorskip("lookdev.materials.disney")
+    res = cli("plot", "gold", "--view", "slice", "--ibl", "studio", "-o", str(tmp_path / "a.png"))
+    assert res.code == 2 and "--ibl" in res.err
+
+
+@pytest.mark.parametrize("view", P.VIEWS)
+def test_cli_plots_presets_side_by_side(cli, tmp_path, view):
+    pytest.importorskip("lookdev.materials.disney")
+    out = tmp_path / f"{view}.png"
+    res = cli(
+        "plot", "gold", "plaster", "--view", view, "-o", str(out), "--resolution", "24", "--json"
+    )
+    assert res.code == 0, res.err
+    assert json.loads(res.out) == {
+        "output": str(out),
+        "view": view,
+        "materials": ["gold", "plaster"],
+    }
+    assert out.read_bytes()[:4] == b"\x89PNG"

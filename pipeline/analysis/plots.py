@@ -64,15 +64,16 @@ def model_named(name: str) -> Model:
     raise PlotError(f"no reflectance model named {name!r} is installed", field="model")
 
 
-def subject_for(name_or_path: str, library_paths: Sequence[Path] | None = None) -> Subject:
-    """Load a preset (name or file) and make it plottable.
+def subject_for(name_or_path: str, library: Any = None) -> Subject:
+    """Load a preset (name or file) from ``library`` (a Library; None = default) and make
+    it plottable.
 
     A layered preset is blended first; views show its parameters at the texture's
     centre (uv 0.5, 0.5) unless the blend is uniform.
     """
-    from lookdev.library import Library, load_material
+    from lookdev.library import load_material
 
-    material = load_material(name_or_path, Library(list(library_paths)) if library_paths else None)
+    material = load_material(name_or_path, library)
     if material.model != "layered":
         return Subject(material.name, model_named(material.model), material.params)
     from lookdev.pipeline.blend import blend

@@ -83,7 +83,10 @@ def plot(
             f"cannot write {output.suffix or 'no extension'}; allowed {', '.join(FORMATS)}",
             where=str(output),
         )
-    subjects = [plots.subject_for(name, library or None) for name in presets]
+    from lookdev.library import Library
+
+    lib = Library(library)
+    subjects = [plots.subject_for(name, lib) for name in presets]
     environment = None
     if ibl is not None:
         if view is not View.sphere:
