@@ -1,0 +1,351 @@
+"""Environment lights (IBLs) for proofs: built-ins generated procedurally, or user files.
+
+A built-in IBL is a small TOML definition in ``presets/ibl/`` (a background gradient or a
+CIE sky, a sun, soft boxes, a ground) rendered once into a lat-long EXR with OpenImageIO
+and cached under ``$LOOKDEV_CACHE`` (default ``~/.cache/lookdev``) by a hash of the
+definition, so editing a definition regenerates it. Any ``.exr`` or ``.hdr`` a user names
+is used the same way.
+
+Every IBL of a batch is brought to one resolution and its exposure is folded into the
+pixels (:func:`load`): in Mitsuba 3.9 a new envmap resolution or ``scale`` compiles a new
+kernel, while new pixel values of the same size do not (DESIGN.md, Proofing).
+
+Lat-long convention (Mitsuba's ``envmap``): pixel (u, v) looks along
+``(sin φ sin θ, cos θ, −cos φ sin θ)`` with φ = 2πu, θ = πv; row 0 is the zenith (+y).
+Light directions in the definitions are (azimuth, elevation) in degrees with azimuth 0
+towards the camera (+z: a front light), 90 from the camera's right (+x), 180 behind the
+subject (a rim light).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import tempfile
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+from lookdev.materials.errors import LookdevError
+
+GENERATOR_VERSION = 1  # bump when the generator's maths changes: invalidates the cache
+DEFAULT_WIDTH = 512
+SUFFIXES = (".exr", ".hdr")
+
+Rgb = tuple[float, float, float]
+
+
+class IblError(LookdevError):
+    """An IBL name, definition or file cannot be used."""
+
+
+# -- definitions ---------------------------------------------------------------------------
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Gradient(_Strict):
+    """Background radiance blending horizon → zenith above and horizon → ground below."""
+
+    zenith: Rgb
+    horizon: Rgb
+    ground: Rgb
+    sharpness: float = Field(1.0, gt=0, description="Exponent on |y|: > 1 hugs the horizon.")
+
+
+class CieSky(_Strict):
+    """CIE S 011/E:2003 standard general sky: relative luminance from five coefficients.
+
+    L(Z, χ)/L_z = f(χ) φ(Z) / (f(Z_s) φ(0)) with φ(Z) = 1 + a·exp(b / cos Z) and
+    f(χ) = 1 + c·(exp(dχ) − exp(dπ/2)) + e·cos²χ (Z: zenith angle, χ: angle to the sun).
+    Type 12 (clear, low turbidity) is a=−1, b=−0.32, c=10, d=−3, e=0.45; type 1 (overcast,
+    steep gradation towards the zenith) is a=4, b=−0.7, c=0, d=−1, e=0.
+    """
+
+    a: float
+    b: float
+    c: float
+    d: float
+    e: float
+    zenith: Rgb = Field(description="Radiance at the zenith.")
+    horizon_tint: Rgb = Field((1.0, 1.0, 1.0), description="Colour multiplier at the horizon.")
+
+
+class Sun(_Strict):
+    """A disc of given irradiance (at normal incidence), spread over ≥ 2 pixels."""
+
+    azimuth: float
+    elevation: float = Field(ge=-90, le=90)
+    irradiance: Rgb
+    angular_diameter: float = Field(0.53, gt=0, le=30, description="Degrees.")
+
+
+class SoftBox(_Strict):
+    """A rectangular area light seen from the subject, with smooth edges."""
+
+    name: str = ""
+    azimuth: float
+    elevation: float = Field(ge=-90, le=90)
+    width: float = Field(gt=0, lt=180, description="Angular width, degrees.")
+    height: float = Field(gt=0, lt=180, description="Angular height, degrees.")
+    radiance: Rgb
+    softness: float = Field(0.15, ge=0, le=1, description="Edge falloff, fraction of size.")
+
+
+class Ground(_Strict):
+    """A diffuse ground below the horizon lit by everything above (radiance = ρ·E/π)."""
+
+    albedo: Rgb
+
+
+class IblDefinition(_Strict):
+    """One built-in IBL: the sum of its parts, scaled by 2^exposure."""
+
+    name: str
+    description: str = ""
+    exposure: float = 0.0
+    background: Gradient | None = None
+    sky: CieSky | None = None
+    sun: Sun | None = None
+    ground: Ground | None = None
+    lights: list[SoftBox] = Field(default_factory=list)
+
+
+def definitions_folder() -> Path:
+    """``presets/ibl`` of this checkout or installation."""
+    import lookdev.presets
+
+    return Path(next(iter(lookdev.presets.__path__))) / "ibl"
+
+
+def builtin_names() -> list[str]:
+    """Names of the built-in IBLs, sorted."""
+    return sorted(p.stem for p in definitions_folder().glob("*.toml"))
+
+
+def definition(name: str) -> IblDefinition:
+    """The parsed definition of built-in IBL ``name``; one-line errors."""
+    path = definitions_folder() / f"{name}.toml"
+    if not path.is_file():
+        raise IblError(
+            f"not a built-in IBL nor an existing .exr/.hdr file; built-ins: "
+            f"{', '.join(builtin_names())}",
+            where=name,
+        )
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        return IblDefinition.model_validate(data)
+    except tomllib.TOMLDecodeError as exc:
+        raise IblError(f"not valid TOML ({exc})", where=str(path)) from None
+    except ValidationError as exc:
+        err = exc.errors()[0]
+        field = ".".join(str(p) for p in err["loc"])
+        raise IblError(err["msg"], where=str(path), field=field) from None
+
+
+# -- generation ----------------------------------------------------------------------------
+def directions(width: int) -> tuple[np.ndarray, np.ndarray]:
+    """Unit directions (H, W, 3) of lat-long pixel centres and their solid angles (H, W).
+
+    >>> d, omega = directions(64)
+    >>> round(float(omega.sum()), 3) == round(4 * math.pi, 3)
+    True
+    """
+    height = width // 2
+    phi = (np.arange(width) + 0.5) / width * 2.0 * math.pi
+    theta = (np.arange(height) + 0.5) / height * math.pi
+    st, ct = np.sin(theta)[:, None], np.cos(theta)[:, None]
+    d = np.stack(np.broadcast_arrays(np.sin(phi) * st, ct, -np.cos(phi) * st), axis=-1)
+    omega = (2.0 * math.pi / width) * (math.pi / height) * np.broadcast_to(st, (height, width))
+    return d, omega
+
+
+def direction(azimuth: float, elevation: float) -> np.ndarray:
+    """Unit vector towards (azimuth, elevation) in degrees (module docstring convention)."""
+    az, el = math.radians(azimuth), math.radians(elevation)
+    return np.array([math.sin(az) * math.cos(el), math.sin(el), math.cos(az) * math.cos(el)])
+
+
+def _smooth_step(x: np.ndarray) -> np.ndarray:
+    x = np.clip(x, 0.0, 1.0)
+    return x * x * (3.0 - 2.0 * x)
+
+
+def gradient(g: Gradient, d: np.ndarray) -> np.ndarray:
+    y = d[..., 1:2]
+    t = np.abs(y) ** g.sharpness
+    far = np.where(y >= 0, np.asarray(g.zenith), np.asarray(g.ground))
+    return (1.0 - t) * np.asarray(g.horizon) + t * far
+
+
+def cie_sky(s: CieSky, d: np.ndarray, sun_dir: np.ndarray) -> np.ndarray:
+    """Upper-hemisphere radiance of the CIE general sky (zero below the horizon)."""
+    cos_z = np.clip(d[..., 1], 1e-3, 1.0)
+    z = np.arccos(cos_z)
+    chi = np.arccos(np.clip(d @ sun_dir, -1.0, 1.0))
+    zs = math.acos(float(np.clip(sun_dir[1], -1.0, 1.0)))
+
+    def gradation(cz: np.ndarray | float) -> np.ndarray:
+        return 1.0 + s.a * np.exp(s.b / cz)
+
+    def indicatrix(x: np.ndarray | float) -> np.ndarray:
+        return 1.0 + s.c * (np.exp(s.d * x) - math.exp(s.d * math.pi / 2)) + s.e * np.cos(x) ** 2
+
+    rel = indicatrix(chi) * gradation(cos_z) / (indicatrix(zs) * gradation(1.0))
+    tint = 1.0 + (np.asarray(s.horizon_tint) - 1.0) * (z / (math.pi / 2))[..., None]
+    radiance = np.clip(rel, 0.0, None)[..., None] * np.asarray(s.zenith) * tint
+    return np.where(d[..., 1:2] > 0, radiance, 0.0)
+
+
+def sun_disc(sun: Sun, d: np.ndarray, omega: np.ndarray, width: int) -> np.ndarray:
+    """The sun as a disc whose pixels integrate exactly to its irradiance."""
+    axis = direction(sun.azimuth, sun.elevation)
+    radius = max(math.radians(sun.angular_diameter) / 2, 2.0 * 2.0 * math.pi / width)
+    angle = np.arccos(np.clip(d @ axis, -1.0, 1.0))
+    weight = _smooth_step((radius - angle) / (0.25 * radius) + 0.5)
+    cosine = np.clip(d @ axis, 0.0, None)
+    norm = float((weight * cosine * omega).sum())
+    if norm <= 0.0:
+        return np.zeros((*weight.shape, 3))
+    return weight[..., None] * (np.asarray(sun.irradiance) / norm)
+
+
+def soft_box(box: SoftBox, d: np.ndarray) -> np.ndarray:
+    """Radiance of one soft box: a rectangle in the box's own angular coordinates."""
+    c = direction(box.azimuth, box.elevation)
+    right = np.cross([0.0, 1.0, 0.0], c)
+    right = right / np.linalg.norm(right) if np.linalg.norm(right) > 1e-6 else np.array([1.0, 0, 0])
+    up = np.cross(c, right)
+    front = d @ c
+    u = np.degrees(np.arctan2(d @ right, front))
+    v = np.degrees(np.arctan2(d @ up, front))
+    soft = max(box.softness, 1e-3)
+
+    def edge(x: np.ndarray, size: float) -> np.ndarray:
+        return _smooth_step((size / 2 - np.abs(x)) / (soft * size) + 0.5)
+
+    mask = edge(u, box.width) * edge(v, box.height) * (front > 0)
+    return mask[..., None] * np.asarray(box.radiance)
+
+
+def generate(defn: IblDefinition, width: int = DEFAULT_WIDTH) -> np.ndarray:
+    """The lat-long image (H, W, 3) float32 of a definition, exposure folded in."""
+    d, omega = directions(width)
+    rgb = np.zeros((*omega.shape, 3))
+    if defn.background is not None:
+        rgb += gradient(defn.background, d)
+    sun_dir = direction(defn.sun.azimuth, defn.sun.elevation) if defn.sun else np.array([0, 1, 0])
+    if defn.sky is not None:
+        rgb += cie_sky(defn.sky, d, sun_dir)
+    if defn.sun is not None:
+        rgb += sun_disc(defn.sun, d, omega, width)
+    for box in defn.lights:
+        rgb += soft_box(box, d)
+    if defn.ground is not None:
+        above = d[..., 1] > 0
+        irradiance = (rgb * (d[..., 1] * omega * above)[..., None]).sum(axis=(0, 1))
+        rgb = np.where(above[..., None], rgb, np.asarray(defn.ground.albedo) * irradiance / math.pi)
+    return (rgb * 2.0**defn.exposure).astype(np.float32)
+
+
+# -- files ---------------------------------------------------------------------------------
+def cache_dir() -> Path:
+    """Where generated IBLs live: ``$LOOKDEV_CACHE/ibl`` or ``~/.cache/lookdev/ibl``."""
+    root = os.environ.get("LOOKDEV_CACHE") or Path.home() / ".cache" / "lookdev"
+    return Path(root) / "ibl"
+
+
+def _key(defn: IblDefinition, width: int) -> str:
+    text = json.dumps([GENERATOR_VERSION, width, defn.model_dump(mode="json")], sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+def write_exr(pixels: np.ndarray, path: Path) -> Path:
+    """Write (H, W, C) float32 as an EXR atomically: a temporary name, then a rename."""
+    import OpenImageIO as oiio
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(suffix=".exr", prefix=f".{path.stem}.", dir=path.parent)
+    os.close(fd)
+    try:
+        buf = oiio.ImageBuf(np.ascontiguousarray(pixels, dtype=np.float32))
+        if not buf.write(tmp, oiio.FLOAT):
+            raise IblError(f"cannot write: {buf.geterror()}", where=str(path))
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return path
+
+
+def resolve(name_or_path: str | Path, width: int = DEFAULT_WIDTH) -> Path:
+    """The lat-long file of an IBL: a user's .exr/.hdr as given, a built-in generated once.
+
+    >>> resolve("studio").suffix
+    '.exr'
+    """
+    path = Path(name_or_path).expanduser()
+    if path.suffix.lower() in SUFFIXES:
+        if not path.is_file():
+            raise IblError("no such IBL file", where=str(path))
+        return path
+    defn = definition(str(name_or_path))
+    out = cache_dir() / f"{defn.name}-{width}-{_key(defn, width)}.exr"
+    if not out.is_file():
+        try:
+            write_exr(generate(defn, width), out)
+        except OSError as exc:
+            raise IblError(f"cannot write the IBL cache ({exc.strerror})", where=str(out)) from None
+    return out
+
+
+@dataclass(frozen=True)
+class Environment:
+    """An IBL ready to render: its name, file and pixels (H, W, 3) float32."""
+
+    name: str
+    source: Path
+    pixels: np.ndarray
+
+
+def read_image(path: Path) -> np.ndarray:
+    """An .exr/.hdr as (H, W, 3) float32 RGB; NaN and negative pixels become 0."""
+    import OpenImageIO as oiio
+
+    buf = oiio.ImageBuf(str(path))
+    pixels = buf.get_pixels(oiio.FLOAT) if not buf.has_error else None
+    if pixels is None or buf.has_error or pixels.ndim != 3:
+        raise IblError(
+            f"cannot decode the image ({buf.geterror() or 'no pixels'})", where=str(path)
+        )
+    pixels = pixels[..., :3] if pixels.shape[-1] >= 3 else np.repeat(pixels[..., :1], 3, -1)
+    return np.clip(np.nan_to_num(pixels, nan=0.0, posinf=0.0), 0.0, None).astype(np.float32)
+
+
+def resample(pixels: np.ndarray, width: int) -> np.ndarray:
+    """Lat-long pixels at ``width`` × ``width/2`` (OpenImageIO's filtered resize)."""
+    import OpenImageIO as oiio
+
+    height = width // 2
+    if pixels.shape[:2] == (height, width):
+        return pixels
+    src = oiio.ImageBuf(np.ascontiguousarray(pixels))
+    dst = oiio.ImageBufAlgo.resize(src, roi=oiio.ROI(0, width, 0, height, 0, 1, 0, 3))
+    return np.clip(dst.get_pixels(oiio.FLOAT), 0.0, None).astype(np.float32)
+
+
+def load(
+    name_or_path: str | Path, width: int = DEFAULT_WIDTH, exposure: float = 0.0
+) -> Environment:
+    """An IBL at ``width`` × ``width/2`` pixels with ``exposure`` stops folded in."""
+    if width < 8 or width % 2:
+        raise IblError(f"width {width} must be even and at least 8", field="width")
+    path = resolve(name_or_path, width)
+    pixels = resample(read_image(path), width) * np.float32(2.0**exposure)
+    name = path.stem if Path(str(name_or_path)).suffix.lower() in SUFFIXES else str(name_or_path)
+    return Environment(name, path, pixels)

@@ -1,0 +1,222 @@
+"""The proof scene: a sphere and a tilted cup on a ground plane, under an IBL.
+
+The sphere shows the material over every normal direction at once. The cup, a thick bowl
+revolved from a closed profile (convex outside and round rim, concave inside), shows how
+the material looks in cavities, where light bounces on the material itself; it is tilted
+towards the camera so that its inside is seen, and since its outside is a hemisphere
+tilted about its own centre it rests on the ground at any tilt and any turntable angle.
+
+The cup is a triangle mesh generated with numpy and written once as a binary PLY into
+the cache (:func:`cup_ply`), so a scene dict, the naive benchmark script and an exported
+XML scene all load the same file. World: y up, camera on +z looking at the pair.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .ibl import cache_dir
+
+GROUND_ALBEDO = 0.18  # a photographer's mid-grey card
+BALL_CENTER = (-1.2, 1.0, 0.0)
+CUP_CENTER = (1.2, 1.0, 0.0)
+CUP_TILT_DEG = 40.0  # towards the camera, so the inside shows
+CUP_WALL = 0.18  # wall thickness, in units of the outer radius
+
+
+@dataclass(frozen=True)
+class MeshData:
+    """Triangles with per-vertex normals and UVs, float32 / uint32."""
+
+    positions: np.ndarray  # (N, 3)
+    normals: np.ndarray  # (N, 3)
+    uvs: np.ndarray  # (N, 2)
+    faces: np.ndarray  # (F, 3)
+
+
+def cup_profile(samples: int = 48) -> tuple[np.ndarray, np.ndarray]:
+    """(r, y) along the cup's closed profile: outer pole → rim → inner pole.
+
+    Outer hemisphere of radius 1, a semicircular rim of diameter ``CUP_WALL``, inner
+    hemisphere of radius 1 − ``CUP_WALL``; the sphere centre is the origin.
+    """
+    w = CUP_WALL
+    t = np.linspace(-math.pi / 2, 0.0, samples)
+    outer = np.stack([np.cos(t), np.sin(t)], axis=1)
+    s = np.linspace(0.0, math.pi, max(8, samples // 4))[1:]
+    rim = np.stack([1 - w / 2 + (w / 2) * np.cos(s), (w / 2) * np.sin(s)], axis=1)
+    inner = (1 - w) * np.stack([np.cos(-t[::-1]), np.sin(-t[::-1])], axis=1)[1:]
+    inner[:, 1] *= -1  # back down into the bowl: y from 0 to −(1 − w)
+    pts = np.concatenate([outer, rim, inner])
+    pts[np.abs(pts[:, 0]) < 1e-9, 0] = 0.0
+    return pts[:, 0], pts[:, 1]
+
+
+def lathe(r: np.ndarray, y: np.ndarray, segments: int = 96) -> MeshData:
+    """Revolve the profile (r, y) about the y axis; normals from the profile's tangent.
+
+    The profile runs so that the solid is on its left when r is right and y up (outer
+    surface bottom → top); the outward normal is the tangent turned clockwise. A seam
+    column is duplicated so UVs wrap; zero-area triangles at the poles are dropped.
+    """
+    n_prof = len(r)
+    tangent = np.gradient(np.stack([r, y], axis=1), axis=0)
+    normal2 = np.stack([tangent[:, 1], -tangent[:, 0]], axis=1)
+    normal2 /= np.linalg.norm(normal2, axis=1, keepdims=True)
+    phi = np.linspace(0.0, 2.0 * math.pi, segments + 1)
+    c, s = np.cos(phi)[None, :], np.sin(phi)[None, :]
+    pos = np.stack(np.broadcast_arrays(r[:, None] * c, y[:, None], r[:, None] * s), -1)
+    nrm = np.stack(np.broadcast_arrays(normal2[:, :1] * c, normal2[:, 1:], normal2[:, :1] * s), -1)
+    arc = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(r), np.diff(y)))])
+    uv = np.stack(np.broadcast_arrays(phi[None, :] / (2 * math.pi), (arc / arc[-1])[:, None]), -1)
+    idx = np.arange(n_prof * (segments + 1)).reshape(n_prof, segments + 1)
+    a, b = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel()
+    cc, d = idx[1:, :-1].ravel(), idx[1:, 1:].ravel()
+    faces = np.concatenate([np.stack([a, d, b], 1), np.stack([a, cc, d], 1)])
+    flat = pos.reshape(-1, 3)
+    area = np.linalg.norm(
+        np.cross(flat[faces[:, 1]] - flat[faces[:, 0]], flat[faces[:, 2]] - flat[faces[:, 0]]),
+        axis=1,
+    )
+    return MeshData(
+        flat.astype(np.float32),
+        nrm.reshape(-1, 3).astype(np.float32),
+        uv.reshape(-1, 2).astype(np.float32),
+        faces[area > 1e-12].astype(np.uint32),
+    )
+
+
+def rotation_y(degrees: float) -> np.ndarray:
+    """3×3 rotation about +y (right-handed: +z turns towards +x)."""
+    a = math.radians(degrees)
+    return np.array([[math.cos(a), 0, math.sin(a)], [0, 1, 0], [-math.sin(a), 0, math.cos(a)]])
+
+
+def rotation_x(degrees: float) -> np.ndarray:
+    """3×3 rotation about +x (right-handed: +y turns towards +z)."""
+    a = math.radians(degrees)
+    return np.array([[1, 0, 0], [0, math.cos(a), -math.sin(a)], [0, math.sin(a), math.cos(a)]])
+
+
+def cup_mesh(segments: int = 96, samples: int = 48) -> MeshData:
+    """The cup in world space at turntable angle 0: tilted, then moved to its place."""
+    m = lathe(*cup_profile(samples), segments)
+    tilt = rotation_x(CUP_TILT_DEG)
+    return MeshData(
+        (m.positions @ tilt.T + np.asarray(CUP_CENTER)).astype(np.float32),
+        (m.normals @ tilt.T).astype(np.float32),
+        m.uvs,
+        m.faces,
+    )
+
+
+def write_ply(mesh: MeshData, path: Path) -> Path:
+    """Binary little-endian PLY (x y z nx ny nz u v; triangles), written atomically."""
+    n, f = len(mesh.positions), len(mesh.faces)
+    header = (
+        "ply\nformat binary_little_endian 1.0\n"
+        f"element vertex {n}\n"
+        + "".join(f"property float {k}\n" for k in ("x", "y", "z", "nx", "ny", "nz", "u", "v"))
+        + f"element face {f}\nproperty list uchar uint vertex_indices\nend_header\n"
+    )
+    vertices = np.concatenate([mesh.positions, mesh.normals, mesh.uvs], axis=1).astype("<f4")
+    faces = np.zeros(f, dtype=[("n", "u1"), ("i", "<u4", 3)])
+    faces["n"], faces["i"] = 3, mesh.faces
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(suffix=".ply", prefix=f".{path.stem}.", dir=path.parent)
+    with os.fdopen(fd, "wb") as out:
+        out.write(header.encode("ascii") + vertices.tobytes() + faces.tobytes())
+    os.replace(tmp, path)
+    return path
+
+
+def cup_ply() -> Path:
+    """The cup's PLY in the cache, generated on first use (keyed by its parameters)."""
+    key = hashlib.sha256(repr((CUP_CENTER, CUP_TILT_DEG, CUP_WALL, 96, 48)).encode())
+    path = cache_dir().parent / "mesh" / f"cup-{key.hexdigest()[:12]}.ply"
+    return path if path.is_file() else write_ply(cup_mesh(), path)
+
+
+def camera(width: int, height: int) -> dict[str, Any]:
+    """A perspective camera framing both shapes, slightly above them."""
+    import mitsuba as mi
+
+    elevation, distance = math.radians(14.0), 9.0
+    target = np.array([0.0, 0.85, 0.0])
+    origin = target + distance * np.array([0.0, math.sin(elevation), math.cos(elevation)])
+    # Horizontal field of view that fits the pair (≈ 4.6 units wide) with a margin; a
+    # tall film keeps the same width and shows more ground and sky.
+    fov = 2.0 * math.degrees(math.atan(2.9 / distance))
+    return {
+        "type": "perspective",
+        "fov": fov,
+        "fov_axis": "x",
+        "to_world": mi.ScalarTransform4f().look_at(
+            origin=origin.tolist(), target=target.tolist(), up=[0.0, 1.0, 0.0]
+        ),
+        "film": {
+            "type": "hdrfilm",
+            "width": int(width),
+            "height": int(height),
+            "pixel_format": "rgb",
+            "rfilter": {"type": "gaussian"},
+        },
+        "sampler": {"type": "independent"},
+    }
+
+
+def ball_to_world(degrees: float) -> Any:
+    """The ball's transform at turntable angle ``degrees``."""
+    import mitsuba as mi
+
+    return mi.ScalarTransform4f().translate(list(BALL_CENTER)).rotate([0, 1, 0], degrees)
+
+
+def scene_dict(
+    bsdf: dict[str, Any],
+    environment: np.ndarray,
+    resolution: tuple[int, int],
+    max_depth: int,
+) -> dict[str, Any]:
+    """The shader-ball scene; the same ``bsdf`` on the ball and the cup.
+
+    ``environment`` is a lat-long (H, W, 3) float32 array, used as it is (exposure is
+    already in its pixels, see :mod:`.ibl`).
+    """
+    import mitsuba as mi
+
+    width, height = resolution
+    return {
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": int(max_depth)},
+        "sensor": camera(width, height),
+        "environment": {
+            "type": "envmap",
+            "bitmap": mi.Bitmap(np.ascontiguousarray(environment, dtype=np.float32)),
+        },
+        "material": bsdf | {"id": "material"},
+        "ball": {
+            "type": "sphere",
+            "to_world": ball_to_world(0.0),
+            "bsdf": {"type": "ref", "id": "material"},
+        },
+        "cup": {
+            "type": "ply",
+            "filename": str(cup_ply()),
+            "face_normals": False,
+            "bsdf": {"type": "ref", "id": "material"},
+        },
+        "ground": {
+            "type": "rectangle",
+            "to_world": mi.ScalarTransform4f().rotate([1, 0, 0], -90).scale([30, 30, 1]),
+            "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": GROUND_ALBEDO}},
+        },
+    }

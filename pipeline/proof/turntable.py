@@ -1,0 +1,179 @@
+"""Turntables: the element rotating through N frames, then the lighting through M frames.
+
+Burley 2012 §6.1: "all turntables include both element and lighting rotations". The scene
+is loaded once; every frame only updates scene parameters through ``mi.traverse`` (the
+ball's ``to_world``, the cup's vertex positions and normals, the envmap's ``to_world``),
+so Mitsuba reuses the kernels it compiled for the first frame (DESIGN.md, Proofing).
+
+Each frame is rendered as two independent half-sample images: their mean is the frame
+and their difference estimates its noise (the variance of a mean of two independent
+estimates is a quarter of their squared difference), at no extra cost.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import warnings
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+
+from . import shaderball
+
+REC709_Y = np.array([0.2126, 0.7152, 0.0722])
+
+
+@dataclass(frozen=True)
+class Frame:
+    """One frame of a turntable: which rotation, and its angle in degrees."""
+
+    index: int
+    kind: Literal["element", "light"]
+    angle: float
+
+    @property
+    def label(self) -> str:
+        return f"{self.kind} {self.angle:.0f}°"
+
+
+def frames(element: int, light: int) -> list[Frame]:
+    """``element`` frames of one element turn, then ``light`` frames of one lighting turn.
+
+    >>> [f.label for f in frames(2, 2)]
+    ['element 0°', 'element 180°', 'light 0°', 'light 180°']
+    """
+    out = [Frame(i, "element", 360.0 * i / element) for i in range(element)]
+    return out + [Frame(element + i, "light", 360.0 * i / light) for i in range(light)]
+
+
+def material_bsdf(material: Any, *, force_all_lobes: bool = False) -> tuple[dict, int]:
+    """The Mitsuba BSDF dict of a material and the path depth it needs.
+
+    Our plugins through :func:`lookdev.pipeline.export.mitsuba.bsdf_dict`. While a model's
+    plugin is not available yet, a Disney material falls back to Mitsuba's ``principled``
+    (with one warning): it differs from Burley on tinted and dielectric speculars and on
+    the clearcoat (DESIGN.md, Traps), so such a proof is a stand-in, not the model.
+    """
+    from lookdev.pipeline.export.mitsuba import MitsubaExportError, bsdf_dict, max_depth_for
+
+    try:
+        return bsdf_dict(material, force_all_lobes=force_all_lobes), max_depth_for(material)
+    except MitsubaExportError as exc:
+        params = getattr(material, "params", None)
+        if "not available" not in str(exc) or getattr(material, "model", "") != "disney":
+            raise
+    warnings.warn(
+        f"{material.name}: the disney plugin is not available; proofing with Mitsuba's "
+        "principled as a stand-in",
+        RuntimeWarning,
+        stacklevel=2,
+    )
+    return _principled(params), 12 if params.spec_trans > 0 else 4
+
+
+_PRINCIPLED_FIELDS = (
+    "metallic",
+    "roughness",
+    "anisotropic",
+    "specular",
+    "spec_tint",
+    "sheen",
+    "sheen_tint",
+    "clearcoat",
+    "clearcoat_gloss",
+    "spec_trans",
+    "flatness",
+)
+
+
+def _principled(params: Any) -> dict[str, Any]:
+    values = params.model_dump()
+    values["spec_tint"] = values["specular_tint"]
+    values["specular"] = params.effective_specular
+    out: dict[str, Any] = {"type": "principled"}
+    out["base_color"] = {"type": "rgb", "value": list(params.base_color)}
+    out.update({k: float(values[k]) for k in _PRINCIPLED_FIELDS})
+    return out
+
+
+class Turntable:
+    """A loaded shader-ball scene whose rotations are set per frame, never reloaded."""
+
+    def __init__(
+        self,
+        bsdf: dict[str, Any],
+        environment: np.ndarray,
+        resolution: tuple[int, int],
+        max_depth: int,
+    ):
+        import mitsuba as mi
+
+        self.scene = mi.load_dict(shaderball.scene_dict(bsdf, environment, resolution, max_depth))
+        self.params = mi.traverse(self.scene)
+        self._cup_positions = self._array("cup.vertex_positions")
+        self._cup_normals = self._array("cup.vertex_normals")
+        self._pivot = np.asarray(shaderball.CUP_CENTER)
+
+    def _array(self, key: str) -> np.ndarray:
+        return np.array(self.params[key], dtype=np.float64).reshape(-1, 3)
+
+    def set_frame(self, frame: Frame) -> None:
+        """Pose the element and the lighting for ``frame`` and push the changes."""
+        import mitsuba as mi
+
+        element = frame.angle if frame.kind == "element" else 0.0
+        light = frame.angle if frame.kind == "light" else 0.0
+        self.params["ball.to_world"] = shaderball.ball_to_world(element)
+        rot = shaderball.rotation_y(element)
+        positions = (self._cup_positions - self._pivot) @ rot.T + self._pivot
+        self.params["cup.vertex_positions"] = mi.Float(positions.ravel().astype(np.float32))
+        self.params["cup.vertex_normals"] = mi.Float(
+            (self._cup_normals @ rot.T).ravel().astype(np.float32)
+        )
+        self.params["environment.to_world"] = mi.ScalarTransform4f().rotate([0, 1, 0], light)
+        self.params.update()
+
+    def render(self, spp: int, seed: int) -> np.ndarray:
+        """One image (H, W, 3) float32 at the current pose."""
+        import mitsuba as mi
+
+        return np.array(mi.render(self.scene, spp=spp, seed=seed), dtype=np.float32)[..., :3]
+
+
+@dataclass(frozen=True)
+class RenderedFrame:
+    """A frame's image and what the manifest records about it."""
+
+    frame: Frame
+    image: np.ndarray
+    seconds: float
+    noise_rmse: float
+    noise_relative: float
+
+
+def render_frame(table: Turntable, frame: Frame, spp: int, seed: int = 0) -> RenderedFrame:
+    """Render ``frame`` as two half-sample images; their mean and a noise estimate.
+
+    ``noise_rmse`` is the estimated RMS error of the mean image, √(mean((A − B)²)/4),
+    taken on luminance; ``noise_relative`` divides it by the mean luminance.
+    """
+    half = max(1, spp // 2)
+    t0 = time.perf_counter()
+    table.set_frame(frame)
+    a = table.render(half, seed=2 * seed)
+    b = table.render(half, seed=2 * seed + 1)
+    seconds = time.perf_counter() - t0
+    image = 0.5 * (a + b)
+    diff = (a - b) @ REC709_Y
+    rmse = math.sqrt(float(np.mean(diff.astype(np.float64) ** 2)) / 4.0)
+    mean = float(np.mean(image @ REC709_Y))
+    return RenderedFrame(frame, image, seconds, rmse, rmse / mean if mean > 0 else math.inf)
+
+
+def render_turntable(table: Turntable, todo: list[Frame], spp: int) -> Iterator[RenderedFrame]:
+    """Render ``todo`` in order; each frame's seed is its index, so reruns match."""
+    for frame in todo:
+        yield render_frame(table, frame, spp, seed=frame.index)
