@@ -87,7 +87,7 @@ def test_render_error_falls_like_one_over_spp():
     rows = M.bench_render(
         "diffuse",
         {"type": "diffuse"},
-        M.default_environment(32),
+        np.ones((16, 32, 3)),
         ladder=(1, 16),
         reference_spp=512,
         resolution=16,
@@ -102,6 +102,7 @@ def test_run_measures_every_item_and_writes_outputs(tmp_path):
     use_mitsuba()
     report = E.run(
         TINY,
+        environment=np.ones((16, 32, 3)),
         render=[("diffuse", {"type": "diffuse"}, 2)],
         models={"lambert": LAMBERT, "phong": PHONG},
     )

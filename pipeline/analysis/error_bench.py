@@ -38,6 +38,7 @@ from .measure import Row
 ITEMS = ("render", "albedo", "lambda", "precision")
 MODEL_NAMES = ("disney", "pixar", "sheen")
 
+RENDER_IBL = "studio"
 # Proof-render cases: label → built-in preset name.
 RENDER_PRESETS: dict[str, str] = {
     "diffuse": "plaster",
@@ -163,7 +164,11 @@ def run(
         if render is None:
             render, gaps = render_cases()
             report.skipped.update(gaps)
-        env = measure.default_environment() if environment is None else environment
+        if environment is None:
+            from lookdev.pipeline.proof import ibl
+
+            environment = ibl.load(RENDER_IBL, 64).pixels
+        env = environment
         for label, bsdf, depth in render:
             tasks.append(
                 (

@@ -239,16 +239,6 @@ def relative_mse(image: np.ndarray, reference: np.ndarray, eps: float = 1e-2) ->
     return float(np.mean((image - reference) ** 2 / (reference**2 + eps)))
 
 
-def default_environment(width: int = 64) -> np.ndarray:
-    """A small lat-long studio for benchmarking: dim floor, graded sky, one soft box."""
-    h = width // 2
-    v = (np.arange(h) + 0.5) / h
-    u = (np.arange(width) + 0.5) / width
-    sky = np.where(v < 0.5, 0.6 + 0.8 * (0.5 - v), 0.15)[:, None, None] * np.ones((1, width, 3))
-    box = (np.abs(v[:, None] - 0.3) < 0.08) & (np.abs(u[None, :] - 0.45) < 0.06)
-    return sky + 12.0 * box[..., None] * np.array([1.0, 0.95, 0.9])
-
-
 def proof_scene(bsdf: dict, environment: np.ndarray, resolution: int, max_depth: int) -> Any:
     """A sphere on black, lit by ``environment``, seen by a perspective camera.
 

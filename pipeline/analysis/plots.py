@@ -86,26 +86,12 @@ def subject_for(name_or_path: str, library: Any = None) -> Subject:
     )
 
 
-def load_environment(name_or_path: str, max_width: int = 256) -> np.ndarray:
-    """A lat-long environment as (H, W, 3) float, box-filtered down to ``max_width``.
+def load_environment(name_or_path: str, width: int = 256) -> np.ndarray:
+    """A lat-long environment (H, W, 3): a built-in IBL name or an .exr/.hdr file, read
+    and resampled by the proof module so the sphere sees what the proofs see."""
+    from lookdev.pipeline.proof import ibl
 
-    A path to an .exr/.hdr file is read as it is; anything else is a built-in IBL name.
-    """
-    import OpenImageIO as oiio
-
-    path = Path(name_or_path)
-    if not (path.suffix.lower() in (".exr", ".hdr") and path.is_file()):
-        from lookdev.pipeline.proof import ibl
-
-        path = ibl.resolve(name_or_path)
-    buf = oiio.ImageBuf(str(path))
-    if buf.has_error:
-        raise PlotError(f"cannot read environment: {buf.geterror()}", where=str(path))
-    pixels = np.asarray(buf.get_pixels(oiio.FLOAT), dtype=np.float64)
-    pixels = pixels[..., :3] if pixels.shape[-1] >= 3 else np.repeat(pixels[..., :1], 3, -1)
-    k = max(1, pixels.shape[1] // max_width)
-    h, w = (pixels.shape[0] // k) * k, (pixels.shape[1] // k) * k
-    return pixels[:h, :w].reshape(h // k, k, w // k, k, 3).mean(axis=(1, 3))
+    return ibl.load(name_or_path, width).pixels.astype(np.float64)
 
 
 # -- slice ---------------------------------------------------------------------------
