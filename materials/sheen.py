@@ -1,0 +1,275 @@
+"""Conty Estevez & Kulla 2017, "Production Friendly Microfacet Sheen BRDF".
+
+A microfacet lobe for cloth, written once over the array shim (:mod:`.arrays`):
+
+    f(ωi, ωo) = F · G · D(h) / (4 |ωo·n| |ωi·n|)                       (eq. 1)
+
+with F the sheen colour, the exponentiated-sine fibre distribution D (eq. 2), the fitted
+Smith Λ (eq. 3, Table 1) in the correlated form G = 1 / (1 + Λ(ωo) + Λ(ωi)) (§3), and,
+on by default, the terminator softening Λ'(θi) = Λ(θi)^(1 + 2(1 − cos θi)^8) (eq. 4) on
+the *light* side only. The softening is the paper's one non-physical step: with it the
+BRDF is **not reciprocal**, f(ωi, ωo) ≠ f(ωo, ωi); switch it off
+(``terminator_softening = false``) for a reciprocal lobe.
+
+Sampling is uniform over the upper hemisphere (§2: it beats inverting D's CDF, whose
+weights divide by cos θm near grazing), pdf 1/2π.
+
+Layering (§5) scales the base by an albedo-derived factor; see :func:`base_scale` for
+the reading taken. The directional albedo E(μ, r) is the table in :mod:`.sheen_albedo`.
+
+Roughness: the paper's r lies in (0, 1] and r is clamped to :data:`R_MIN` = 0.05.
+Table 1's "r = 0" row cannot be a fit at r → 0, where D tends to a delta at θm = 90°
+and Λ to infinity; measured against the integrated Λ (``lookdev.pipeline.analysis.
+sheen_fit``), the fit is under half the true Λ below r ≈ 0.03 and the lobe then reflects
+more than it receives (albedo 1.04 at r = 0.01, cos θ = 0.01). At r = 0.05 the albedo
+peaks at 0.92.
+
+>>> import numpy as np
+>>> round(float(D(np.float64(0.0), 1.0)), 6)  # (2 + 1)/2π · sin^1 90°
+0.477465
+>>> round(float(lambda_fit(np.float64(0.5), 1.0)), 5)  # e^L(0.5), Table 1 row r = 1
+0.71003
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from pydantic import Field
+
+from .arrays import NumpyOps
+from .bsdf import Model, density, draw, evaluate
+from .params import Color, Params, register_schema
+from .sheen_albedo import N_MU as _N_MU
+from .sheen_albedo import N_R as _N_R
+from .sheen_albedo import VALUES as _TABLE_VALUES
+
+R_MIN = 0.05
+COS_MIN = 1e-5
+INV_TWO_PI = 1.0 / (2.0 * math.pi)
+
+# Table 1: (a, b, c, d, e) of L(x) = a / (1 + b x^c) + d x + e at r = 0 and r = 1.
+_FIT_R0 = (25.3245, 3.32435, 0.16801, -1.27393, -4.85967)
+_FIT_R1 = (21.5473, 3.82987, 0.19823, -1.97760, -4.32054)
+
+
+@register_schema
+class SheenParams(Params):
+    """The sheen lobe on its own (Disney uses the same maths via ``sheen_roughness``)."""
+
+    color: Color = Field((1.0, 1.0, 1.0), description="Sheen colour F (eq. 1), linear RGB.")
+    roughness: float = Field(
+        0.3, ge=0.0, le=1.0, description="Fibre spread r (eq. 2); below 0.01 it is clamped."
+    )
+    terminator_softening: bool = Field(
+        True, description="Eq. 4's softer light terminator (non-reciprocal)."
+    )
+
+
+# -- the distribution, eq. 2 ---------------------------------------------------------------
+def clamp_roughness(xp: Any, r: Any) -> Any:
+    """r in [R_MIN, 1]: the paper's (0, 1] with the delta limit kept out."""
+    return xp.clip(r, R_MIN, 1.0)
+
+
+def distribution(xp: Any, sin2_theta: Any, r: Any) -> Any:
+    """D(m) = (2 + 1/r) sin^(1/r) θm / 2π (eq. 2), from sin²θm.
+
+    Written as exp(log(sin²θ) / 2r) so that r → 0 and sin θ = 0 give 0, not NaN.
+    Normalised: ∫ D cos θm dωm = (2 + 1/r) ∫₀¹ s^(1/r + 1) ds = 1 for every r.
+    """
+    r = clamp_roughness(xp, r)
+    return (2.0 + 1.0 / r) * INV_TWO_PI * xp.exp(xp.log(sin2_theta) * (0.5 / r))
+
+
+# -- shadowing, eq. 3 and eq. 4 ------------------------------------------------------------
+def fit_coefficients(xp: Any, r: Any) -> tuple[Any, ...]:
+    """Table 1 interpolated: P = (1 − r)² P₀ + (1 − (1 − r)²) P₁ (caption of Table 1)."""
+    t = (1.0 - r) * (1.0 - r)
+    return tuple(t * p0 + (1.0 - t) * p1 for p0, p1 in zip(_FIT_R0, _FIT_R1, strict=True))
+
+
+def _curve(xp: Any, x: Any, coeffs: tuple[Any, ...]) -> Any:
+    """L(x) = a / (1 + b x^c) + d x + e (eq. 3)."""
+    a, b, c, d, e = coeffs
+    return a / (1.0 + b * xp.power(x, c)) + d * x + e
+
+
+def log_lambda(xp: Any, cos_theta: Any, coeffs: tuple[Any, ...]) -> Any:
+    """log Λ(θ): L(cos θ) below cos θ = 0.5, 2 L(0.5) − L(1 − cos θ) above (eq. 3).
+
+    The two branches meet continuously at 0.5 by construction; both are evaluated on
+    clamped arguments so neither produces NaN where it is not selected.
+    """
+    mu = xp.clip(cos_theta, 0.0, 1.0)
+    low = _curve(xp, mu, coeffs)
+    high = 2.0 * _curve(xp, 0.5, coeffs) - _curve(xp, 1.0 - mu, coeffs)
+    return xp.select(mu < 0.5, low, high)
+
+
+def log_lambda_light(xp: Any, cos_theta: Any, coeffs: tuple[Any, ...], soften: bool) -> Any:
+    """log Λ'(θi) = (1 + 2(1 − cos θi)^8) log Λ(θi) (eq. 4), or log Λ when not softened."""
+    log_l = log_lambda(xp, cos_theta, coeffs)
+    if not soften:
+        return log_l
+    one_minus = 1.0 - xp.clip(cos_theta, 0.0, 1.0)
+    return log_l * (1.0 + 2.0 * xp.power(one_minus, 8.0))
+
+
+def shadowing(xp: Any, cos_i: Any, cos_o: Any, r: Any, soften: bool) -> Any:
+    """Correlated G = 1 / (1 + Λ(ωo) + Λ'(ωi)) (§3, §4)."""
+    coeffs = fit_coefficients(xp, clamp_roughness(xp, r))
+    lam_o = xp.exp(log_lambda(xp, cos_o, coeffs))
+    lam_i = xp.exp(log_lambda_light(xp, cos_i, coeffs, soften))
+    return 1.0 / (1.0 + lam_o + lam_i)
+
+
+def lobe(xp: Any, wi: Any, wo: Any, r: Any, soften: bool) -> Any:
+    """Uncoloured sheen f(ωi, ωo) (eq. 1 with F = 1); 0 unless both lie above the surface.
+
+    The cosines in 1/(4 cos θi cos θo) are floored at :data:`COS_MIN` (θ ≤ 89.9994°):
+    the fitted Λ stays finite at 90° where the integrated one grows like 1/cos θ, so
+    without the floor the albedo would diverge in that last 10⁻⁵ of cos θ (E = 1.5 at
+    cos θo = 10⁻⁶, r = 1). The floor also keeps float32 from underflowing to 0/0.
+    """
+    cos_i, cos_o = wi[2], wo[2]
+    upper = (cos_i > 0.0) & (cos_o > 0.0)
+    h = wi + wo
+    # sin²θh from the half vector's components: exact near the normal, unlike 1 − cos².
+    sin2_h = (h[0] * h[0] + h[1] * h[1]) / xp.maximum(xp.dot(h, h), xp.tiny)
+    g = shadowing(xp, cos_i, cos_o, r, soften)
+    denom = 4.0 * xp.maximum(cos_i, COS_MIN) * xp.maximum(cos_o, COS_MIN)
+    f = distribution(xp, sin2_h, r) * g / denom
+    return xp.select(upper, f, 0.0)
+
+
+# -- albedo and layering, §5 ---------------------------------------------------------------
+# The table (:mod:`.sheen_albedo`) holds E at nodes uniform in t = μ^(1/8) from
+# t(COS_MIN) to 1 (E changes fastest near grazing) and uniform in r. μ below COS_MIN
+# reads the COS_MIN node: an upper bound there (E falls towards 0 as the fitted Λ takes
+# over from the floored cosines), so it errs towards a darker base, never a gain.
+_EXP = 0.125
+_T0 = COS_MIN**_EXP
+
+
+def table_nodes(n_mu: int, n_r: int) -> tuple[np.ndarray, np.ndarray]:
+    """(μ, r) at which the albedo table is sampled."""
+    t = np.linspace(_T0, 1.0, n_mu)
+    return t ** (1.0 / _EXP), R_MIN + (1.0 - R_MIN) * np.linspace(0.0, 1.0, n_r) ** 2
+
+
+def _gather(xp: Any, flat: np.ndarray, index: Any) -> Any:
+    if xp.name == "numpy":
+        return flat[np.asarray(index, dtype=np.int64)]
+    dr = xp.dr
+    return dr.gather(xp.Float, xp.Float(flat), dr.uint32_array_t(xp.Float)(index))
+
+
+def interpolate(xp: Any, table: np.ndarray, cos_theta: Any, r: Any) -> Any:
+    """Bilinear read of ``table`` (shape (n_r, n_mu), nodes :func:`table_nodes`)."""
+    n_r, n_mu = table.shape
+    mu = xp.clip(cos_theta, COS_MIN, 1.0)
+    x = (xp.power(mu, _EXP) - _T0) * ((n_mu - 1) / (1.0 - _T0))
+    y = xp.sqrt((clamp_roughness(xp, r) - R_MIN) / (1.0 - R_MIN)) * (n_r - 1) + 0.0 * x
+    i = xp.clip(xp.floor(x), 0.0, n_mu - 2.0)
+    j = xp.clip(xp.floor(y), 0.0, n_r - 2.0)
+    fx, fy = x - i, y - j
+    flat = np.ascontiguousarray(table, dtype=np.float64).reshape(-1)
+    k = j * n_mu + i
+    e0 = xp.lerp(_gather(xp, flat, k), _gather(xp, flat, k + 1.0), fx)
+    e1 = xp.lerp(_gather(xp, flat, k + n_mu), _gather(xp, flat, k + n_mu + 1.0), fx)
+    return xp.lerp(e0, e1, fy)
+
+
+def albedo_lookup(xp: Any, cos_theta: Any, r: Any) -> Any:
+    """E(μ, r) = ∫ f(ωi, ωo) cos θi dωi for a view at cos θo = μ (F = 1), from the table."""
+    return interpolate(xp, _TABLE, cos_theta, r)
+
+
+def base_scale(xp: Any, cos_i: Any, cos_o: Any, r: Any, color: Any = 1.0) -> Any:
+    """Factor on the layer under the sheen: 1 − F · max(E(ωi), E(ωo)).
+
+    §5 says the nested lobe is scaled by "min(αi, αo)" of the albedos. Read literally
+    (scale by the smaller albedo) a dark sheen would black out its base, so we read αi,
+    αo as Kelemen & Szirmay-Kalos' albedo-scaling factors 1 − E: the minimum of
+    1 − E(ωi) and 1 − E(ωo) is 1 − max(E(ωi), E(ωo)). Per channel with the sheen colour
+    F ≤ 1 this is ≤ 1 − F·E(ωo), so sheen + scaled base never reflects more than the
+    base alone could: no energy gain, whichever way the light travels.
+    """
+    e = xp.maximum(albedo_lookup(xp, cos_i, r), albedo_lookup(xp, cos_o, r))
+    return 1.0 - color * e
+
+
+# -- the Model -----------------------------------------------------------------------------
+def _prepare(xp: Any, params: SheenParams, **maps: Any) -> dict[str, Any]:
+    color = xp.color(maps.get("color", params.color))
+    r = xp.scalar(maps.get("roughness", params.roughness))
+    lobes = () if xp.known_zero(color) else ("sheen",)
+    return {"color": color, "r": r, "soften": params.terminator_softening, "lobes": lobes}
+
+
+def _eval(xp: Any, prepared: dict[str, Any], wi: Any, wo: Any) -> Any:
+    if not prepared["lobes"]:
+        return xp.zeros(wi[2]) * prepared["color"]
+    return prepared["color"] * lobe(xp, wi, wo, prepared["r"], prepared["soften"])
+
+
+def _pdf(xp: Any, prepared: dict[str, Any], wi: Any, wo: Any) -> Any:
+    if not prepared["lobes"]:
+        return xp.zeros(wi[2])
+    return xp.select((wi[2] > 0.0) & (wo[2] > 0.0), INV_TWO_PI, 0.0)
+
+
+def _sample(xp: Any, prepared: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any, Any]:
+    # Uniform hemisphere (§2): cos θi = u1, φ = 2π u2; pdf 1/2π.
+    z = u[1]
+    s = xp.safe_sqrt(1.0 - z * z)
+    phi = 2.0 * math.pi * u[2]
+    wi = xp.vec3(s * xp.cos(phi), s * xp.sin(phi), z)
+    pdf = _pdf(xp, prepared, wi, wo)
+    f = _eval(xp, prepared, wi, wo)
+    weight = f * xp.select(pdf > 0.0, z * (2.0 * math.pi), 0.0)
+    return wi, weight, pdf
+
+
+_TABLE = np.asarray(_TABLE_VALUES, dtype=np.float64).reshape(_N_R, _N_MU)
+MODEL = Model("sheen", SheenParams, _prepare, _eval, _pdf, _sample)
+
+
+# -- public numpy API ----------------------------------------------------------------------
+def D(cos_theta: Any, r: Any) -> np.ndarray:
+    """Eq. 2 at micro-normal angle θ, float64, broadcast over both arguments."""
+    c = np.asarray(cos_theta, dtype=np.float64)
+    with np.errstate(divide="ignore"):
+        return distribution(NumpyOps(), np.maximum(1.0 - c * c, 0.0), np.asarray(r, float))
+
+
+def lambda_fit(cos_theta: Any, r: Any) -> np.ndarray:
+    """Λ(θ) from the fit (eq. 3, Table 1), broadcast over both arguments."""
+    xp = NumpyOps()
+    c, rr = np.broadcast_arrays(np.asarray(cos_theta, float), np.asarray(r, float))
+    return np.exp(log_lambda(xp, c, fit_coefficients(xp, clamp_roughness(xp, rr))))
+
+
+def albedo(cos_theta: Any, r: Any) -> np.ndarray:
+    """Tabulated directional albedo E(μ, r) of the lobe with F = 1 and softening on."""
+    xp = NumpyOps()
+    c, rr = np.broadcast_arrays(np.asarray(cos_theta, float), np.asarray(r, float))
+    return albedo_lookup(xp, c, rr)
+
+
+def eval(params: SheenParams, wi: Any, wo: Any, **kw: Any) -> np.ndarray:  # noqa: A001
+    """f(ωi, ωo) without the cosine, (..., 3); see :func:`lookdev.materials.bsdf.evaluate`."""
+    return evaluate(MODEL, params, wi, wo, **kw)
+
+
+def pdf(params: SheenParams, wi: Any, wo: Any, **kw: Any) -> np.ndarray:
+    """Density of :func:`sample` producing ωi given ωo (solid angle)."""
+    return density(MODEL, params, wi, wo, **kw)
+
+
+def sample(params: SheenParams, wo: Any, u: Any, **kw: Any) -> tuple[np.ndarray, ...]:
+    """(ωi, f·cos θi/pdf, pdf) from uniforms u of shape (..., 3)."""
+    return draw(MODEL, params, wo, u, **kw)

@@ -1,0 +1,173 @@
+"""Measurements behind the Conty-Kulla sheen (:mod:`lookdev.materials.sheen`).
+
+* :func:`lambda_integrated` is Smith's Λ computed from the distribution itself by the
+  projected-area normalisation of Heitz 2014 (eq. 3 there, "the projected area of the
+  visible microsurface equals that of the geometric surface"):
+
+      1 + Λ(ωo) = (1 / cos θo) ∫ ⟨ωo·m⟩ D(m) dm.
+
+  The azimuthal integral of the clamped cosine is closed-form, so only θm is left to
+  quadrature, split where ⟨ωo·m⟩ starts to clip (θm = 90° − θo).
+* :func:`lambda_fit_error` compares Conty-Kulla's fitted Λ (eq. 3, Table 1) against it.
+* :func:`albedo_integrated` is the lobe's directional albedo by product quadrature, the
+  reference for the shipped albedo table; :func:`build_albedo_table`,
+  :func:`albedo_table_error` and :func:`write_albedo_module` make and measure the table
+  (``python -m lookdev.pipeline.analysis.sheen_fit`` rewrites it).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lookdev.materials import sheen
+from lookdev.materials.arrays import NumpyOps
+
+
+def _clamped_cosine_azimuthal(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """∫₀^2π max(0, a cos φ + b) dφ for a ≥ 0, b ≥ 0.
+
+    With b ≥ a nothing clips: 2πb. Otherwise the positive arc is |φ| < φ₀ with
+    cos φ₀ = −b/a, giving 2(a sin φ₀ + b φ₀).
+    """
+    safe_a = np.where(a > 0, a, 1.0)
+    phi0 = np.arccos(np.clip(-b / safe_a, -1.0, 1.0))
+    return np.where(b >= a, 2.0 * math.pi * b, 2.0 * (a * np.sin(phi0) + b * phi0))
+
+
+def lambda_integrated(cos_theta: Any, r: float, n: int = 400) -> np.ndarray:
+    """Λ(θ) of eq. 2's distribution by the projected-area integral (Heitz 2014)."""
+    mu = np.atleast_1d(np.asarray(cos_theta, dtype=np.float64))
+    x, w = np.polynomial.legendre.leggauss(n)
+    sin_o = np.sqrt(np.maximum(0.0, 1.0 - mu * mu))
+    split = np.arcsin(np.clip(mu, 0.0, 1.0))  # = 90° − θo
+    total = np.zeros_like(mu)
+    for lo, hi in ((np.zeros_like(mu), split), (split, np.full_like(mu, math.pi / 2))):
+        half = 0.5 * (hi - lo)
+        t = (0.5 * (lo + hi))[:, None] + half[:, None] * x[None, :]
+        a = sin_o[:, None] * np.sin(t)
+        b = mu[:, None] * np.cos(t)
+        d = sheen.D(np.cos(t), r)
+        total += half * np.sum(w * d * np.sin(t) * _clamped_cosine_azimuthal(a, b), axis=1)
+    return total / mu - 1.0
+
+
+@dataclass(frozen=True)
+class FitError:
+    """Worst absolute and relative error of a fit over a (cos θ, r) grid, and where."""
+
+    max_abs: float
+    at_abs: tuple[float, float]  # (cos θ, r)
+    max_rel: float
+    at_rel: tuple[float, float]
+
+    def __str__(self) -> str:
+        (ma, ra), (mr, rr) = self.at_abs, self.at_rel
+        return (
+            f"max abs {self.max_abs:.4g} at cos θ = {ma:.3g}, r = {ra:.3g};\n"
+            f"max rel {self.max_rel:.3g} at cos θ = {mr:.3g}, r = {rr:.3g}"
+        )
+
+
+def _worst(err_abs: np.ndarray, err_rel: np.ndarray, mu: np.ndarray, r: np.ndarray) -> FitError:
+    ia = np.unravel_index(np.argmax(err_abs), err_abs.shape)
+    ir = np.unravel_index(np.argmax(err_rel), err_rel.shape)
+    return FitError(
+        float(err_abs[ia]),
+        (float(mu[ia[1]]), float(r[ia[0]])),
+        float(err_rel[ir]),
+        (float(mu[ir[1]]), float(r[ir[0]])),
+    )
+
+
+def lambda_fit_error(cos_theta: Any = None, roughness: Any = None, *, n: int = 400) -> FitError:
+    """Conty-Kulla's fitted Λ against :func:`lambda_integrated` over θ × r.
+
+    Defaults: cos θ from 0.01 (the fit is finite at 0, where Λ is not) to 1, r from
+    :data:`~lookdev.materials.sheen.R_MIN` to 1. The relative error counts only where
+    Λ ≥ 0.01: below that Λ moves G = 1/(1 + Λo + Λi) by under 1% whatever its relative
+    error (at cos θ = 1, Λ = 0 exactly and every fit is "infinitely" wrong).
+    """
+    mu = np.linspace(0.01, 1.0, 34) if cos_theta is None else np.asarray(cos_theta, float)
+    r = np.linspace(sheen.R_MIN, 1.0, 20) if roughness is None else np.asarray(roughness, float)
+    ref = np.stack([lambda_integrated(mu, rr, n) for rr in r])
+    fit = sheen.lambda_fit(mu[None, :], r[:, None])
+    err = np.abs(fit - ref)
+    return _worst(err, np.where(ref >= 0.01, err / np.maximum(ref, 0.01), 0.0), mu, r)
+
+
+# -- directional albedo --------------------------------------------------------------------
+def albedo_integrated(cos_theta: Any, r: float, *, n: int = 96, soften: bool = True) -> np.ndarray:
+    """E(μ) = ∫ f(ωi, ωo) cos θi dωi (F = 1) by Gauss-Legendre × trapezoid quadrature.
+
+    μi = s² concentrates nodes near grazing light, where the lobe peaks; the integrand is
+    even in φ, so [0, π] is doubled.
+    """
+    mu_o = np.atleast_1d(np.asarray(cos_theta, dtype=np.float64))
+    x, w = np.polynomial.legendre.leggauss(n)
+    s, ws = 0.5 * (x + 1.0), 0.5 * w
+    mu, wmu = s * s, ws * 2.0 * s
+    phi = (np.arange(n) + 0.5) * (math.pi / n)
+    sin_i = np.sqrt(1.0 - mu * mu)
+    wi = np.stack(
+        [np.outer(sin_i, np.cos(phi)), np.outer(sin_i, np.sin(phi)), np.outer(mu, np.ones(n))]
+    ).reshape(3, 1, -1)
+    weights = np.outer(wmu * mu, np.full(n, 2.0 * math.pi / n)).reshape(1, -1)
+    wo = np.stack([np.sqrt(1.0 - mu_o * mu_o), np.zeros_like(mu_o), mu_o])[:, :, None]
+    with np.errstate(all="ignore"):
+        f = sheen.lobe(NumpyOps(), wi, wo, r, soften)
+    return np.sum(f * weights, axis=-1)
+
+
+def build_albedo_table(n_mu: int, n_r: int, *, n: int = 96) -> np.ndarray:
+    """E at the table's nodes (see :mod:`lookdev.materials.sheen_albedo`), shape (n_r, n_mu)."""
+    mu, r = sheen.table_nodes(n_mu, n_r)
+    return np.stack([albedo_integrated(mu, rr, n=n) for rr in r])
+
+
+def albedo_table_error(
+    table: np.ndarray, *, n_mu: int = 61, n_r: int = 23, n: int = 96, seed: int = 0
+) -> FitError:
+    """Interpolated ``table`` against direct quadrature at off-node (μ, r) points."""
+    rng = np.random.default_rng(seed)
+    mu = np.sort(np.concatenate([rng.random(n_mu - 4) ** 4, [0.0, 1e-5, 1e-3, 1.0]]))
+    r = np.sort(rng.uniform(sheen.R_MIN, 1.0, n_r))
+    ref = np.stack([albedo_integrated(np.maximum(mu, sheen.COS_MIN), rr, n=n) for rr in r])
+    xp = NumpyOps()
+    got = sheen.interpolate(xp, table, mu[None, :], r[:, None])
+    err = np.abs(got - ref)
+    return _worst(err, err / np.maximum(ref, 1e-3), mu, r)
+
+
+def write_albedo_module(path: Path, n_mu: int, n_r: int, error: FitError) -> None:
+    """Rewrite the table's data module: row-major (r, μ) values, eight to a line."""
+    values = [f"{v:.6g}," for v in build_albedo_table(n_mu, n_r).ravel()]
+    lines = "\n".join("    " + " ".join(values[k : k + 8]) for k in range(0, len(values), 8))
+    text = (
+        '"""Generated by ``python -m lookdev.pipeline.analysis.sheen_fit``; do not edit.\n\n'
+        f"Conty-Kulla sheen albedo E(μ, r), row-major at {n_r} r × {n_mu} μ nodes\n"
+        "(:func:`lookdev.materials.sheen.table_nodes`). Measured interpolation error:\n"
+        f"{error}.\n"
+        f'"""\n\nN_MU = {n_mu}\nN_R = {n_r}\n# fmt: off\nVALUES = (\n{lines}\n)\n# fmt: on\n'
+    )
+    Path(path).write_text(text)
+
+
+TABLE_SHAPE = (64, 32)  # (μ, r) nodes: chosen by albedo_table_error, see sheen_albedo
+
+
+def main() -> None:
+    """Rebuild ``materials/sheen_albedo.py`` and print its measured error."""
+    n_mu, n_r = TABLE_SHAPE
+    error = albedo_table_error(build_albedo_table(n_mu, n_r))
+    print(f"lambda fit vs integrated: {lambda_fit_error()}")
+    print(f"albedo table {n_mu}x{n_r}: {error}")
+    write_albedo_module(Path(sheen.__file__).with_name("sheen_albedo.py"), n_mu, n_r, error)
+
+
+if __name__ == "__main__":
+    main()
