@@ -1,0 +1,95 @@
+"""Which lobes of a material carry weight, and its parameters with the dead ones reset.
+
+"A lobe whose weight is zero everywhere is not … exported" (DESIGN.md). A Disney
+material's lobe weights follow Burley 2012 §5 and Schutte 2018 §3: the dielectric part
+is weighted ``1 - metallic``; sheen and subsurface sit on the diffuse, which is further
+weighted ``1 - spec_trans``; ``diff_trans`` and ``flatness`` exist only on thin surfaces.
+A parameter of a dead lobe has no effect, so it is neither written nor compared.
+
+>>> from lookdev.materials.params import DisneyParams
+>>> on = active_lobes(canonical(DisneyParams(metallic=1.0, sheen=0.5)))
+>>> on["sheen"], on["dielectric"]
+(False, False)
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from lookdev.materials.params import DisneyParams
+
+PARAM_LOBE: dict[str, dict[str, str]] = {
+    "disney": {
+        "specular": "dielectric",
+        "specular_tint": "dielectric",
+        "ior": "dielectric",
+        "sheen": "sheen",
+        "sheen_tint": "sheen",
+        "sheen_model": "sheen",
+        "sheen_roughness": "conty_kulla",
+        "clearcoat": "clearcoat",
+        "clearcoat_gloss": "clearcoat",
+        "spec_trans": "spec_trans",
+        "diff_trans": "diff_trans",
+        "subsurface": "subsurface",
+        "flatness": "flatness",
+        "scatter_distance": "scatter",
+    },
+}
+"""model → parameter → the lobe it belongs to (parameters not listed are always live)."""
+
+DEFAULTS: dict[str, dict[str, Any]] = {
+    "disney": {**DisneyParams().model_dump(), "ior": 1.5, "specular": 0.5},
+}
+"""model → our defaults, with both spellings of the specular filled in."""
+
+
+def canonical(params: Any) -> dict[str, Any]:
+    """All parameters as plain values, with ``specular`` and ``ior`` both filled in.
+
+    >>> c = canonical(DisneyParams(ior=1.5))
+    >>> round(c["specular"], 6), c["ior"]
+    (0.5, 1.5)
+    """
+    data = params.model_dump()
+    if isinstance(params, DisneyParams):
+        data["specular"] = params.effective_specular
+        data["ior"] = params.effective_ior
+    return data
+
+
+def active_lobes(values: dict[str, Any], model: str = "disney") -> dict[str, bool]:
+    """lobe → whether it carries any weight, for canonical ``values`` of ``model``."""
+    if model != "disney":
+        raise KeyError(model)
+    v = values
+    dielectric = v["metallic"] < 1.0
+    diffuse = dielectric and v["spec_trans"] < 1.0
+    spec_trans = dielectric and v["spec_trans"] > 0.0
+    subsurface = diffuse and v["subsurface"] > 0.0
+    sheen = dielectric and v["sheen"] > 0.0
+    return {
+        "specular": True,
+        "dielectric": dielectric,
+        "diffuse": diffuse,
+        "sheen": sheen,
+        "conty_kulla": sheen and v["sheen_model"] == "conty_kulla",
+        "clearcoat": v["clearcoat"] > 0.0,
+        "spec_trans": spec_trans,
+        "subsurface": subsurface,
+        "diff_trans": diffuse and v["thin"] and v["diff_trans"] > 0.0,
+        "flatness": diffuse and v["thin"] and v["flatness"] > 0.0,
+        "scatter": (spec_trans or subsurface) and not v["thin"] and v["scatter_distance"] > 0,
+        "thin": bool(v["thin"]),
+    }
+
+
+def effective(values: dict[str, Any], model: str = "disney", lobes: dict | None = None):
+    """``values`` with every parameter of a dead lobe reset to its default.
+
+    Two materials with equal effective values reflect light identically.
+    """
+    lobes = active_lobes(values, model) if lobes is None else lobes
+    owner = PARAM_LOBE[model]
+    defaults = DEFAULTS[model]
+    return {k: (v if k not in owner or lobes[owner[k]] else defaults[k]) for k, v in values.items()}

@@ -1,0 +1,163 @@
+"""The ``mtlx`` context: MaterialX networks inside USD, and standalone ``.mtlx`` documents.
+
+The surface per model is chosen in :mod:`.names` (Disney → ``ND_disney_principled``).
+Maps are ``ND_image_*`` nodes reading the default texture coordinates. Layered
+materials exported live become ``ND_mix_*`` chains driven by mask images: Burley §5.7
+blends *parameters*, so each parameter that differs between layers gets its own chain
+``mix(bg = below, fg = layer, mix = mask)``, feeding one surface.
+
+The same :class:`~.network.Network` objects are written into a MaterialX document with
+the ``MaterialX`` package and checked with its own ``validate``; usd-core cannot check
+MaterialX ids (it ships without UsdMtlx).
+"""
+
+from __future__ import annotations
+
+import os
+from functools import cache
+from pathlib import Path
+from typing import Any
+
+from .names import SURFACE_IDS, Slot, table_for
+from .network import (
+    Connection,
+    ExportError,
+    Image,
+    MaterialSpec,
+    Network,
+    Node,
+    Source,
+    loss_note,
+    prim_name,
+    surface_inputs,
+)
+from .textures import converted
+
+SURFACE = "mtlx_surface"
+MX_TYPES = {
+    "float": "float",
+    "color3f": "color3",
+    "float3": "color3",
+    "vector3f": "vector3",
+    "normal3f": "vector3",
+    "float2": "vector2",
+    "int": "integer",
+    "bool": "boolean",
+    "string": "string",
+    "asset": "filename",
+    "token": "string",
+}
+"""USD value type → MaterialX type."""
+
+
+@cache
+def _library():
+    import MaterialX as mx
+
+    lib = mx.createDocument()
+    mx.loadLibraries(mx.getDefaultDataLibraryFolders(), mx.getDefaultDataSearchPath(), lib)
+    return lib
+
+
+@cache
+def node_defaults(node_id: str) -> dict[str, Any]:
+    """Input defaults of a MaterialX node definition, as plain Python values."""
+    nodedef = _library().getNodeDef(node_id)
+    out: dict[str, Any] = {}
+    for inp in nodedef.getActiveInputs():
+        value = inp.getValue()
+        if value is None:
+            continue
+        out[inp.getName()] = tuple(value.asTuple()) if hasattr(value, "asTuple") else value
+    return out
+
+
+def build(source: Source) -> Network:
+    """The MaterialX network of ``source`` (surface plus image nodes)."""
+    nodes: list[Node] = []
+    node_id = SURFACE_IDS[("mtlx", source.model)]
+    table = table_for("mtlx", source.model)
+    inputs = surface_inputs(source, table, node_defaults(node_id), nodes, _texture)
+    extra = ""
+    if source.normal_map is not None:
+        extra = f"{node_id} has no normal input: the normal map is not applied"
+    note = loss_note(source, node_id, {s.param for s in table}, extra)
+    surface = Node(SURFACE, node_id, inputs, {"out": "token"}, {"loss": note})
+    return Network("mtlx", Connection(SURFACE, "out"), [surface, *nodes])
+
+
+def _texture(nodes: list[Node], slot: Slot, image: Image) -> tuple[str, Any]:
+    if slot.texture_linear != (1.0, 0.0):
+        image = converted(image, slot)
+    kind = "color3" if slot.type == "color3f" else "float"
+    name = f"mtlx_{slot.param}"
+    nodes.append(Node(name, f"ND_image_{kind}", {"file": ("asset", image)}, {"out": slot.type}))
+    return slot.type, Connection(name, "out")
+
+
+def document(specs: list[MaterialSpec], relative_to: Path):
+    """A MaterialX document holding the mtlx network of every spec.
+
+    Asset paths are written relative to ``relative_to`` (the ``.mtlx`` file's folder).
+    """
+    import MaterialX as mx
+
+    doc = mx.createDocument()
+    for spec in specs:
+        for net in spec.networks:
+            if net.context == "mtlx":
+                _add_network(doc, spec.name, net, relative_to)
+    return doc
+
+
+def _add_network(doc, material: str, net: Network, relative_to: Path) -> None:
+    lib = _library()
+    material = prim_name(material)
+    prefix = f"{material}_"
+    for node in net.nodes:
+        nodedef = lib.getNodeDef(node.id)
+        mx_node = doc.addNode(nodedef.getNodeString(), prefix + node.name, nodedef.getType())
+        mx_node.setNodeDefString(node.id)
+        for name, (kind, value) in node.inputs.items():
+            inp = mx_node.addInput(name, MX_TYPES[kind])
+            if isinstance(value, Connection):
+                inp.setNodeName(prefix + value.node)
+            elif isinstance(value, Image):
+                inp.setValueString(_relative(value.path, relative_to))
+            else:
+                inp.setValueString(_mx_value(value))
+    mat = doc.addNode("surfacematerial", material, "material")
+    shader = mat.addInput("surfaceshader", "surfaceshader")
+    shader.setNodeName(prefix + net.terminal.node)
+
+
+def _mx_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, tuple):
+        return ", ".join(repr(float(x)) for x in value)
+    return str(value)
+
+
+def _relative(path: Path, base: Path) -> str:
+    return Path(os.path.relpath(path, base)).as_posix()
+
+
+def validate_document(doc) -> list[str]:
+    """MaterialX's own validation of ``doc`` against the standard libraries: messages."""
+    doc.setDataLibrary(_library())
+    ok, message = doc.validate()
+    return [] if ok else [line for line in message.splitlines() if line.strip()]
+
+
+def write_document(specs: list[MaterialSpec], path: Path, *, where: Path | None = None) -> None:
+    """Write the mtlx networks of ``specs`` as a standalone ``.mtlx`` file, validated."""
+    import MaterialX as mx
+
+    doc = document(specs, path.parent)
+    problems = validate_document(doc)
+    if problems:
+        raise ExportError(
+            f"MaterialX rejects the document: {problems[0]}", where=str(where or path)
+        )
+    mx.writeToXmlFile(doc, str(path))

@@ -1,0 +1,236 @@
+"""The name tables: one per target, mapping lookdev parameters to shader inputs.
+
+Each :class:`Slot` says which of our parameters feeds which input of the target's
+surface, with what USD value type, and how a value converts there and back. A table is
+the only place a target's spelling of a parameter appears (DESIGN.md, Names).
+
+Choice of MaterialX surface per model:
+
+- Disney → ``ND_disney_principled``: MaterialX's port of Burley 2012 takes his eleven
+  parameters as they are (plus ``specTrans``/``ior`` of the 2015 BSDF), so nothing is
+  refitted; OpenPBR or Standard Surface would need a lossy re-parametrisation of
+  ``specular_tint``, ``sheen`` and the GTR1 clearcoat.
+- Pixar → ``ND_open_pbr_surface_surfaceshader``: Smits' lobe weights are colours with a
+  normal and a grazing value; OpenPBR's ``specular_color`` (F0 tint) and its F82 edge
+  behaviour are the closest match of any MaterialX surface, and it has a coat for the
+  sharp reflection lobe, which ``disney_principled`` would force through Burley's fixed
+  Fresnel.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+CLEARCOAT_ALPHA = (0.1, 0.001)  # Burley App. B.2: α_c = mix(0.1, 0.001, clearcoat_gloss)
+CLEARCOAT_PREVIEW_SCALE = 0.25  # Burley App. B.2: the clearcoat lobe is weighted 0.25·clearcoat
+
+
+def _same(v):
+    return v
+
+
+@dataclass(frozen=True)
+class Slot:
+    """One parameter → one shader input, with conversions both ways.
+
+    ``lobe`` names the lobe (see :mod:`.lobes`) whose weight gates the input: when the
+    lobe is off the input is not written. ``texture_linear`` is ``(scale, bias)`` when
+    ``to_target`` is affine, so a texture can be converted by ``UsdUVTexture``'s
+    scale/bias instead of a rewritten image; ``None`` means it is not affine.
+    """
+
+    param: str
+    input: str
+    type: str  # Sdf value type name: float, color3f, int, bool
+    lobe: str | None = None
+    to_target: Callable = field(default=_same, repr=False)
+    from_target: Callable = field(default=_same, repr=False)
+    texture_linear: tuple[float, float] | None = (1.0, 0.0)
+
+
+def gloss_to_roughness(gloss: float) -> float:
+    """Burley's clearcoat gloss → the perceptual roughness r of a GGX lobe with α = r².
+
+    Burley App. B.2 gives α = mix(0.1, 0.001, gloss); UsdPreviewSurface (like Burley's
+    base lobe) squares its roughness, so r = √α.
+
+    >>> round(gloss_to_roughness(1.0), 6), round(gloss_to_roughness(0.0), 6)
+    (0.031623, 0.316228)
+    """
+    lo, hi = CLEARCOAT_ALPHA
+    return math.sqrt(lo + (hi - lo) * gloss)
+
+
+def roughness_to_gloss(r: float) -> float:
+    """Inverse of :func:`gloss_to_roughness`, clamped to the gloss range 0..1.
+
+    >>> round(roughness_to_gloss(gloss_to_roughness(0.3)), 6)
+    0.3
+    """
+    lo, hi = CLEARCOAT_ALPHA
+    return min(1.0, max(0.0, (r * r - lo) / (hi - lo)))
+
+
+def specular_to_ior(specular: float) -> float:
+    """Burley §5.4: F0 = 0.08·specular, and F0 = ((ior - 1)/(ior + 1))² for a dielectric.
+
+    >>> round(specular_to_ior(0.5), 6)
+    1.5
+    """
+    r = math.sqrt(min(0.08 * specular, 1.0 - 1e-7))
+    return (1.0 + r) / (1.0 - r)
+
+
+def ior_to_specular(ior: float) -> float:
+    """Inverse of :func:`specular_to_ior`.
+
+    >>> round(ior_to_specular(1.5), 6)
+    0.5
+    """
+    return ((ior - 1.0) / (ior + 1.0)) ** 2 / 0.08
+
+
+def _one_minus(v):
+    return 1.0 - v
+
+
+def _times(k: float) -> Callable[[float], float]:
+    return lambda v: v * k
+
+
+def _grey(v):
+    return (v, v, v)
+
+
+def _mean(v):
+    return sum(v) / 3.0
+
+
+def _flag(v):
+    return int(bool(v))
+
+
+# UsdPreviewSurface in its metallic workflow (UsdPreviewSurface spec, 2.6).
+PREVIEW_DISNEY: tuple[Slot, ...] = (
+    Slot("base_color", "diffuseColor", "color3f"),
+    Slot("metallic", "metallic", "float"),
+    Slot("roughness", "roughness", "float"),
+    # F0 = ((ior-1)/(ior+1))² in the spec's dielectric; Burley §5.4 F0 = 0.08·specular.
+    Slot("ior", "ior", "float", lobe="dielectric", texture_linear=None),
+    # The spec's clearcoat is a white GGX lobe with F0 0.04 scaled by `clearcoat`;
+    # Burley weights his 0.25·clearcoat, so scale by 0.25 to keep the reflected energy.
+    Slot(
+        "clearcoat",
+        "clearcoat",
+        "float",
+        lobe="clearcoat",
+        to_target=_times(CLEARCOAT_PREVIEW_SCALE),
+        from_target=_times(1.0 / CLEARCOAT_PREVIEW_SCALE),
+        texture_linear=(CLEARCOAT_PREVIEW_SCALE, 0.0),
+    ),
+    Slot(
+        "clearcoat_gloss",
+        "clearcoatRoughness",
+        "float",
+        lobe="clearcoat",
+        to_target=gloss_to_roughness,
+        from_target=roughness_to_gloss,
+        texture_linear=None,
+    ),
+    # The spec: opacity < 1 is translucent, refracting by `ior`: the spec_trans lobe.
+    Slot(
+        "spec_trans",
+        "opacity",
+        "float",
+        lobe="spec_trans",
+        to_target=_one_minus,
+        from_target=_one_minus,
+        texture_linear=(-1.0, 1.0),
+    ),
+)
+
+# MaterialX 1.39 ND_disney_principled (libraries/bxdf/disney_principled.mtlx).
+MTLX_DISNEY: tuple[Slot, ...] = (
+    Slot("base_color", "baseColor", "color3f"),
+    Slot("metallic", "metallic", "float"),
+    Slot("roughness", "roughness", "float"),
+    Slot("anisotropic", "anisotropic", "float", lobe="specular"),
+    Slot("specular", "specular", "float", lobe="dielectric"),
+    Slot("specular_tint", "specularTint", "float", lobe="dielectric"),
+    Slot("sheen", "sheen", "float", lobe="sheen"),
+    Slot("sheen_tint", "sheenTint", "float", lobe="sheen"),
+    Slot("clearcoat", "clearcoat", "float", lobe="clearcoat"),
+    Slot("clearcoat_gloss", "clearcoatGloss", "float", lobe="clearcoat"),
+    Slot("spec_trans", "specTrans", "float", lobe="spec_trans"),
+    Slot("ior", "ior", "float", lobe="spec_trans"),
+    Slot("subsurface", "subsurface", "float", lobe="subsurface"),
+    Slot(
+        "scatter_distance",
+        "subsurfaceDistance",
+        "color3f",
+        lobe="scatter",
+        to_target=_grey,
+        from_target=_mean,
+        texture_linear=None,
+    ),
+)
+
+# RenderMan PxrDisneyBsdf: Schutte's 2015 parameter set under camelCase names.
+RI_DISNEY: tuple[Slot, ...] = (
+    Slot("base_color", "baseColor", "color3f"),
+    Slot("metallic", "metallic", "float"),
+    Slot("roughness", "roughness", "float"),
+    Slot("anisotropic", "anisotropic", "float", lobe="specular"),
+    Slot("specular", "specular", "float", lobe="dielectric"),
+    Slot("specular_tint", "specularTint", "float", lobe="dielectric"),
+    Slot("sheen", "sheen", "float", lobe="sheen"),
+    Slot("sheen_tint", "sheenTint", "float", lobe="sheen"),
+    Slot("clearcoat", "clearcoat", "float", lobe="clearcoat"),
+    Slot("clearcoat_gloss", "clearcoatGloss", "float", lobe="clearcoat"),
+    Slot("spec_trans", "specTrans", "float", lobe="spec_trans"),
+    Slot("ior", "ior", "float", lobe="spec_trans"),
+    Slot("diff_trans", "diffTrans", "float", lobe="diff_trans"),
+    Slot("subsurface", "subsurface", "float", lobe="subsurface"),
+    Slot("flatness", "flatness", "float", lobe="flatness"),
+    Slot(
+        "scatter_distance",
+        "scatterDistance",
+        "color3f",
+        lobe="scatter",
+        to_target=_grey,
+        from_target=_mean,
+        texture_linear=None,
+    ),
+    Slot("thin", "thin", "int", lobe="thin", to_target=_flag, from_target=bool),
+)
+
+TABLES: dict[tuple[str, str], tuple[Slot, ...]] = {
+    ("universal", "disney"): PREVIEW_DISNEY,
+    ("mtlx", "disney"): MTLX_DISNEY,
+    ("ri", "disney"): RI_DISNEY,
+}
+"""(context, model) → the table of that target."""
+
+SURFACE_IDS: dict[tuple[str, str], str] = {
+    ("universal", "disney"): "UsdPreviewSurface",
+    ("mtlx", "disney"): "ND_disney_principled",
+    ("ri", "disney"): "PxrDisneyBsdf",
+}
+"""(context, model) → the surface shader's ``info:id``."""
+
+
+def table_for(context: str, model: str) -> tuple[Slot, ...]:
+    """The name table of ``context`` for ``model``."""
+    return TABLES[(context, model)]
+
+
+def lost_params(context: str, model: str, params: dict) -> list[str]:
+    """Our parameters with a non-default effect that ``context`` has no input for."""
+    mapped = {s.param for s in table_for(context, model)}
+    if "ior" in mapped:
+        mapped.add("specular")  # one parameter, two spellings
+    if "specular" in mapped:
+        mapped.add("ior")
+    return sorted(k for k in params if k not in mapped)

@@ -1,0 +1,207 @@
+"""A small, USD-free description of shading networks, and what feeds them.
+
+Every render context (:mod:`.preview`, :mod:`.mtlx`, :mod:`.ri`) turns a :class:`Source`
+into a :class:`Network` of :class:`Node` s; :mod:`.writer` authors those into USD layers
+(and :mod:`.mtlx` into standalone ``.mtlx`` documents). Keeping the description apart
+from the authoring lets the fast Sdf writer, the naive Usd-API reference of the
+benchmark and the MaterialX writer share one set of networks.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lookdev.materials.errors import LookdevError
+
+from .lobes import DEFAULTS, active_lobes, canonical, effective
+from .names import Slot
+
+CONTEXT_OUTPUT = {"universal": "surface", "mtlx": "mtlx:surface", "ri": "ri:surface"}
+"""render context → the Material's terminal output name (UsdShade convention)."""
+
+CONTEXTS = tuple(CONTEXT_OUTPUT)
+
+WEIGHTS = frozenset(
+    ("sheen", "clearcoat", "spec_trans", "diff_trans", "subsurface", "flatness", "scatter_distance")
+)
+"""Parameters that switch their own lobe on: written whenever the lobe is live, default
+or not, so that a reader can tell a pruned lobe (input absent) from a live one."""
+
+
+class ExportError(LookdevError):
+    """A material cannot be exported as asked (missing texture, unwritable path …)."""
+
+
+@dataclass(frozen=True)
+class Connection:
+    """The output ``output`` of node ``node`` in the same material."""
+
+    node: str
+    output: str
+
+
+@dataclass
+class Node:
+    """One shader: its id, inputs (``name → (type, value or Connection)``) and outputs."""
+
+    name: str
+    id: str
+    inputs: dict[str, tuple[str, Any]] = field(default_factory=dict)
+    outputs: dict[str, str] = field(default_factory=dict)
+    custom: dict[str, str] = field(default_factory=dict)
+
+
+@dataclass
+class Network:
+    """The nodes of one render context and the connection its terminal reads."""
+
+    context: str
+    terminal: Connection
+    nodes: list[Node]
+
+
+@dataclass
+class MaterialSpec:
+    """Everything written for one material: its networks and its metadata."""
+
+    name: str
+    networks: list[Network]
+    custom: dict[str, Any]
+
+
+@dataclass(frozen=True)
+class Image:
+    """A texture a network reads: a file, and optionally its pixels (for conversions).
+
+    ``write`` marks an image the exporter must write itself (a converted map, a baked
+    procedural mask) before the stage that references it.
+    """
+
+    path: Path
+    pixels: np.ndarray | None = None
+    write: bool = False
+
+
+@dataclass
+class Source:
+    """What a network needs of a material: values, maps, normal map, lobes.
+
+    ``values`` are canonical (:func:`.lobes.canonical`); ``maps`` maps a parameter to the
+    image that varies it (baked blends); ``spelling`` records whether the preset wrote
+    ``specular`` or ``ior`` so an import gives back the same spelling.
+    """
+
+    name: str
+    model: str
+    values: dict[str, Any]
+    maps: dict[str, Image] = field(default_factory=dict)
+    normal_map: Image | None = None
+    spelling: str = "specular"
+    description: str = ""
+
+    @property
+    def lobes(self) -> dict[str, bool]:
+        """Lobes with weight; a mapped weight parameter counts as live."""
+        values = dict(self.values)
+        for k in self.maps:
+            if isinstance(values.get(k), float):
+                values[k] = max(values[k], 1e-6)
+        return active_lobes(values, self.model)
+
+    @property
+    def live_values(self) -> dict[str, Any]:
+        """The values with every parameter of a dead lobe reset to its default."""
+        return effective(self.values, self.model, self.lobes)
+
+
+def source_from_params(name: str, model: str, params: Any, description: str = "") -> Source:
+    """A constant material's :class:`Source` (no maps)."""
+    spelling = "ior" if getattr(params, "uses_ior", False) else "specular"
+    return Source(name, model, canonical(params), spelling=spelling, description=description)
+
+
+TextureFactory = Callable[[list[Node], Slot, Image], tuple[str, Any]]
+"""Adds the nodes reading one map for ``slot`` and returns the (type, Connection)."""
+
+
+def surface_inputs(
+    source: Source,
+    table: tuple[Slot, ...],
+    defaults: dict[str, Any] | None,
+    nodes: list[Node],
+    texture: TextureFactory,
+) -> dict[str, tuple[str, Any]]:
+    """Inputs of a surface from a name table: only live lobes, only non-default values.
+
+    ``defaults`` are the target's own input defaults (``None``: unknown, author all).
+    """
+    lobes = source.lobes
+    values = source.live_values
+    inputs: dict[str, tuple[str, Any]] = {}
+    for slot in table:
+        if slot.lobe is not None and not lobes[slot.lobe]:
+            continue
+        if slot.param in source.maps:
+            inputs[slot.input] = texture(nodes, slot, source.maps[slot.param])
+            continue
+        value = slot.to_target(values[slot.param])
+        at_default = defaults is not None and same_or_eq(value, defaults.get(slot.input))
+        if at_default and slot.param not in WEIGHTS:
+            continue
+        inputs[slot.input] = (slot.type, value)
+    return inputs
+
+
+def same(a: Any, b: Any) -> bool:
+    """Equal as USD would store them (float32), for values and colour triples."""
+    a32 = np.asarray(a, dtype=np.float32)
+    b32 = np.asarray(b, dtype=np.float32)
+    return a32.shape == b32.shape and bool(np.all(a32 == b32))
+
+
+def loss_note(source: Source, context: str, mapped: set[str], extra: str = "") -> str:
+    """One sentence naming the live parameters ``context`` cannot express, or ``""``."""
+    values = source.live_values
+    defaults = DEFAULTS[source.model]
+    lost = sorted(
+        k
+        for k, v in values.items()
+        if k not in mapped and k not in ("specular", "ior") and not same_or_eq(v, defaults[k])
+    )
+    parts = []
+    if lost:
+        shown = ", ".join(f"{k}={_short(values[k])}" for k in lost)
+        parts.append(f"{context} cannot express {shown}")
+    if extra:
+        parts.append(extra)
+    return "; ".join(parts)
+
+
+def same_or_eq(a: Any, b: Any) -> bool:
+    if isinstance(a, str | bool) or isinstance(b, str | bool) or a is None or b is None:
+        return a == b
+    return same(a, b)
+
+
+def _short(v: Any) -> str:
+    if isinstance(v, float):
+        return f"{v:g}"
+    if isinstance(v, tuple):
+        return "(" + ", ".join(f"{x:g}" for x in v) + ")"
+    return str(v)
+
+
+def prim_name(name: str) -> str:
+    """A USD prim name for a preset name (``-`` and a leading digit are not allowed).
+
+    >>> prim_name("car-paint"), prim_name("3m_tape")
+    ('car_paint', '_3m_tape')
+    """
+    safe = re.sub(r"[^A-Za-z0-9_]", "_", name)
+    return f"_{safe}" if safe[:1].isdigit() else safe

@@ -1,0 +1,99 @@
+"""The universal context: a ``UsdPreviewSurface`` network every DCC reads.
+
+Maps are ``UsdUVTexture`` nodes reading ``st`` through one ``UsdPrimvarReader_float2``;
+affine conversions (``opacity = 1 - spec_trans``, the clearcoat scale) ride on the
+texture's ``scale``/``bias`` so the baked image is shared with the other contexts.
+What the surface cannot express is named in the surface shader's ``customData``
+(``lookdev:loss``), and an importer reads only what is there.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+from typing import Any
+
+from .names import Slot, table_for
+from .network import Connection, Image, Network, Node, Source, loss_note, surface_inputs
+from .textures import converted
+
+SURFACE = "preview_surface"
+ST_READER = "preview_st"
+LOBE_SHAPES = (
+    "lobe shapes differ: GGX for Burley's GTR1 clearcoat, the surface's own diffuse "
+    "for Burley's retro-reflective one"
+)
+
+
+@cache
+def preview_defaults() -> dict[str, Any]:
+    """UsdPreviewSurface's input defaults, as the Sdr registry of usd-core knows them."""
+    from pxr import Sdr
+
+    node = Sdr.Registry().GetShaderNodeByIdentifier("UsdPreviewSurface")
+    return {n: _plain(node.GetShaderInput(n).GetDefaultValue()) for n in node.GetShaderInputNames()}
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, str) or not hasattr(value, "__len__"):
+        return value
+    return tuple(float(x) for x in value)
+
+
+def build(source: Source) -> Network:
+    """The UsdPreviewSurface network of ``source``."""
+    nodes: list[Node] = []
+    table = table_for("universal", source.model)
+    inputs = surface_inputs(source, table, preview_defaults(), nodes, _texture)
+    if source.normal_map is not None:
+        inputs["normal"] = _normal(nodes, source.normal_map)
+    mapped = {s.param for s in table}
+    note = loss_note(source, "UsdPreviewSurface", mapped, LOBE_SHAPES)
+    surface = Node(SURFACE, "UsdPreviewSurface", inputs, {"surface": "token"})
+    surface.custom["loss"] = note
+    return Network("universal", Connection(SURFACE, "surface"), [surface, *nodes])
+
+
+def _st(nodes: list[Node]) -> Connection:
+    if not any(n.name == ST_READER for n in nodes):
+        reader = Node(ST_READER, "UsdPrimvarReader_float2", {"varname": ("string", "st")})
+        reader.outputs["result"] = "float2"
+        nodes.append(reader)
+    return Connection(ST_READER, "result")
+
+
+def _uv_texture(nodes: list[Node], name: str, image: Image, output: str, kind: str) -> Node:
+    node = Node(
+        name,
+        "UsdUVTexture",
+        {
+            "file": ("asset", image),
+            "st": ("float2", _st(nodes)),
+            "sourceColorSpace": ("token", "raw"),
+            "wrapS": ("token", "repeat"),
+            "wrapT": ("token", "repeat"),
+        },
+        {output: kind},
+    )
+    nodes.append(node)
+    return node
+
+
+def _texture(nodes: list[Node], slot: Slot, image: Image) -> tuple[str, Any]:
+    output = "rgb" if slot.type == "color3f" else "r"
+    kind = "float3" if output == "rgb" else "float"
+    if slot.texture_linear is None:
+        image = converted(image, slot)
+    node = _uv_texture(nodes, f"preview_{slot.param}", image, output, kind)
+    if slot.texture_linear not in (None, (1.0, 0.0)):
+        scale, bias = slot.texture_linear
+        node.inputs["scale"] = ("float4", (scale, scale, scale, 1.0))
+        node.inputs["bias"] = ("float4", (bias, bias, bias, 0.0))
+    return slot.type, Connection(node.name, output)
+
+
+def _normal(nodes: list[Node], image: Image) -> tuple[str, Any]:
+    """A tangent-space normal map: texel 0..1 ↦ -1..1 by scale 2, bias -1 (spec 5.4)."""
+    node = _uv_texture(nodes, "preview_normal_map", image, "rgb", "float3")
+    node.inputs["scale"] = ("float4", (2.0, 2.0, 2.0, 1.0))
+    node.inputs["bias"] = ("float4", (-1.0, -1.0, -1.0, 0.0))
+    return "normal3f", Connection(node.name, "rgb")

@@ -1,0 +1,254 @@
+"""``lookdev import usd``: UsdShade networks back into presets.
+
+Reading inverts the name tables of :mod:`.names`: an input that is authored gives its
+value through ``Slot.from_target``; one that is not authored takes the target's default
+(which is what a renderer would use), except in the RenderMan context, whose defaults
+usd-core does not know and where lookdev writes every live input. An input connected to
+a texture node gives that texture's file as the parameter's map.
+
+Contexts are read in the order universal, RenderMan, MaterialX, each overriding the
+parameters it expresses more faithfully: a lookdev-written file thus gives back every
+parameter, a foreign ``UsdPreviewSurface`` what that surface can say.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .lobes import DEFAULTS, active_lobes, effective
+from .names import SURFACE_IDS, ior_to_specular, specular_to_ior, table_for
+from .network import (
+    CONTEXT_OUTPUT,
+    Connection,
+    ExportError,
+    Image,
+    MaterialSpec,
+    Network,
+    Node,
+    same_or_eq,
+)
+from .preview import preview_defaults
+
+TEXTURE_FILE_INPUT = {"UsdUVTexture": "file", "PxrTexture": "filename"}
+READ_ORDER = ("universal", "ri", "mtlx")
+
+
+@dataclass
+class Imported:
+    """One material read from USD: preset fields, maps, and what was not readable."""
+
+    name: str
+    model: str
+    params: dict[str, Any]
+    maps: dict[str, Path] = field(default_factory=dict)
+    contexts: list[str] = field(default_factory=list)
+    loss: list[str] = field(default_factory=list)
+
+
+def read_networks(stage) -> list[MaterialSpec]:
+    """Every material's networks as :class:`~.network.MaterialSpec` (switch prims skipped)."""
+    from pxr import Usd, UsdShade
+
+    specs = []
+    for prim in stage.Traverse(Usd.TraverseInstanceProxies()):
+        if not prim.IsA(UsdShade.Material) or _custom(prim).get("switch"):
+            continue
+        material = UsdShade.Material(prim)
+        networks = []
+        for context, output_name in CONTEXT_OUTPUT.items():
+            net = _network(material, context, output_name)
+            if net is not None:
+                networks.append(net)
+        specs.append(
+            MaterialSpec(_custom(prim).get("preset", prim.GetName()), networks, _custom(prim))
+        )
+    return specs
+
+
+def _custom(prim) -> dict[str, Any]:
+    return dict(prim.GetCustomDataByKey("lookdev") or {})
+
+
+def _network(material, context: str, output_name: str) -> Network | None:
+    output = material.GetOutput(output_name)
+    if not output:
+        return None
+    terminal = _source(output)
+    if terminal is None:
+        return None
+    nodes: dict[str, Node] = {}
+    _collect(material.GetPrim().GetStage().GetPrimAtPath(terminal[0]), nodes)
+    name = terminal[0].name
+    return Network(context, Connection(name, terminal[1]), list(nodes.values()))
+
+
+def _source(port):
+    sources, _ = port.GetConnectedSources()
+    if not sources:
+        return None
+    src = sources[0]
+    return src.source.GetPrim().GetPath(), src.sourceName
+
+
+def _collect(prim, nodes: dict[str, Node]) -> None:
+    from pxr import UsdShade
+
+    shader = UsdShade.Shader(prim)
+    if not shader or prim.GetName() in nodes:
+        return
+    node = Node(prim.GetName(), str(shader.GetIdAttr().Get() or ""))
+    nodes[node.name] = node
+    for out in shader.GetOutputs():
+        node.outputs[out.GetBaseName()] = str(out.GetTypeName())
+    for inp in shader.GetInputs():
+        kind = str(inp.GetTypeName())
+        source = _source(inp)
+        if source is not None:
+            node.inputs[inp.GetBaseName()] = (kind, Connection(source[0].name, source[1]))
+            _collect(prim.GetStage().GetPrimAtPath(source[0]), nodes)
+        elif inp.GetAttr().HasAuthoredValue():
+            node.inputs[inp.GetBaseName()] = (kind, _plain(inp.Get()))
+    node.custom.update(_custom(prim))
+
+
+def _plain(value: Any) -> Any:
+    from pxr import Sdf
+
+    if isinstance(value, Sdf.AssetPath):
+        return Image(Path(value.resolvedPath or value.path))
+    if hasattr(value, "__len__") and not isinstance(value, str):
+        return tuple(float(x) for x in value)
+    return value
+
+
+def import_usd(path: Path) -> list[Imported]:
+    """Read every material of the USD file ``path`` into presets."""
+    from pxr import Tf, Usd
+
+    path = Path(path)
+    if not path.is_file():
+        raise ExportError("file does not exist", where=str(path))
+    try:
+        stage = Usd.Stage.Open(str(path))
+    except Tf.ErrorException:
+        raise ExportError("USD cannot open it", where=str(path)) from None
+    found = [_imported(spec) for spec in read_networks(stage)]
+    found = [f for f in found if f is not None]
+    if not found:
+        raise ExportError(
+            "no material with a UsdPreviewSurface, ND_disney_principled or PxrDisneyBsdf surface",
+            where=str(path),
+        )
+    return found
+
+
+def _imported(spec: MaterialSpec) -> Imported | None:
+    model = spec.custom.get("model", "disney")
+    values = dict(DEFAULTS[model])
+    result = Imported(spec.name, model, {})
+    by_context = {net.context: net for net in spec.networks}
+    for context in READ_ORDER:
+        net = by_context.get(context)
+        surface = _surface(net, context, model)
+        if surface is None:
+            continue
+        _read_surface(net, surface, context, model, values, result)
+        result.contexts.append(context)
+        if surface.custom.get("loss"):
+            result.loss.append(f"{context}: {surface.custom['loss']}")
+    if not result.contexts:
+        return None
+    spelling = spec.custom.get("spelling") or ("ior" if "ior" in result.maps else "specular")
+    result.params = _preset_params(values, model, spelling)
+    return result
+
+
+def _surface(net: Network | None, context: str, model: str) -> Node | None:
+    if net is None:
+        return None
+    node = next((n for n in net.nodes if n.name == net.terminal.node), None)
+    if node is None or node.id != SURFACE_IDS.get((context, model)):
+        return None
+    return node
+
+
+def _read_surface(net, surface, context, model, values, result) -> None:
+    """Values of one surface into ``values`` (our names), maps into ``result.maps``.
+
+    Unwritten inputs of a lobe take the target's default only once the written ones
+    show the lobe live: lookdev prunes a dead lobe's inputs, and their target defaults
+    (MaterialX's ``subsurfaceDistance`` = 1) must not bring it back to life.
+    """
+    defaults = _defaults(context, surface.id)
+    nodes = {n.name: n for n in net.nodes}
+    table = table_for(context, model)
+    has_specular = any(s.param == "specular" for s in table)
+    pending = []
+    for slot in table:
+        if slot.param == "ior" and has_specular:
+            continue  # there `ior` only refracts and equals the specular's IOR by construction
+        given = surface.inputs.get(slot.input)
+        if given is not None and isinstance(given[1], Connection):
+            result.maps[slot.param] = _texture_file(nodes, given[1])
+        elif given is not None:
+            values[slot.param] = slot.from_target(given[1])
+        elif defaults is not None and slot.input in defaults:
+            pending.append(slot)
+    lobes = active_lobes(values, model)
+    for slot in pending:
+        if slot.lobe is None or lobes[slot.lobe]:
+            values[slot.param] = slot.from_target(defaults[slot.input])
+    if has_specular:
+        values["ior"] = specular_to_ior(values["specular"])
+    else:
+        values["specular"] = ior_to_specular(values["ior"])
+
+
+def _defaults(context: str, node_id: str) -> dict[str, Any] | None:
+    """The target's input defaults; None for RenderMan, whose usd-core has none."""
+    if context == "universal":
+        return preview_defaults()
+    if context == "mtlx":
+        from .mtlx import node_defaults
+
+        return node_defaults(node_id)
+    return None
+
+
+def _texture_file(nodes: dict[str, Node], conn: Connection) -> Path | None:
+    node = nodes.get(conn.node)
+    if node is None:
+        return None
+    key = TEXTURE_FILE_INPUT.get(node.id, "file")
+    value = node.inputs.get(key, (None, None))[1]
+    return value.path if isinstance(value, Image) else None
+
+
+def _preset_params(values: dict[str, Any], model: str, spelling: str) -> dict:
+    """Non-default live parameters, ``specular``/``ior`` in the preset's own spelling."""
+    live = effective(values, model)
+    defaults = DEFAULTS[model]
+    params = {}
+    for k, v in live.items():
+        if k in ("specular", "ior"):
+            continue
+        if not same_or_eq(v, defaults[k]):
+            params[k] = _round(v)
+    key = "ior" if spelling == "ior" else "specular"
+    params[key] = _round(live[key])
+    if same_or_eq(params[key], defaults[key]):
+        del params[key]
+    return params
+
+
+def _round(v: Any) -> Any:
+    """float32-stored values as the shortest decimal that reads back the same float32."""
+    import numpy as np
+
+    if isinstance(v, float):
+        return float(np.format_float_positional(np.float32(v), unique=True))
+    if isinstance(v, tuple):
+        return tuple(_round(x) for x in v)
+    return v

@@ -1,0 +1,48 @@
+"""The ``ri`` context: RenderMan's ``PxrDisneyBsdf`` for Disney materials.
+
+usd-core has no Sdr description of RenderMan's nodes, so only the defaults that are
+certain are relied on (a lobe weight of 0 and RenderMan's zero metallic, anisotropy and
+tint); every other input of a live lobe is written. Maps are ``PxrTexture`` nodes
+(``resultRGB``/``resultR``), the normal map a ``PxrNormalMap`` into ``bumpNormal``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from .names import SURFACE_IDS, Slot, table_for
+from .network import Connection, Image, Network, Node, Source, loss_note, surface_inputs
+from .textures import converted
+
+SURFACE = "ri_surface"
+RI_DEFAULTS = {"metallic": 0.0, "anisotropic": 0.0, "specularTint": 0.0}
+
+
+def build(source: Source) -> Network:
+    """The RenderMan network of ``source``."""
+    nodes: list[Node] = []
+    table = table_for("ri", source.model)
+    inputs = surface_inputs(source, table, RI_DEFAULTS, nodes, _texture)
+    if source.normal_map is not None:
+        nodes.append(
+            Node(
+                "ri_normal_map",
+                "PxrNormalMap",
+                {"filename": ("asset", source.normal_map)},
+                {"resultN": "normal3f"},
+            )
+        )
+        inputs["bumpNormal"] = ("normal3f", Connection("ri_normal_map", "resultN"))
+    node_id = SURFACE_IDS[("ri", source.model)]
+    note = loss_note(source, node_id, {s.param for s in table})
+    surface = Node(SURFACE, node_id, inputs, {"bxdf_out": "token"}, {"loss": note})
+    return Network("ri", Connection(SURFACE, "bxdf_out"), [surface, *nodes])
+
+
+def _texture(nodes: list[Node], slot: Slot, image: Image) -> tuple[str, Any]:
+    if slot.texture_linear != (1.0, 0.0):
+        image = converted(image, slot)
+    output = "resultRGB" if slot.type == "color3f" else "resultR"
+    name = f"ri_{slot.param}"
+    nodes.append(Node(name, "PxrTexture", {"filename": ("asset", image)}, {output: slot.type}))
+    return slot.type, Connection(name, output)

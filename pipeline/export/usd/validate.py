@@ -1,0 +1,104 @@
+"""``lookdev validate usd``: every usd-core validator, then MaterialX's own check.
+
+usd-core's ``UsdValidation`` registry runs on the whole stage. Its one expected error
+is ``MissingShaderIdInRegistry`` for MaterialX (``ND_*``) and RenderMan (``Pxr*``)
+shader ids: the pip build ships without UsdMtlx and RenderMan's node definitions, so
+Sdr cannot know them. Those networks are checked instead by converting each MaterialX
+network back into a MaterialX document and running MaterialX's ``validate``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .network import ExportError
+
+ALLOWED = "MissingShaderIdInRegistry"
+FOREIGN_ID_PREFIXES = ("ND_", "Pxr")
+
+
+@dataclass
+class Report:
+    """Validation outcome: errors (fail), warnings, and the errors allowed as expected."""
+
+    path: str
+    errors: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    allowed: list[str] = field(default_factory=list)
+    validators: int = 0
+    mtlx_networks: int = 0
+
+    @property
+    def ok(self) -> bool:
+        return not self.errors
+
+
+def validate_usd(path: Path) -> Report:
+    """Run every registered usd-core validator and MaterialX's ``validate`` on ``path``."""
+    from pxr import Tf, Usd, UsdValidation
+
+    path = Path(path)
+    if not path.is_file():
+        raise ExportError("file does not exist", where=str(path))
+    try:
+        stage = Usd.Stage.Open(str(path))
+    except Tf.ErrorException as exc:
+        raise ExportError(f"USD cannot open it: {_first_line(exc)}", where=str(path)) from None
+    validators = UsdValidation.ValidationRegistry().GetOrLoadAllValidators()
+    report = Report(str(path), validators=len(validators))
+    for error in UsdValidation.ValidationContext(validators).Validate(stage):
+        _file(report, error)
+    _check_mtlx(stage, report)
+    return report
+
+
+def _file(report: Report, error) -> None:
+    from pxr import UsdValidation
+
+    text = f"{error.GetIdentifier()}: {error.GetMessage()}"
+    kind = error.GetType()
+    if kind == UsdValidation.ValidationErrorType.Error:
+        if _expected(error):
+            report.allowed.append(text)
+        else:
+            report.errors.append(text)
+    elif kind == UsdValidation.ValidationErrorType.Warn:
+        report.warnings.append(text)
+
+
+def _expected(error) -> bool:
+    """A missing Sdr entry for a MaterialX or RenderMan id, and nothing else."""
+    from pxr import UsdShade
+
+    if ALLOWED not in str(error.GetIdentifier()):
+        return False
+    for site in error.GetSites():
+        prim = site.GetProperty().GetPrim() if site.IsProperty() else site.GetPrim()
+        if not prim or not prim.IsA(UsdShade.Shader):
+            return False
+        ident = UsdShade.Shader(prim).GetIdAttr().Get() or ""
+        if not str(ident).startswith(FOREIGN_ID_PREFIXES):
+            return False
+    return True
+
+
+def _check_mtlx(stage, report: Report) -> None:
+    from . import mtlx
+    from .reader import read_networks
+
+    specs = [s for s in read_networks(stage) if any(n.context == "mtlx" for n in s.networks)]
+    report.mtlx_networks = len(specs)
+    if not specs:
+        return
+    try:
+        doc = mtlx.document(specs, Path(stage.GetRootLayer().realPath).parent)
+        problems = mtlx.validate_document(doc)
+    except Exception as exc:  # a network MaterialX cannot even build
+        problems = [f"cannot build a MaterialX document: {_first_line(exc)}"]
+    report.errors += [f"MaterialX: {p}" for p in problems]
+
+
+def _first_line(exc: BaseException) -> str:
+    lines = [line.strip() for line in str(exc).splitlines() if line.strip()]
+    return lines[-1] if lines else type(exc).__name__

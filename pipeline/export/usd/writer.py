@@ -1,0 +1,343 @@
+"""Authoring networks into USD layers: one stage, a split library, a ``.usdz`` package.
+
+Authoring is Sdf-level (``Sdf.ChangeBlock``, ``Sdf.PrimSpec``, ``Sdf.AttributeSpec``):
+one change notification per stage instead of one per attribute. Files are written to
+temporary names beside their destination and renamed into place only when everything
+succeeded, so a failure leaves no partial file (:class:`Staging`).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from . import mtlx, preview, ri
+from .network import (
+    CONTEXT_OUTPUT,
+    Connection,
+    ExportError,
+    Image,
+    MaterialSpec,
+    Source,
+    prim_name,
+)
+from .textures import write_image
+
+BUILDERS = {"universal": preview.build, "mtlx": mtlx.build, "ri": ri.build}
+SWITCH = "Look"  # the prim whose variant set switches between the exported presets
+USD_SUFFIXES = (".usda", ".usdc", ".usd")
+
+
+def material_spec(source: Source, contexts: tuple[str, ...]) -> MaterialSpec:
+    """The networks of ``source`` for each of ``contexts`` and the material's metadata."""
+    custom = {
+        "preset": source.name,
+        "model": source.model,
+        "spelling": source.spelling,
+    }
+    return MaterialSpec(source.name, [BUILDERS[c](source) for c in contexts], custom)
+
+
+def value_types() -> dict[str, Any]:
+    from pxr import Sdf
+
+    t = Sdf.ValueTypeNames
+    return {
+        "float": t.Float,
+        "float2": t.Float2,
+        "float3": t.Float3,
+        "float4": t.Float4,
+        "color3f": t.Color3f,
+        "normal3f": t.Normal3f,
+        "vector3f": t.Vector3f,
+        "int": t.Int,
+        "bool": t.Bool,
+        "token": t.Token,
+        "string": t.String,
+        "asset": t.Asset,
+    }
+
+
+def usd_value(kind: str, value: Any, base: Path) -> Any:
+    """A Python value as USD stores it; asset paths relative to ``base`` (a folder)."""
+    from pxr import Gf, Sdf
+
+    if kind == "asset":
+        path = value.path if isinstance(value, Image) else Path(value)
+        return Sdf.AssetPath(relative_asset(path, base))
+    if kind in ("color3f", "float3", "normal3f", "vector3f"):
+        return Gf.Vec3f(*value)
+    if kind == "float2":
+        return Gf.Vec2f(*value)
+    if kind == "float4":
+        return Gf.Vec4f(*value)
+    if kind == "float":
+        return float(value)
+    return value
+
+
+def relative_asset(path: Path, base: Path) -> str:
+    """``path`` relative to the folder ``base``, as a ``./``-anchored posix string."""
+    rel = Path(os.path.relpath(Path(path).resolve(), Path(base).resolve())).as_posix()
+    return rel if rel.startswith("../") else f"./{rel}"
+
+
+def new_layer(default_prim: str = "Materials"):
+    """An empty anonymous layer with the stage metadata validators expect."""
+    from pxr import Sdf
+
+    layer = Sdf.Layer.CreateAnonymous(".usda")
+    layer.defaultPrim = default_prim
+    layer.pseudoRoot.SetInfo("upAxis", "Y")
+    layer.pseudoRoot.SetInfo("metersPerUnit", 1.0)
+    return layer
+
+
+def author(layer, specs: list[MaterialSpec], base: Path) -> list[str]:
+    """Author ``specs`` under ``/Materials`` of ``layer``; returns their prim paths."""
+    from pxr import Sdf
+
+    types = value_types()
+    paths = []
+    with Sdf.ChangeBlock():
+        scope = layer.GetPrimAtPath("/Materials") or Sdf.CreatePrimInLayer(layer, "/Materials")
+        scope.specifier = Sdf.SpecifierDef
+        scope.typeName = "Scope"
+        for spec in specs:
+            paths.append(str(_author_material(scope, spec, base, types).path))
+    return paths
+
+
+def _author_material(scope, spec: MaterialSpec, base: Path, types: dict[str, Any]):
+    from pxr import Sdf
+
+    prim = Sdf.PrimSpec(scope, prim_name(spec.name), Sdf.SpecifierDef, "Material")
+    prim.customData = {"lookdev": dict(spec.custom)}
+    for net in spec.networks:
+        out = Sdf.AttributeSpec(prim, f"outputs:{CONTEXT_OUTPUT[net.context]}", types["token"])
+        out.connectionPathList.explicitItems.append(_output_path(prim.path, net.terminal))
+        for node in net.nodes:
+            shader = Sdf.PrimSpec(prim, node.name, Sdf.SpecifierDef, "Shader")
+            if any(node.custom.values()):
+                shader.customData = {"lookdev": {k: v for k, v in node.custom.items() if v}}
+            ident = Sdf.AttributeSpec(shader, "info:id", types["token"], Sdf.VariabilityUniform)
+            ident.default = node.id
+            for name, (kind, value) in node.inputs.items():
+                attr = Sdf.AttributeSpec(shader, f"inputs:{name}", types[kind])
+                if isinstance(value, Connection):
+                    attr.connectionPathList.explicitItems.append(_output_path(prim.path, value))
+                else:
+                    attr.default = usd_value(kind, value, base)
+            for name, kind in node.outputs.items():
+                Sdf.AttributeSpec(shader, f"outputs:{name}", types[kind])
+    return prim
+
+
+def _output_path(material_path, conn: Connection):
+    return material_path.AppendChild(conn.node).AppendProperty(f"outputs:{conn.output}")
+
+
+def add_switch(layer, targets: dict[str, tuple[str, str]]) -> None:
+    """A ``/Look`` material whose variant set ``preset`` references each target.
+
+    ``targets`` maps a variant name to ``(asset path or "" for this layer, prim path)``.
+    """
+    from pxr import Sdf
+
+    with Sdf.ChangeBlock():
+        look = Sdf.PrimSpec(layer.pseudoRoot, SWITCH, Sdf.SpecifierDef, "Material")
+        look.customData = {"lookdev": {"switch": True}}
+        vset = Sdf.VariantSetSpec(look, "preset")
+        for name, (asset, prim_path) in targets.items():
+            variant = Sdf.VariantSpec(vset, name)
+            ref = Sdf.Reference(asset, Sdf.Path(prim_path))
+            variant.primSpec.referenceList.prependedItems.append(ref)
+        look.variantSetNameList.prependedItems.append("preset")
+        look.variantSelections["preset"] = next(iter(targets))
+
+
+@dataclass
+class Staging:
+    """Files written under temporary names, renamed into place together on commit."""
+
+    moves: list[tuple[Path, Path]] = field(default_factory=list)
+
+    def temp_for(self, final: Path) -> Path:
+        fd, name = tempfile.mkstemp(prefix=f".{final.stem}.", suffix=final.suffix, dir=final.parent)
+        os.close(fd)
+        tmp = Path(name)
+        self.moves.append((tmp, final))
+        return tmp
+
+    def commit(self) -> None:
+        for tmp, final in self.moves:
+            os.replace(tmp, final)
+        self.moves.clear()
+
+    def abort(self) -> None:
+        for tmp, _ in self.moves:
+            tmp.unlink(missing_ok=True)
+        self.moves.clear()
+
+
+def check_writable(path: Path) -> None:
+    """Raise :class:`ExportError` unless ``path`` can be created in an existing folder."""
+    folder = path.parent
+    if not folder.is_dir():
+        raise ExportError(f"folder {folder} does not exist", where=str(path))
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise ExportError(f"folder {folder} is not writable", where=str(path))
+    if path.exists() and path.is_dir():
+        raise ExportError("is a folder; give a file name", where=str(path))
+
+
+def images_of(specs: list[MaterialSpec]) -> list[Image]:
+    """Every image the networks reference, once each."""
+    seen: dict[Path, Image] = {}
+    for spec in specs:
+        for net in spec.networks:
+            for node in net.nodes:
+                for kind, value in node.inputs.values():
+                    if kind == "asset" and isinstance(value, Image):
+                        if value.write or value.path not in seen:
+                            seen[value.path] = value
+    return list(seen.values())
+
+
+def check_images(images: list[Image]) -> None:
+    """Every referenced image that the export does not write itself must exist."""
+    for image in images:
+        if not image.write and not image.path.is_file():
+            raise ExportError("texture does not exist", where=str(image.path))
+
+
+@dataclass
+class ExportResult:
+    """What an export wrote: files in place, materials, images referenced."""
+
+    files: list[Path]
+    materials: list[str]
+    images: list[Path]
+
+
+def export_usd(
+    sources: list[Source],
+    out: Path,
+    *,
+    contexts: tuple[str, ...] = tuple(BUILDERS),
+    mtlx_path: Path | None = None,
+    package: bool = False,
+    split_dir: Path | None = None,
+) -> ExportResult:
+    """Export ``sources`` to ``out`` (``.usda``/``.usdc``/``.usd``, or ``.usdz`` to package).
+
+    ``split_dir``: one file per material there, ``out`` a library referencing them.
+    ``mtlx_path``: also a standalone MaterialX document. Nothing is left behind on error.
+    """
+    out = Path(out)
+    package = package or out.suffix == ".usdz"
+    if package and split_dir is not None:
+        raise ExportError("--package and --split exclude each other", where=str(out))
+    if out.suffix not in (*USD_SUFFIXES, ".usdz"):
+        raise ExportError("not a USD file name; use .usda, .usdc, .usd or .usdz", where=str(out))
+    out = out.with_suffix(".usdz") if package else out
+    for path in (out, mtlx_path, split_dir and split_dir / "x.usda"):
+        if path is not None:
+            check_writable(Path(path))
+    specs = [material_spec(s, contexts) for s in sources]
+    _check_names(specs, out)
+    images = images_of(specs)
+    check_images(images)
+    staging = Staging()
+    try:
+        files = _write_all(specs, images, out, mtlx_path, package, split_dir, staging)
+        staging.commit()
+    except BaseException:
+        staging.abort()
+        raise
+    return ExportResult(files, [s.name for s in specs], [i.path for i in images])
+
+
+def _check_names(specs: list[MaterialSpec], out: Path) -> None:
+    seen: dict[str, str] = {}
+    for spec in specs:
+        key = prim_name(spec.name)
+        if key in seen:
+            raise ExportError(
+                f"materials {seen[key]!r} and {spec.name!r} both become prim {key!r}",
+                where=str(out),
+            )
+        seen[key] = spec.name
+    if not specs:
+        raise ExportError("no materials to export", where=str(out))
+
+
+def _write_all(specs, images, out, mtlx_path, package, split_dir, staging) -> list[Path]:
+    for image in images:
+        if image.write:
+            target = image.path if package else staging.temp_for(image.path)
+            write_image(target, image.pixels)
+    files = [out, *(i.path for i in images if i.write and not package)]
+    if split_dir is not None:
+        files += _write_split(specs, out, Path(split_dir), staging)
+    else:
+        layer = new_layer()
+        paths = author(layer, specs, out.parent)
+        if len(specs) > 1:
+            add_switch(
+                layer, {prim_name(s.name): ("", p) for s, p in zip(specs, paths, strict=True)}
+            )
+        if package:
+            _package(layer, out, staging)
+        else:
+            _export_layer(layer, staging.temp_for(out))
+    if mtlx_path is not None:
+        mtlx.write_document(specs, staging.temp_for(Path(mtlx_path)), where=mtlx_path)
+        files.append(Path(mtlx_path))
+    return files
+
+
+def _write_split(specs, out: Path, folder: Path, staging: Staging) -> list[Path]:
+    from pxr import Sdf
+
+    files, targets = [], {}
+    library = new_layer()
+    scope = Sdf.CreatePrimInLayer(library, "/Materials")
+    scope.specifier, scope.typeName = Sdf.SpecifierDef, "Scope"
+    for spec in specs:
+        name = prim_name(spec.name)
+        path = folder / f"{name}.usda"
+        layer = new_layer()
+        (prim_path,) = author(layer, [spec], folder)
+        _export_layer(layer, staging.temp_for(path))
+        asset = relative_asset(path, out.parent)
+        ref = Sdf.PrimSpec(scope, name, Sdf.SpecifierDef, "Material")
+        ref.referenceList.prependedItems.append(Sdf.Reference(asset, Sdf.Path(prim_path)))
+        targets[name] = (asset, prim_path)
+        files.append(path)
+    add_switch(library, targets)
+    _export_layer(library, staging.temp_for(out))
+    return files
+
+
+def _export_layer(layer, path: Path) -> None:
+    if not layer.Export(str(path)):
+        raise ExportError("USD could not write the layer", where=str(path))
+
+
+def _package(layer, out: Path, staging: Staging) -> None:
+    """A ``.usdz`` holding the layer and every texture it references."""
+    from pxr import UsdUtils
+
+    fd, name = tempfile.mkstemp(prefix=f".{out.stem}.", suffix=".usdc", dir=out.parent)
+    os.close(fd)
+    root = Path(name)
+    try:
+        _export_layer(layer, root)
+        if not UsdUtils.CreateNewUsdzPackage(str(root), str(staging.temp_for(out))):
+            raise ExportError("USD could not write the package", where=str(out))
+    finally:
+        root.unlink(missing_ok=True)
