@@ -27,7 +27,7 @@ import tomli_w
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from lookdev.materials.errors import ParameterError
-from lookdev.materials.layers import LayerSpec
+from lookdev.materials.layers import ConstantMask, LayerSpec
 from lookdev.materials.params import DisneyParams, Params
 
 from .errors import PresetError
@@ -210,8 +210,32 @@ def dump_preset(preset: PresetFile) -> str:
     """
     data = preset.model_dump(mode="json", exclude_none=True, exclude_defaults=True)
     data["name"] = preset.name
+    if preset.layers:
+        data["layers"] = [_layer_doc(layer) for layer in preset.layers]
     ordered = {k: data[k] for k in PresetFile.model_fields if k in data}
     return _compact_arrays(tomli_w.dumps(ordered))
+
+
+def _layer_doc(layer: LayerSpec) -> dict[str, Any]:
+    maps = ("mask", "normal_map", "specular_normal_map")
+    doc = layer.model_dump(mode="json", exclude_none=True, exclude_defaults=True, exclude=set(maps))
+    for key in maps:
+        value = getattr(layer, key)
+        if value is not None and value != ConstantMask():
+            doc[key] = _mask_doc(value)
+    return doc
+
+
+def _mask_doc(mask: Any) -> dict[str, Any]:
+    """A mask tree as TOML data; ``kind`` always written, since it selects the type."""
+    nested = ("input", "inputs")
+    doc = {"kind": mask.kind}
+    doc |= mask.model_dump(mode="json", exclude_defaults=True, exclude={"kind", *nested})
+    if "inputs" in type(mask).model_fields:
+        doc["inputs"] = [_mask_doc(m) for m in mask.inputs]
+    elif "input" in type(mask).model_fields:
+        doc["input"] = _mask_doc(mask.input)
+    return doc
 
 
 _SCALAR_ARRAY = re.compile(r"\[\n((?:[ ]+[^\[\]{}\n]+,\n)+)[ ]*\]")
