@@ -1,0 +1,516 @@
+"""The Disney BSDF: Burley 2012 (+ 2014 addenda) and its 2015 BSDF extension (Schutte seed).
+
+One implementation over the array shim (:mod:`.arrays`), published as :data:`MODEL`
+(the :mod:`.bsdf` contract) and as the numpy functions :func:`eval`, :func:`pdf` and
+:func:`sample`. Lobes, with w_d = (1 − metallic)(1 − spec_trans) and
+w_g = (1 − metallic)·spec_trans:
+
+``diffuse``     w_d (1 − diff_trans) · base/π · [Burley §5.3 with retro-reflection, split as
+                Schutte's f_lambert(1 − F_L/2)(1 − F_V/2) + f_retro; ``flatness`` (thin only)
+                blends f_lambert towards Hanrahan-Krueger; ``subsurface`` (2012) blends the
+                whole shape towards it as the BRDF Explorer does]
+``diff_trans``  w_d · diff_trans · T/π, Lambertian through the surface (T = base, or √base thin)
+``sheen``       w_d · sheen · mix(1, tint, sheen_tint) · (1 − cos θd)⁵ (2014 addendum), or the
+                Conty-Kulla lobe of :mod:`.sheen` with ``sheen_model = "conty_kulla"``
+``specular``    F · D · G / (4 cos θl cos θv), anisotropic GGX (App. B eq. 13) with the
+                un-remapped anisotropic Smith G (2014 addendum); F blends metal, dielectric
+                and the glass's reflection (see :func:`_fresnel_terms`)
+``clearcoat``   0.25 · clearcoat · D_GTR1 · F(0.04) · G(α = 0.25) / (4 cos θl cos θv)
+``spec_trans``  w_g · T · Walter et al. 2007 rough dielectric BTDF (solid), or the
+                mirrored-reflection thin sheet with Burley 2015's roughness scale (thin)
+
+Sources disagree in places; the choices (each said once in the code): the tint's luminance
+is (0.3, 0.6, 0.1) (Burley; Schutte's 1.0 is a typo), the clearcoat keeps its
+1/(4 cos cos) (Burley; Schutte and Mitsuba drop it), HK's F_ss90 uses roughness, not
+roughness² (BRDF Explorer; Schutte squares it). Transmission uses the radiance-mode
+1/η² (pbrt-v4, Mitsuba; Schutte omits it for his VCM).
+
+Thin surfaces look the same from both sides; a solid one shows only its glass from inside.
+Sampling picks a lobe with probability proportional to its estimated albedo; a lobe whose
+weight is a known zero is neither evaluated nor sampled.
+
+>>> import numpy as np
+>>> from .params import DisneyParams
+>>> wi = wo = np.array([0.0, 0.0, 1.0])
+>>> f = eval(DisneyParams(base_color=(1, 1, 1), specular=0, roughness=1), wi, wo)
+>>> bool(np.all(f > 0))
+True
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+from typing import Any
+
+from . import fresnel as fr
+from . import microfacet as mf
+from .bsdf import Model, density, draw, evaluate
+from .params import SPECULAR_F0_SCALE, DisneyParams
+
+INV_PI = 1.0 / math.pi
+LUMINANCE = (0.3, 0.6, 0.1)  # Burley's tint weights (Schutte's (0.3, 0.6, 1.0) is a typo)
+CLEARCOAT_F0 = 0.04  # IOR 1.5 polyurethane (Burley §5.4)
+SCHLICK_MEAN = 1.0 / 21.0  # ∫ (1 − μ)⁵ 2μ dμ: hemispherical mean of the Schlick weight
+SHEEN_ALBEDO_GUESS = 0.1  # rough albedo of sheen 1, only used to weight sampling
+ETA_MIN = 1.001  # as Mitsuba: at η = 1 the rough BTDF becomes a delta
+LOBES = ("diffuse", "diff_trans", "sheen", "specular", "clearcoat", "spec_trans")
+
+
+# -- parameters --------------------------------------------------------------------------
+def luminance(c: Any) -> Any:
+    return LUMINANCE[0] * c[0] + LUMINANCE[1] * c[1] + LUMINANCE[2] * c[2]
+
+
+def tint_color(xp: Any, base: Any) -> Any:
+    """Base colour over its luminance (hue and saturation only); white for black."""
+    lum = luminance(base)
+    if isinstance(lum, float):
+        return base / lum if lum > 0 else xp.color((1.0, 1.0, 1.0))
+    return xp.select(lum > 0.0, base / xp.select(lum > 0.0, lum, 1.0), 1.0)
+
+
+def _mix(a: Any, b: Any, t: Any) -> Any:
+    return a + (b - a) * t
+
+
+def _eta(xp: Any, params: DisneyParams, maps: dict[str, Any]) -> Any:
+    """Relative IOR: ``ior`` or the IOR whose F0 is 0.08·specular (Burley §5.4)."""
+    if "ior" in maps:
+        return xp.scalar(maps["ior"])
+    if "specular" in maps and not params.uses_ior:
+        r = xp.sqrt(xp.minimum(SPECULAR_F0_SCALE * xp.scalar(maps["specular"]), 0.999999))
+        return (1.0 + r) / (1.0 - r)
+    return params.effective_ior
+
+
+def _fresnel_terms(xp, p, base, tint, w_d, w_g, eta) -> tuple[Any, Any, Any]:
+    """(A, B, c) with F_front(θd) = A + (B − A)(1 − cos θd)⁵ + c · F_dielectric(θd, η).
+
+    Schlick is linear in F0, so the metal, the tinted dielectric and the glass reflection
+    collapse into one colour A, one scalar B and one exact-Fresnel weight c:
+
+    * ``specular`` given: the BRDF Explorer's Schlick with F0 = mix(0.08·specular·
+      mix(1, tint, specular_tint), base, metallic) on the BRDF part (weight 1 − w_g);
+    * ``ior`` given: the 2015 dielectric Fresnel, tinted like Mitsuba's ``principled``
+      (Schutte's DisneyFresnel drops specular_tint unless metallic > 0);
+    * the glass part w_g always reflects the exact dielectric Fresnel.
+    """
+    metallic, spec_tint = p["metallic"], p["specular_tint"]
+    tinted = _mix(1.0, tint, spec_tint)
+    if p["uses_ior"]:
+        a = metallic * base + w_d * spec_tint * fr.schlick_f0(eta) * tint
+        b = metallic + w_d * spec_tint
+        return a, b, w_d * (1.0 - spec_tint) + w_g
+    a = metallic * base + w_d * (SPECULAR_F0_SCALE * p["specular"]) * tinted
+    return a, metallic + w_d, w_g
+
+
+def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
+    """Derived colours, α, lobe weights, which lobes exist, and their sampling odds."""
+    names = (
+        "subsurface metallic specular specular_tint roughness anisotropic sheen sheen_tint "
+        "sheen_roughness clearcoat clearcoat_gloss spec_trans diff_trans flatness"
+    ).split()
+    p = {n: xp.scalar(maps.get(n, getattr(params, n))) for n in names}
+    p["uses_ior"] = params.uses_ior
+    thin = params.thin
+    base = xp.color(maps.get("base_color", params.base_color))
+    tint = tint_color(xp, base)
+    eta = xp.maximum(_eta(xp, params, maps), ETA_MIN)
+    w_d = (1.0 - p["metallic"]) * (1.0 - p["spec_trans"])
+    w_g = (1.0 - p["metallic"]) * p["spec_trans"]
+    a, b, c = _fresnel_terms(xp, p, base, tint, w_d, w_g, eta)
+    trans_color = xp.sqrt(base) if thin else base
+    ax, ay = mf.anisotropic_alphas(xp, p["roughness"], p["anisotropic"])
+    pr = {
+        "thin": thin,
+        "base": base,
+        "roughness": p["roughness"],
+        "ax": ax,
+        "ay": ay,
+        "eta": eta,
+        "spec_a": a,
+        "spec_b": b,
+        "spec_c": c,
+        "glass": w_g,
+        "diffuse": w_d * (1.0 - p["diff_trans"]),
+        "diff_trans": w_d * p["diff_trans"],
+        "trans_color": trans_color,
+        "sheen": w_d * p["sheen"],
+        "sheen_color": _mix(1.0, tint, p["sheen_tint"]),
+        "sheen_model": params.sheen_model,
+        "sheen_r": p["sheen_roughness"],
+        "clearcoat": 0.25 * p["clearcoat"],
+        "clearcoat_a2": _sq(_mix(0.1, 0.001, p["clearcoat_gloss"])),  # Burley §5.4 / App. B
+        "subsurface": p["subsurface"],
+        "flatness": p["flatness"] if thin else 0.0,
+    }
+    if thin:
+        # Burley 2015 Fig. 15 via Schutte: a thin sheet's transmission looks rougher.
+        r_t = xp.clip((0.65 * eta - 0.35) * p["roughness"], 0.0, 1.0)
+        pr["tax"], pr["tay"] = mf.anisotropic_alphas(xp, r_t, p["anisotropic"])
+    else:
+        pr["tax"], pr["tay"] = ax, ay
+    weights = {
+        "diffuse": pr["diffuse"],
+        "diff_trans": pr["diff_trans"],
+        "sheen": pr["sheen"],
+        "specular": 1.0,
+        "clearcoat": pr["clearcoat"],
+        "spec_trans": w_g,
+    }
+    pr["lobes"] = tuple(k for k in LOBES if not xp.known_zero(weights[k]))
+    pr["odds"], pr["odds_inside"] = _lobe_odds(xp, pr)
+    return pr
+
+
+def _sq(x: Any) -> Any:
+    return x * x
+
+
+def _lobe_odds(xp: Any, pr: dict[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
+    """Selection probabilities ∝ estimated albedo, for a viewer outside and (solid) inside.
+
+    Estimates: diffuse ρ·lum(base), Schlick lobes F0 + (1 − F0)/21, glass 1 − F0 split
+    by 1/η² inside. Sheen is sampled like the diffuse, by the cosine.
+    """
+    f0 = fr.schlick_f0(pr["eta"])
+    lum_a = luminance(pr["spec_a"])
+    lum_t = luminance(pr["trans_color"])
+    est = {
+        "diffuse": pr["diffuse"] * luminance(pr["base"]),
+        "sheen": pr["sheen"] * luminance(pr["sheen_color"]) * SHEEN_ALBEDO_GUESS,
+        "diff_trans": pr["diff_trans"] * lum_t,
+        "specular": lum_a
+        + (pr["spec_b"] - lum_a) * SCHLICK_MEAN
+        + pr["spec_c"] * (f0 + (1.0 - f0) * SCHLICK_MEAN),
+        "clearcoat": pr["clearcoat"] * (CLEARCOAT_F0 + (1.0 - CLEARCOAT_F0) * SCHLICK_MEAN),
+        "spec_trans": pr["glass"] * lum_t * (1.0 - f0),
+    }
+    inside = {k: 0.0 for k in est}
+    if not pr["thin"]:
+        escape = (1.0 - f0) / (pr["eta"] * pr["eta"])
+        inside.update(
+            diff_trans=est["diff_trans"],
+            specular=pr["glass"] * (1.0 - escape),
+            spec_trans=pr["glass"] * lum_t * escape,
+        )
+    return _normalise(xp, est, pr["lobes"]), _normalise(xp, inside, pr["lobes"])
+
+
+def _normalise(xp: Any, est: dict[str, Any], lobes: tuple[str, ...]) -> dict[str, Any]:
+    keep = [k for k in lobes if k in est]
+    total = sum(est[k] for k in keep)
+    if isinstance(total, float):
+        return {k: (est[k] / total if total > 0 else 0.0) for k in keep}
+    safe = xp.select(total > 0.0, total, 1.0)
+    return {k: est[k] / safe for k in keep}
+
+
+# -- the frame: thin sheets are two-sided, a solid is seen from inside only through glass --
+def _orient(xp: Any, wi: Any, wo: Any) -> tuple[Any, Any, Any]:
+    """(wi, wo) mirrored so that wo is in the upper hemisphere, and the mirror sign."""
+    s = xp.select(wo[2] < 0.0, -1.0, 1.0)
+    return xp.vec3(wi[0], wi[1], wi[2] * s), xp.vec3(wo[0], wo[1], wo[2] * s), s
+
+
+def _front(pr: dict[str, Any], s: Any) -> Any:
+    """Where the outside's lobes exist: everywhere on a thin sheet, else where wo.z > 0."""
+    return True if pr["thin"] else s > 0.0
+
+
+def _pick(xp: Any, front: Any, outside: Any, inside: Any) -> Any:
+    return outside if front is True else xp.select(front, outside, inside)
+
+
+# -- lobes, in the oriented frame (wo.z ≥ 0) -------------------------------------------------
+def _diffuse_shape(xp: Any, pr: dict[str, Any], ci: Any, co: Any, cos2_d: Any) -> Any:
+    """Burley §5.3 diffuse (without base/π), retro-reflection, flatness and subsurface."""
+    fl, fv = fr.schlick_weight(xp, ci), fr.schlick_weight(xp, co)
+    rr = 2.0 * pr["roughness"] * cos2_d
+    retro = rr * (fl + fv + fl * fv * (rr - 1.0))  # Schutte's split of (1 + (F_D90 − 1)F)²
+    lambert = (1.0 - 0.5 * fl) * (1.0 - 0.5 * fv)
+    flat, sss = pr["flatness"], pr["subsurface"]
+    if xp.known_zero(flat) and xp.known_zero(sss):
+        return retro + lambert
+    # Hanrahan-Krueger; F_ss90 = cos²θd·roughness as the BRDF Explorer (Schutte: roughness²).
+    fss90 = cos2_d * pr["roughness"]
+    fss = _mix(1.0, fss90, fl) * _mix(1.0, fss90, fv)
+    hk = 1.25 * (fss * (1.0 / xp.maximum(ci + co, xp.tiny) - 0.5) + 0.5)
+    shape = retro + lambert * _mix(1.0, hk, flat)  # 2015 flatness (Schutte)
+    return _mix(shape, hk, sss)  # 2012 subsurface (BRDF Explorer)
+
+
+def _sheen(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, cos2_d: Any) -> Any:
+    color = pr["sheen"] * pr["sheen_color"]
+    if pr["sheen_model"] == "conty_kulla":
+        ck = _conty_kulla()
+        return color * ck.lobe(xp, wi, wo, pr["sheen_r"], True)
+    return color * fr.schlick_weight(xp, xp.sqrt(cos2_d))  # 2014 addendum
+
+
+def _conty_kulla() -> Any:
+    return importlib.import_module(".sheen", __package__)
+
+
+def _base_scale(xp: Any, pr: dict[str, Any], ci: Any, co: Any) -> Any:
+    """Conty-Kulla §5 albedo scaling of what lies under their sheen (1 elsewhere)."""
+    if "sheen" not in pr["lobes"] or pr["sheen_model"] != "conty_kulla":
+        return 1.0
+    color = pr["sheen"] * pr["sheen_color"]
+    return xp.maximum(_conty_kulla().base_scale(xp, ci, co, pr["sheen_r"], color), 0.0)
+
+
+def _specular(xp, pr, wi, wo, h, front) -> Any:
+    """F·D·G/(4 cos θl cos θv) with G1/cos kept together (finite at grazing)."""
+    cos_d = xp.dot(wi, h)
+    w = fr.schlick_weight(xp, cos_d)
+    a, b, c = pr["spec_a"], pr["spec_b"], pr["spec_c"]
+    eta_side = _pick(xp, front, pr["eta"], 1.0 / pr["eta"])
+    f_exact = 0.0 if xp.known_zero(c) else fr.dielectric(xp, cos_d, eta_side)
+    color = _pick(xp, front, a + (b - a) * w + c * f_exact, pr["glass"] * f_exact)
+    ax, ay = pr["ax"], pr["ay"]
+    dg = mf.ggx_d(xp, h, ax, ay) * _g1_over_cos(xp, wi, ax, ay) * _g1_over_cos(xp, wo, ax, ay)
+    return color * (0.25 * dg)
+
+
+def _g1_over_cos(xp: Any, w: Any, ax: Any, ay: Any) -> Any:
+    """G1(w)/|cos θ| = 2/(|z| + √(z² + αx²x² + αy²y²)) (Heitz 2014 eq. 86, divided)."""
+    z = xp.abs(w[2])
+    q = (ax * w[0]) * (ax * w[0]) + (ay * w[1]) * (ay * w[1])
+    return 2.0 / xp.maximum(z + xp.sqrt(z * z + q), xp.tiny)
+
+
+def _clearcoat_d(xp: Any, pr: dict[str, Any], h: Any) -> Any:
+    return mf.gtr_d(xp, 1.0, pr["clearcoat_a2"], h[2] * h[2], h[0] * h[0] + h[1] * h[1])
+
+
+def _clearcoat(xp, pr, wi, wo, h) -> Any:
+    """Burley's clearcoat, with the 1/(4 cos cos) that Schutte and Mitsuba leave out."""
+    f = fr.schlick(xp, CLEARCOAT_F0, xp.dot(wi, h))
+    g = _g1_over_cos(xp, wi, mf.CLEARCOAT_G_ALPHA, mf.CLEARCOAT_G_ALPHA) * _g1_over_cos(
+        xp, wo, mf.CLEARCOAT_G_ALPHA, mf.CLEARCOAT_G_ALPHA
+    )
+    return pr["clearcoat"] * f * _clearcoat_d(xp, pr, h) * g * 0.25
+
+
+def _transmission_half(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, etap: Any) -> Any:
+    """Walter 2007's generalised half vector wi·η' + wo, turned to the upper side."""
+    h = xp.normalize(wi * etap + wo)
+    return h * xp.select(h[2] < 0.0, -1.0, 1.0)
+
+
+def _solid_transmission(xp, pr, wi, wo, etap) -> tuple[Any, Any]:
+    """(f, pdf) of the rough dielectric BTDF (pbrt-v4 DielectricBxDF, radiance mode)."""
+    h = _transmission_half(xp, pr, wi, wo, etap)
+    ih, oh = xp.dot(wi, h), xp.dot(wo, h)
+    ok = (ih < 0.0) & (oh > 0.0)
+    denom = ih + oh / etap
+    denom2 = xp.maximum(denom * denom, xp.tiny)
+    ax, ay = pr["tax"], pr["tay"]
+    d = mf.ggx_d(xp, h, ax, ay)
+    jac = xp.abs(ih) / denom2
+    f = (
+        (1.0 - fr.dielectric(xp, oh, etap))
+        * d
+        * _g1_over_cos(xp, wi, ax, ay)
+        * _g1_over_cos(xp, wo, ax, ay)
+        * xp.abs(ih * oh)
+        / (denom2 * etap * etap)
+    )
+    pdf = mf.visible_ggx_pdf(xp, wo, h, ax, ay) * jac
+    return xp.select(ok, f, 0.0), xp.select(ok, pdf, 0.0)
+
+
+def _thin_transmission(xp, pr, wi, wo) -> tuple[Any, Any]:
+    """(f, pdf): reflection about the rougher thin α, mirrored through the sheet (Schutte)."""
+    wm = xp.vec3(wi[0], wi[1], -wi[2])
+    h = xp.normalize(wm + wo)
+    ax, ay = pr["tax"], pr["tay"]
+    d = mf.ggx_d(xp, h, ax, ay)
+    f = (
+        (1.0 - fr.dielectric(xp, xp.dot(wo, h), pr["eta"]))
+        * d
+        * _g1_over_cos(xp, wm, ax, ay)
+        * _g1_over_cos(xp, wo, ax, ay)
+        * 0.25
+    )
+    pdf = mf.visible_ggx_pdf(xp, wo, h, ax, ay) / xp.maximum(4.0 * xp.dot(wo, h), xp.tiny)
+    return f, pdf
+
+
+# -- the model's four core functions -------------------------------------------------------
+def _add(total: Any, term: Any) -> Any:
+    return term if total is None else total + term
+
+
+def _eval_oriented(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> Any:
+    lobes = pr["lobes"]
+    ci, co = wi[2], wo[2]
+    up = (ci > 0.0) & (co > 0.0)
+    down = (ci < 0.0) & (co > 0.0)
+    h = xp.normalize(wi + wo)
+    cos2_d = xp.maximum(0.5 * (1.0 + xp.dot(wi, wo)), 0.0)  # cos²θd = (1 + wi·wo)/2
+    scale = _base_scale(xp, pr, ci, co)
+    outside = None
+    if "diffuse" in lobes:
+        shape = _diffuse_shape(xp, pr, ci, co, cos2_d)
+        outside = (pr["diffuse"] * INV_PI) * pr["base"] * (shape * scale)
+    if "sheen" in lobes:
+        outside = _add(outside, _sheen(xp, pr, wi, wo, cos2_d))
+    if "clearcoat" in lobes:
+        outside = _add(outside, _clearcoat(xp, pr, wi, wo, h))
+    f = _specular(xp, pr, wi, wo, h, front) * scale if "specular" in lobes else None
+    if outside is not None:
+        f = _add(f, _pick(xp, front, outside, 0.0))
+    f = xp.select(up, f, 0.0) if f is not None else xp.zeros(ci) * pr["base"]
+    if "diff_trans" in lobes:
+        f = f + xp.select(down, (pr["diff_trans"] * INV_PI) * pr["trans_color"], 0.0)
+    if "spec_trans" in lobes:
+        ft, _ = _transmission(xp, pr, wi, wo, front)
+        f = f + xp.select(down, (pr["glass"] * ft) * pr["trans_color"], 0.0)
+    return f
+
+
+def _transmission(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> tuple[Any, Any]:
+    if pr["thin"]:
+        return _thin_transmission(xp, pr, wi, wo)
+    return _solid_transmission(xp, pr, wi, wo, _pick(xp, front, pr["eta"], 1.0 / pr["eta"]))
+
+
+def _odds(xp: Any, pr: dict[str, Any], front: Any) -> dict[str, Any]:
+    return {k: _pick(xp, front, v, pr["odds_inside"][k]) for k, v in pr["odds"].items()}
+
+
+def _pdf_oriented(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> Any:
+    odds = _odds(xp, pr, front)
+    ci, co = wi[2], wo[2]
+    up = (ci > 0.0) & (co > 0.0)
+    down = (ci < 0.0) & (co > 0.0)
+    h = xp.normalize(wi + wo)
+    oh4 = xp.maximum(4.0 * xp.dot(wo, h), xp.tiny)
+    p_up = 0.0
+    if "specular" in odds:
+        p_up = odds["specular"] * mf.visible_ggx_pdf(xp, wo, h, pr["ax"], pr["ay"]) / oh4
+    cosine = odds.get("diffuse", 0.0) + odds.get("sheen", 0.0)
+    if "diffuse" in odds or "sheen" in odds:
+        p_up = p_up + cosine * ci * INV_PI
+    if "clearcoat" in odds:
+        p_up = p_up + odds["clearcoat"] * _clearcoat_d(xp, pr, h) * h[2] / oh4
+    p = xp.select(up, p_up, 0.0)
+    if "diff_trans" in odds:
+        p = p + xp.select(down, odds["diff_trans"] * -ci * INV_PI, 0.0)
+    if "spec_trans" in odds:
+        _, pt = _transmission(xp, pr, wi, wo, front)
+        p = p + xp.select(down, odds["spec_trans"] * pt, 0.0)
+    return p
+
+
+def eval_core(xp: Any, pr: dict[str, Any], wi: Any, wo: Any) -> Any:
+    """f(wi, wo) without the cosine (the :class:`~.bsdf.Model` contract)."""
+    wi_, wo_, s = _orient(xp, wi, wo)
+    return _eval_oriented(xp, pr, wi_, wo_, _front(pr, s))
+
+
+def pdf_core(xp: Any, pr: dict[str, Any], wi: Any, wo: Any) -> Any:
+    """Solid-angle density of :func:`sample_core` producing wi: the lobe mixture."""
+    wi_, wo_, s = _orient(xp, wi, wo)
+    return _pdf_oriented(xp, pr, wi_, wo_, _front(pr, s))
+
+
+def _candidates(xp: Any, pr: dict[str, Any], wo: Any, u1: Any, u2: Any, front: Any) -> dict:
+    """One direction per present lobe from (u1, u2), and whether it is a valid output."""
+    lobes = pr["lobes"]
+    out = {}
+    if {"diffuse", "sheen", "diff_trans"} & set(lobes):
+        r, phi = xp.sqrt(u1), 2.0 * math.pi * u2  # Malley's method
+        x, y, z = r * xp.cos(phi), r * xp.sin(phi), xp.safe_sqrt(1.0 - u1)
+        out["diffuse"] = out["sheen"] = (xp.vec3(x, y, z), z > 0.0)
+        out["diff_trans"] = (xp.vec3(x, y, -z), z > 0.0)
+    if "specular" in lobes:
+        wi = mf.reflect(xp, wo, mf.sample_visible_ggx(xp, wo, pr["ax"], pr["ay"], u1, u2))
+        out["specular"] = (wi, wi[2] > 0.0)
+    if "clearcoat" in lobes:
+        wi = mf.reflect(xp, wo, mf.sample_gtr(xp, 1.0, pr["clearcoat_a2"], u1, u2))
+        out["clearcoat"] = (wi, wi[2] > 0.0)
+    if "spec_trans" in lobes:
+        h = mf.sample_visible_ggx(xp, wo, pr["tax"], pr["tay"], u1, u2)
+        if pr["thin"]:
+            wi = mf.reflect(xp, wo, h)
+            out["spec_trans"] = (xp.vec3(wi[0], wi[1], -wi[2]), wi[2] > 0.0)
+        else:
+            etap = _pick(xp, front, pr["eta"], 1.0 / pr["eta"])
+            wi, ok = mf.refract(xp, wo, h, etap)
+            out["spec_trans"] = (wi, ok & (wi[2] < 0.0))
+    return out
+
+
+def sample_core(xp: Any, pr: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any, Any]:
+    """(wi, f·|cos θi|/pdf, pdf): u[0] picks a lobe by its odds, u[1], u[2] its direction."""
+    _, wo_, s = _orient(xp, wo, wo)
+    front = _front(pr, s)
+    odds = _odds(xp, pr, front)
+    cands = _candidates(xp, pr, wo_, u[1], u[2], front)
+    order = [k for k in LOBES if k in odds]
+    if not order:  # nothing to sample (an opaque solid seen from inside)
+        zero = xp.zeros(wo_[2])
+        return xp.vec3(zero, zero, zero), zero * pr["base"], zero
+    wi, valid = cands[order[-1]]
+    cum = 0.0
+    chosen = []
+    for k in order[:-1]:
+        cum = cum + odds[k]
+        chosen.append((u[0] < cum, k))
+    for cond, k in reversed(chosen):
+        wi = xp.select(cond, cands[k][0], wi)
+        valid = xp.select(cond, cands[k][1], valid)
+    valid = valid & (wo_[2] > 0.0)
+    pdf = xp.select(valid, _pdf_oriented(xp, pr, wi, wo_, front), 0.0)
+    f = _eval_oriented(xp, pr, wi, wo_, front)
+    ok = pdf > 0.0
+    weight = xp.select(ok, f * (xp.abs(wi[2]) / xp.select(ok, pdf, 1.0)), 0.0)
+    return xp.vec3(wi[0], wi[1], wi[2] * s), weight, pdf
+
+
+MODEL = Model("disney", DisneyParams, prepare, eval_core, pdf_core, sample_core)
+
+
+def lobe_model(*names: str) -> Model:
+    """The Disney model restricted to some lobes (their odds renormalised), for tests and
+    per-lobe analysis. ``lobe_model("clearcoat")`` evaluates and samples only the clearcoat.
+    """
+    unknown = set(names) - set(LOBES)
+    if unknown:
+        raise ValueError(f"unknown lobe(s) {sorted(unknown)}; known: {', '.join(LOBES)}")
+
+    def prepare_only(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
+        pr = prepare(xp, params, **maps)
+        pr["lobes"] = tuple(k for k in pr["lobes"] if k in names)
+        pr["odds"], pr["odds_inside"] = _lobe_odds(xp, pr)
+        return pr
+
+    return Model(
+        "disney[" + ",".join(names) + "]",
+        DisneyParams,
+        prepare_only,
+        eval_core,
+        pdf_core,
+        sample_core,
+    )
+
+
+# -- public numpy API --------------------------------------------------------------------
+def eval(params: DisneyParams, wi: Any, wo: Any, **kw: Any) -> Any:  # noqa: A001
+    """f(wi, wo) without the cosine, shape (..., 3); wi towards the light, wo the viewer."""
+    return evaluate(MODEL, params, wi, wo, **kw)
+
+
+def pdf(params: DisneyParams, wi: Any, wo: Any, **kw: Any) -> Any:
+    """Solid-angle density with which :func:`sample` produces wi given wo, shape (...)."""
+    return density(MODEL, params, wi, wo, **kw)
+
+
+def sample(params: DisneyParams, wo: Any, u: Any, **kw: Any) -> tuple[Any, Any, Any]:
+    """(wi, weight = f·|cos θi|/pdf, pdf) from uniforms u of shape (..., 3)."""
+    return draw(MODEL, params, wo, u, **kw)

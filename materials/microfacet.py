@@ -1,0 +1,185 @@
+"""Microfacet building blocks: GTR distributions, anisotropic Smith masking, sampling.
+
+Written once over the array shim (:mod:`.arrays`); directions are channel-first vectors in
+the shading frame (normal +z, tangent +x). References:
+
+* Burley 2012, Appendix B: the Generalized-Trowbridge-Reitz distribution (eqs. 1–9) and
+  its anisotropic γ = 2 form (eqs. 10–15); the 2014 addendum's α_x, α_y.
+* Heitz 2014, "Understanding the Masking-Shadowing Function …", eq. 86 (anisotropic
+  GGX Λ), as the 2014 addendum adopts it.
+* Heitz 2018, "Sampling the GGX Distribution of Visible Normals" (JCGT 7(4)), listing 1.
+
+**Minimum α.** ``ALPHA_MIN`` = 10⁻³, the value of the Disney BRDF Explorer (and
+Schutte's and Mitsuba's ``principled``): roughness 0 gives this α, not a delta. At it the
+GGX peak D(n) = 1/(π α²) ≈ 3·10⁵ is still finite in float32, and ``sample``, ``pdf`` and
+``eval`` all see the same α, so they agree at roughness 0 exactly.
+
+**Stability of the GTR normalisation** (eq. 1) at γ → 1 and α → 1: with L = log α² and
+t = (1 − γ) L the constant is
+
+    c = (γ − 1)(α² − 1) / (π (1 − (α²)^(1−γ)))  =  exprel(L) / (π exprel(t)),
+
+where exprel(x) = (eˣ − 1)/x → 1 as x → 0 is computed with ``expm1`` and a first-order
+series within 10⁻⁶ of 0: eq. 4 (γ = 1) and 1/π (α = 1) are its limits, and there is no
+0/0 anywhere near them.
+
+>>> import numpy as np
+>>> from .arrays import NumpyOps
+>>> xp = NumpyOps()
+>>> round(float(gtr_norm(xp, 2.0, 0.25)), 6) == round(0.25 / np.pi, 6)   # eq. 8
+True
+>>> round(float(gtr_norm(xp, 1.0, 1.0) * np.pi), 12)                      # α = 1
+1.0
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+ALPHA_MIN = 1e-3
+CLEARCOAT_G_ALPHA = 0.25  # Burley 2012 §5.6: the clearcoat's fixed GGX G roughness
+_SERIES = 1e-6  # |x| below which exprel and the sampling ratio use their series
+
+
+# -- GTR, any γ > 0 (Burley App. B.2) --------------------------------------------------------
+def exprel(xp: Any, x: Any) -> Any:
+    """(eˣ − 1)/x, exact to rounding everywhere including x = 0 (limit 1)."""
+    small = xp.abs(x) < _SERIES
+    safe = xp.select(small, 1.0, x)
+    return xp.select(small, 1.0 + 0.5 * x, xp.expm1(safe) / safe)
+
+
+def gtr_norm(xp: Any, gamma: float, a2: Any) -> Any:
+    """The constant c of eq. 1 (eq. 4 at γ = 1, 1/π at α = 1), as exprel(L)/(π exprel(t))."""
+    log_a2 = xp.log(a2)
+    return exprel(xp, log_a2) / (math.pi * exprel(xp, (1.0 - gamma) * log_a2))
+
+
+def gtr_d(xp: Any, gamma: float, a2: Any, cos2_h: Any, sin2_h: Any) -> Any:
+    """D_GTR(θh) of eq. 1 from cos²θh and sin²θh (α² cos² + sin² = 1 + (α² − 1) cos²).
+
+    Taking sin²θh separately (from the half vector's x, y) keeps the peak accurate: at
+    α = 10⁻³ the denominator is 10⁻⁶ and 1 − cos² would lose it in float32.
+    """
+    base = a2 * cos2_h + sin2_h
+    return gtr_norm(xp, gamma, a2) * xp.exp(-gamma * xp.log(base))
+
+
+def gtr_sample_cos2(xp: Any, gamma: float, a2: Any, xi: Any) -> Any:
+    """cos²θh from a uniform ξ (eq. 3; eq. 5 at γ = 1, eq. 9 at γ = 2), stably.
+
+    With u = 1 − ξ, eq. 3's bracket is 1 + u·expm1(t) and its power 1/(1 − γ) = L/t, so
+    cos²θh = r·exprel(L r)/exprel(L) with r = log1p(u·expm1(t))/t, whose t → 0 limit is
+    u(1 + ξt/2) (eq. 5 is r = u).
+    """
+    log_a2 = xp.log(a2)
+    t = (1.0 - gamma) * log_a2
+    u = 1.0 - xi
+    small = xp.abs(t) < _SERIES
+    safe = xp.select(small, 1.0, t)
+    r = xp.select(small, u * (1.0 + 0.5 * xi * t), xp.log1p(u * xp.expm1(safe)) / safe)
+    return xp.clip(r * exprel(xp, log_a2 * r) / exprel(xp, log_a2), 0.0, 1.0)
+
+
+def sample_gtr(xp: Any, gamma: float, a2: Any, u1: Any, u2: Any) -> Any:
+    """A micro-normal with density D_GTR(h) cos θh (eqs. 2–3)."""
+    cos2 = gtr_sample_cos2(xp, gamma, a2, u2)
+    sin_t = xp.safe_sqrt(1.0 - cos2)
+    phi = 2.0 * math.pi * u1
+    return xp.vec3(sin_t * xp.cos(phi), sin_t * xp.sin(phi), xp.sqrt(cos2))
+
+
+# -- anisotropic GTR2 = GGX (Burley App. B, eqs. 10–15; 2014 addendum) ------------------
+def anisotropic_alphas(xp: Any, roughness: Any, anisotropic: Any) -> tuple[Any, Any]:
+    """α_x = r²/aspect, α_y = r²·aspect, aspect = √(1 − 0.9·anisotropic) (2014 addendum).
+
+    Both are clamped below at :data:`ALPHA_MIN` (as the BRDF Explorer does).
+    """
+    a = roughness * roughness
+    if xp.known_zero(anisotropic):
+        a = xp.maximum(a, ALPHA_MIN)
+        return a, a
+    aspect = xp.sqrt(1.0 - 0.9 * anisotropic)
+    return xp.maximum(a / aspect, ALPHA_MIN), xp.maximum(a * aspect, ALPHA_MIN)
+
+
+def ggx_d(xp: Any, h: Any, ax: Any, ay: Any) -> Any:
+    """D_GTR2aniso(h) = 1/(π αx αy ((h·x)²/αx² + (h·y)²/αy² + (h·n)²)²) (eq. 13).
+
+    ``h`` need not be normalised: D is evaluated at h/|h| (the ratio is homogeneous).
+    """
+    hx, hy, hz = h[0] / ax, h[1] / ay, h[2]
+    s = hx * hx + hy * hy + hz * hz
+    n2 = h[0] * h[0] + h[1] * h[1] + hz * hz
+    return (n2 * n2) / (math.pi * ax * ay * s * s)
+
+
+def sample_ggx(xp: Any, ax: Any, ay: Any, u1: Any, u2: Any) -> Any:
+    """A micro-normal with density D(h) cos θh via the projected half vector (eqs. 14–15)."""
+    phi = 2.0 * math.pi * u1
+    t = xp.sqrt(u2 / xp.maximum(1.0 - u2, 1e-30))
+    return xp.normalize(xp.vec3(t * ax * xp.cos(phi), t * ay * xp.sin(phi), 1.0 + 0.0 * t))
+
+
+# -- Smith masking (Heitz 2014) -------------------------------------------------------------
+def smith_g1(xp: Any, w: Any, ax: Any, ay: Any) -> Any:
+    """G1(w) = 1/(1 + Λ(w)), Λ = (−1 + √(1 + (αx²wx² + αy²wy²)/wz²))/2 (Heitz 2014 eq. 86).
+
+    Written as 2|wz| / (|wz| + √(wz² + αx²wx² + αy²wy²)): no tan θ, so grazing w (wz → 0)
+    gives 0 instead of ∞/∞, and w = n gives exactly 1.
+    """
+    z = xp.abs(w[2])
+    q = (ax * w[0]) * (ax * w[0]) + (ay * w[1]) * (ay * w[1])
+    return 2.0 * z / xp.maximum(z + xp.sqrt(z * z + q), xp.tiny)
+
+
+def clearcoat_g1(xp: Any, w: Any) -> Any:
+    """Isotropic GGX G1 at the fixed α = 0.25 of the clearcoat (Burley §5.6)."""
+    return smith_g1(xp, w, CLEARCOAT_G_ALPHA, CLEARCOAT_G_ALPHA)
+
+
+# -- visible normals (Heitz 2018) ------------------------------------------------------------
+def sample_visible_ggx(xp: Any, wo: Any, ax: Any, ay: Any, u1: Any, u2: Any) -> Any:
+    """A micro-normal h with density D_wo(h) = G1(wo) max(0, wo·h) D(h) / wo.z.
+
+    ``wo`` must lie in the upper hemisphere (callers flip it). Heitz 2018, listing 1.
+    """
+    vh = xp.normalize(xp.vec3(ax * wo[0], ay * wo[1], wo[2]))
+    lensq = vh[0] * vh[0] + vh[1] * vh[1]
+    inv = 1.0 / xp.sqrt(xp.select(lensq > 0.0, lensq, 1.0))
+    t1 = xp.vec3(
+        xp.select(lensq > 0.0, -vh[1] * inv, 1.0), xp.select(lensq > 0.0, vh[0] * inv, 0.0), 0.0
+    )
+    t2 = xp.cross(vh, t1)
+    r = xp.sqrt(u1)
+    phi = 2.0 * math.pi * u2
+    p1 = r * xp.cos(phi)
+    p2 = r * xp.sin(phi)
+    s = 0.5 * (1.0 + vh[2])
+    p2 = (1.0 - s) * xp.safe_sqrt(1.0 - p1 * p1) + s * p2
+    nh = t1 * p1 + t2 * p2 + vh * xp.safe_sqrt(1.0 - p1 * p1 - p2 * p2)
+    return xp.normalize(xp.vec3(ax * nh[0], ay * nh[1], xp.maximum(nh[2], 0.0)))
+
+
+def visible_ggx_pdf(xp: Any, wo: Any, h: Any, ax: Any, ay: Any) -> Any:
+    """D_wo(h) of :func:`sample_visible_ggx` (``wo`` upper, ``h`` unit)."""
+    cos_o = xp.maximum(wo[2], xp.tiny)
+    return smith_g1(xp, wo, ax, ay) * xp.maximum(xp.dot(wo, h), 0.0) * ggx_d(xp, h, ax, ay) / cos_o
+
+
+def reflect(xp: Any, w: Any, h: Any) -> Any:
+    """Mirror ``w`` about the unit normal ``h``: 2(w·h)h − w (Burley App. B.1)."""
+    return h * (2.0 * xp.dot(w, h)) - w
+
+
+def refract(xp: Any, w: Any, h: Any, eta: Any) -> tuple[Any, Any]:
+    """Refract ``w`` (pointing away, on h's side) through ``h``; ``eta`` = η_t/η_i.
+
+    Returns (direction, valid): ``valid`` is False under total internal reflection.
+    """
+    c = xp.dot(w, h)
+    sin2_t = (1.0 - c * c) / (eta * eta)
+    cos_t = xp.safe_sqrt(1.0 - sin2_t)
+    d = h * (c / eta - cos_t) - w * (1.0 / eta)
+    return d, sin2_t < 1.0
