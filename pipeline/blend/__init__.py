@@ -1,1 +1,14 @@
-"""Blending engine: masks, Disney parameter blending, Pixar lobe compositing."""
+"""Blending engine: masks, Disney parameter blending, Pixar lobe compositing (issue 5).
+
+>>> from lookdev.library import Library
+>>> blended = blend(Library(use_env=False).load("gold"), 64)
+>>> blended.maps, blended.to_params().metallic
+({}, 1.0)
+"""
+
+from .bake import bake
+from .engine import BlendedMaterial, blend
+from .errors import BlendError, TextureError
+from .masks import MaskSampler
+
+__all__ = ["BlendError", "BlendedMaterial", "MaskSampler", "TextureError", "bake", "blend"]

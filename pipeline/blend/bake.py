@@ -1,0 +1,131 @@
+"""Write a :class:`~.engine.BlendedMaterial` to disk: one EXR per map, one JSON sidecar.
+
+Layout for a material ``NAME`` in ``out_dir``::
+
+    NAME.json              constants, map files, resolution, decisions (the sidecar)
+    NAME_roughness.exr     one file per varying parameter (float32, ZIP), "Y" or "R,G,B"
+    NAME_normal_map.exr    unit normals encoded (n + 1)/2, the usual normal-map encoding
+
+Files are written the way images are viewed, top row first: the top row of each file is
+v = 1 (the UsdUVTexture and OpenImageIO convention), so UV (0, 0) is the bottom-left.
+Reading one back with :func:`.resample.read_channels` gives the map in UV order again.
+
+Nothing is half-written: every file goes to a temporary folder beside the output first
+and is renamed into place only when all were written; the sidecar is renamed last, so a
+sidecar on disk always describes files that are complete. Map files listed by an older
+sidecar of the same material and not written now are removed (they no longer vary).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import OpenImageIO as oiio
+
+from .engine import BlendedMaterial
+from .errors import BlendError
+
+SCHEMA = "lookdev.blend/1"
+
+
+def bake(
+    blended: BlendedMaterial,
+    out_dir: str | Path,
+    *,
+    progress: Callable[[int, int], None] | None = None,
+) -> dict[str, Path]:
+    """Write the maps and the sidecar; returns ``{map name: path, "sidecar": path}``."""
+    out_dir = Path(out_dir)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise BlendError(f"cannot create {out_dir}: {exc.strerror}", where=blended.name) from None
+    arrays = blended.arrays
+    files = {name: f"{blended.name}_{name}.exr" for name in arrays}
+    sidecar = out_dir / f"{blended.name}.json"
+    stale = _listed_files(sidecar) - set(files.values())
+    tmp = Path(tempfile.mkdtemp(prefix=f".{blended.name}-", dir=out_dir))
+    try:
+        for i, (name, array) in enumerate(arrays.items()):
+            _write_exr(tmp / files[name], _encode(name, array), blended.name)
+            if progress is not None:
+                progress(i + 1, len(arrays) + 1)
+        (tmp / sidecar.name).write_text(json.dumps(sidecar_dict(blended, files), indent=2))
+        for name in files.values():
+            os.replace(tmp / name, out_dir / name)
+        os.replace(tmp / sidecar.name, sidecar)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    for name in stale:
+        (out_dir / name).unlink(missing_ok=True)
+    if progress is not None:
+        progress(len(arrays) + 1, len(arrays) + 1)
+    return {**{name: out_dir / f for name, f in files.items()}, "sidecar": sidecar}
+
+
+def sidecar_dict(blended: BlendedMaterial, files: dict[str, str]) -> dict[str, Any]:
+    """The JSON sidecar: everything a reader needs besides the pixels."""
+    width, height = blended.resolution
+    return {
+        "schema": SCHEMA,
+        "name": blended.name,
+        "model": blended.model,
+        "resolution": [width, height],
+        "orientation": "top row of each file is v = 1; UV (0, 0) is the bottom-left texel",
+        "constants": {k: _plain(v) for k, v in blended.constants.items()},
+        "maps": {
+            name: {
+                "file": files[name],
+                "channels": ["R", "G", "B"] if array.ndim == 3 else ["Y"],
+                "encoding": "(n + 1) / 2" if name.endswith("normal_map") else "linear",
+            }
+            for name, array in blended.arrays.items()
+        },
+        "layers": [
+            {"layer": d.layer, "kept": d.kept, "reason": d.reason} for d in blended.decisions
+        ],
+    }
+
+
+def _encode(name: str, array: np.ndarray) -> np.ndarray:
+    """Rows flipped to file order (top row v = 1); normals to the (n + 1)/2 encoding."""
+    if name.endswith("normal_map"):
+        array = 0.5 * array + 0.5
+    return np.ascontiguousarray(array[::-1], dtype=np.float32)
+
+
+def _write_exr(path: Path, pixels: np.ndarray, where: str) -> None:
+    height, width = pixels.shape[:2]
+    channels = 1 if pixels.ndim == 2 else pixels.shape[2]
+    spec = oiio.ImageSpec(width, height, channels, oiio.FLOAT)
+    spec.channelnames = ("Y",) if channels == 1 else ("R", "G", "B")
+    spec.attribute("compression", "zip")
+    out = oiio.ImageOutput.create(str(path))
+    ok = out is not None and out.open(str(path), spec) and out.write_image(pixels)
+    message = (out.geterror() if out is not None else oiio.geterror()) if not ok else ""
+    if out is not None:
+        out.close()
+    if not ok:
+        raise BlendError(f"cannot write {path.name}: {message or 'unknown error'}", where=where)
+
+
+def _listed_files(sidecar: Path) -> set[str]:
+    """Map files named by an existing sidecar (empty if there is none or it is not ours)."""
+    try:
+        data = json.loads(sidecar.read_text())
+        return {m["file"] for m in data["maps"].values() if "/" not in m["file"]}
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return set()
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, tuple | list | np.ndarray):
+        return [float(x) for x in np.asarray(value).ravel()]
+    return value.item() if isinstance(value, np.generic) else value

@@ -1,0 +1,127 @@
+"""Disney layers: parameter blending (Burley 2012 §5.7 and §6.1).
+
+A stack is blended bottom to top like a Photoshop layer stack: each layer's parameters
+replace those below in proportion to its mask, ``p ← lerp(p, pᵢ, mᵢ)``, for every
+parameter, colours included, in the space the parameters are written in. That space is
+Burley's perceptually linear one (roughness, not α = roughness²; ``specular``, not F0),
+the one in which "materials generally interpolate in a very intuitive way" (§5.7).
+
+Unrolled, the chain is a weighted sum (:func:`stack_weights`)::
+
+    p = Σᵢ wᵢ pᵢ,   wᵢ = mᵢ · Πⱼ>ᵢ (1 − mⱼ),   w₀ = Πⱼ>₀ (1 − mⱼ)
+
+which is exact at masks 0 and 1 (a full-coverage layer gives weight exactly 1 to itself and
+exactly 0 below), and lets one matrix product produce every parameter map of a tile.
+
+Parameters that cannot be interpolated (``thin``, ``sheen_model``) must agree across the
+layers that show; ``ior`` is blended as the ``specular`` it spells (Burley's parameter,
+linear in F0) and spelled back as ``ior`` only when every layer wrote ``ior``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from lookdev.materials.params import SPECULAR_F0_SCALE, DisneyParams
+
+from .errors import BlendError
+
+COLOR = "base_color"
+SCALARS = tuple(
+    name
+    for name, info in DisneyParams.model_fields.items()
+    if info.annotation in (float, "float") and name != COLOR
+)
+"""Continuous scalar parameters, blended linearly (``ior`` travels as ``specular``)."""
+DISCRETE = ("thin", "sheen_model")
+"""Parameters with no in-between: every layer that shows must agree."""
+
+
+def layer_values(params: DisneyParams) -> dict[str, Any]:
+    """The continuous parameters of one layer in blending space (``ior`` as ``specular``)."""
+    values: dict[str, Any] = {COLOR: tuple(params.base_color)}
+    values.update({name: float(getattr(params, name)) for name in SCALARS})
+    values["specular"] = float(params.effective_specular)
+    return values
+
+
+def stack_weights(masks: Sequence[Any]) -> list[Any]:
+    """Weights of the layers of a stack whose masks above the base are ``masks``.
+
+    Returns ``[w₀, w₁, …]`` (base first), each broadcastable like the masks; they sum to 1.
+
+    >>> [float(w) for w in stack_weights([0.5, 1.0])]  # a full-coverage top hides all below
+    [0.0, 0.0, 1.0]
+    >>> [float(w) for w in stack_weights([0.5, 0.5])]
+    [0.25, 0.25, 0.5]
+    """
+    weights = []
+    remaining: Any = 1.0
+    for m in reversed(masks):
+        weights.append(m * remaining)
+        remaining = remaining * (1.0 - m)
+    weights.append(remaining)
+    return weights[::-1]
+
+
+def check_discrete(stack: Sequence[tuple[str, DisneyParams]]) -> dict[str, Any]:
+    """The one value of each discrete parameter, or a :class:`BlendError` naming the layer.
+
+    A layer without sheen does not vote on ``sheen_model`` (the choice changes nothing
+    there). ``stack`` is ``(label, params)`` bottom to top, of the layers that show.
+    """
+    out: dict[str, Any] = {}
+    for name in DISCRETE:
+        voters = [(label, p) for label, p in stack if name != "sheen_model" or p.sheen > 0]
+        voters = voters or list(stack[-1:])
+        first_label, first = voters[0]
+        for label, p in voters[1:]:
+            if getattr(p, name) != getattr(first, name):
+                raise BlendError(
+                    f"{name} = {getattr(p, name)!r} differs from layer {first_label!r} "
+                    f"({getattr(first, name)!r}); it cannot be blended, so the layers that "
+                    "show must agree",
+                    where=f"layer {label!r}",
+                    field=name,
+                )
+        out[name] = getattr(first, name)
+    return out
+
+
+def spell_specular(stack: Sequence[DisneyParams], specular: Any) -> dict[str, Any]:
+    """``specular`` (constant or map) in the spelling the layers used.
+
+    ``ior`` when every layer wrote ``ior`` (one shared value passes through exactly), else
+    ``specular``: a stack mixing the two spellings takes the 2012 one.
+    """
+    iors = {p.ior for p in stack}
+    if None in iors:
+        return {"specular": specular}
+    if len(iors) == 1:
+        return {"ior": iors.pop()}
+    return {"ior": specular_to_ior(specular)}
+
+
+def specular_to_ior(specular: Any) -> Any:
+    """IOR whose normal-incidence Fresnel is ``0.08 · specular`` (Burley §5.4).
+
+    >>> round(float(specular_to_ior(0.5)), 6)
+    1.5
+    """
+    r = np.sqrt(np.minimum(SPECULAR_F0_SCALE * np.asarray(specular), 1.0 - 1e-7))
+    out = (1.0 + r) / (1.0 - r)
+    return out.astype(np.float32) if np.ndim(out) else float(out)
+
+
+def assemble(
+    constants: dict[str, Any], discrete: dict[str, Any], stack: Sequence[DisneyParams]
+) -> dict[str, Any]:
+    """The constants of a blended Disney material: one spelling of specular, plain values."""
+    out = {k: v for k, v in constants.items() if k != "specular"}
+    if "specular" in constants:
+        out.update(spell_specular(stack, constants["specular"]))
+    out.update(discrete)
+    return out

@@ -1,0 +1,245 @@
+"""``blend()``: a layered material in, a :class:`BlendedMaterial` out.
+
+The result holds each parameter as a constant where it is uniform and as a map where it
+varies, and nothing is computed that the result does not need (DESIGN.md):
+
+- a layer whose mask is zero everywhere is dropped;
+- a layer under a full-coverage layer (mask 1 everywhere, presence 1) is dropped;
+- a layer that sets every parameter to what is already below it, and carries no normal
+  map, is dropped;
+- a uniform mask folds into the constants: parameters stay constants until a varying
+  mask meets a value that differs from the one below;
+- a material that needs no map produces none.
+
+Coverage is bounded from the mask sources before any texel is evaluated
+(:meth:`.MaskSampler.bounds`). Maps are computed in tiles of rows so the peak memory is
+the output plus the mask sources plus one tile of temporaries.
+
+Maps are float32 ``(H, W)`` scalars and ``(H, W, 3)`` colours and normals, in UV order:
+``map[r, c]`` is the texel centred on ``(u, v) = ((c + ½)/W, (r + ½)/H)``, so texel (0, 0)
+is UV (0, 0), the bottom-left corner of the image as a viewer shows it. Normal maps are
+unit tangent-space vectors (decoded, not 0..1 encoded).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from . import disney
+from .errors import BlendError
+from .masks import MaskSampler
+from .stack import Decision, Entry, prune, stack_of
+
+TILE_TEXELS = 1 << 16
+"""Texels per tile: a tile's temporaries (a few channels) stay within a CPU cache."""
+
+Progress = Callable[[int, int], None]
+"""Called as ``progress(rows_done, rows_total)`` after each tile."""
+
+
+@dataclass
+class BlendedMaterial:
+    """A blended material: constants where uniform, maps where varying (see module doc)."""
+
+    name: str
+    model: str
+    resolution: tuple[int, int]
+    """(width, height) of the maps, whether or not any exist."""
+    constants: dict[str, Any]
+    maps: dict[str, np.ndarray] = field(default_factory=dict)
+    normal_map: np.ndarray | None = None
+    specular_normal_map: np.ndarray | None = None
+    decisions: list[Decision] = field(default_factory=list)
+
+    @property
+    def arrays(self) -> dict[str, np.ndarray]:
+        """Every array of the result by name: the maps and any normal maps."""
+        out = dict(self.maps)
+        for name in ("normal_map", "specular_normal_map"):
+            if getattr(self, name) is not None:
+                out[name] = getattr(self, name)
+        return out
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes held by the maps (the size of the output)."""
+        return sum(a.nbytes for a in self.arrays.values())
+
+    def params_at(self, row: int, col: int):
+        """The model's parameters at texel ``(row, col)`` (UV order; see module doc)."""
+        values = dict(self.constants)
+        for name, a in self.maps.items():
+            v = a[row, col]
+            values[name] = tuple(float(x) for x in v) if np.ndim(v) else float(v)
+        return _params_type(self.model).parse(values, where=f"{self.name} texel {row},{col}")
+
+    def to_params(self):
+        """The parameters of a uniform result; a :class:`BlendError` if anything varies."""
+        if self.maps:
+            raise BlendError(
+                f"parameters vary across the surface ({', '.join(sorted(self.maps))}); "
+                "use params_at(row, col) or the maps",
+                where=self.name,
+            )
+        return _params_type(self.model).parse(dict(self.constants), where=self.name)
+
+
+def _params_type(model: str):
+    if model == "disney":
+        return disney.DisneyParams
+    from lookdev.materials.pixar import PixarParams
+
+    return PixarParams
+
+
+def blend(
+    material: Any,
+    resolution: int | tuple[int, int] = 1024,
+    *,
+    progress: Progress | None = None,
+) -> BlendedMaterial:
+    """Blend a library :class:`~lookdev.library.Material` at ``resolution``.
+
+    ``resolution`` is ``N`` (N × N) or ``(width, height)``. A non-layered material blends
+    to constants and no maps. Disney stacks blend parameters (:mod:`.disney`); Pixar
+    stacks composite lobe weights (:mod:`.pixar`).
+    """
+    width, height = (resolution, resolution) if isinstance(resolution, int) else resolution
+    if width < 1 or height < 1:
+        raise BlendError(f"resolution {width}x{height} must be at least 1x1", where=material.name)
+    sampler = MaskSampler((height, width))
+    entries = stack_of(material)
+    kept, decisions = prune(entries, sampler)
+    if entries[0].model == "pixar":
+        from . import pixar
+
+        result = pixar.blend_stack(material.name, kept, sampler, progress)
+    else:
+        result = _blend_disney(material.name, kept, sampler, progress)
+    result.decisions = decisions + result.decisions
+    return result
+
+
+def _blend_disney(name: str, kept: list[Entry], sampler: MaskSampler, progress) -> BlendedMaterial:
+    """Parameter blending of the kept layers (bottom first) into constants and maps."""
+    values = [disney.layer_values(e.params) for e in kept]
+    constants, varying, inert = _plan(values, kept)
+    decisions = [Decision(kept[i].label, False, "sets what is already below it") for i in inert]
+    kept = [e for i, e in enumerate(kept) if i not in inert]
+    values = [v for i, v in enumerate(values) if i not in inert]
+    discrete = disney.check_discrete([(e.label, e.params) for e in kept])
+    stack = [e.params for e in kept]
+    resolution = (sampler.width, sampler.height)
+    out = BlendedMaterial(name, "disney", resolution, {}, decisions=decisions)
+    out.maps = _disney_maps(kept, values, varying, sampler, progress, out)
+    out.constants = disney.assemble(constants, discrete, stack)
+    if "specular" in out.maps:
+        out.maps.update(disney.spell_specular(stack, out.maps.pop("specular")))
+    return out
+
+
+def _plan(values: list[dict[str, Any]], kept: list[Entry]):
+    """Which parameters vary, the constants of the rest, and layers that change nothing.
+
+    Walks the stack bottom to top with each parameter either a constant or "varying".
+    A uniform mask lerps constants into constants; a varying mask makes a parameter vary
+    unless the layer's value equals the constant below.
+    """
+    constants: dict[str, Any] = dict(values[0])
+    varying: set[str] = set()
+    inert = []
+    for i, (entry, layer) in enumerate(zip(kept[1:], values[1:], strict=True), start=1):
+        changes = entry.normal_map is not None or entry.specular_normal_map is not None
+        for key, p in layer.items():
+            if key in varying:
+                changes = True
+            elif entry.uniform:
+                changes |= p != constants[key]
+                constants[key] = _lerp(constants[key], p, entry.low)
+            elif p != constants[key]:
+                varying.add(key)
+                del constants[key]
+                changes = True
+        if not changes:
+            inert.append(i)
+    return constants, varying, set(inert)
+
+
+def _lerp(a: Any, b: Any, m: float) -> Any:
+    """``a + m (b − a)`` per channel, exact at m = 0 and m = 1."""
+    if m == 0.0 or a == b:
+        return a
+    if m == 1.0:
+        return b
+    if isinstance(a, tuple):
+        return tuple((1.0 - m) * x + m * y for x, y in zip(a, b, strict=True))
+    return (1.0 - m) * a + m * b
+
+
+def _disney_maps(kept, values, varying, sampler, progress, out: BlendedMaterial):
+    """Fill the varying parameter maps (and normal maps) tile by tile."""
+    height, width = sampler.height, sampler.width
+    scalars = [k for k in disney.SCALARS if k in varying]
+    normals = any(e.normal_map is not None for e in kept)
+    spec_normals = any(e.specular_normal_map is not None for e in kept)
+    if not (varying or normals or spec_normals):
+        return {}
+    block = np.empty((len(scalars), height, width), dtype=np.float32)
+    maps = {k: block[i] for i, k in enumerate(scalars)}
+    p_scalar = np.array([[v[k] for v in values] for k in scalars], dtype=np.float32)
+    p_color = np.array([v[disney.COLOR] for v in values], dtype=np.float32).T
+    if disney.COLOR in varying:
+        maps[disney.COLOR] = np.empty((height, width, 3), dtype=np.float32)
+    if normals:
+        out.normal_map = np.empty((height, width, 3), dtype=np.float32)
+    if spec_normals:
+        out.specular_normal_map = np.empty((height, width, 3), dtype=np.float32)
+    rows_per_tile = max(1, TILE_TEXELS // width)
+    for r0 in range(0, height, rows_per_tile):
+        rows = slice(r0, min(height, r0 + rows_per_tile))
+        n = rows.stop - rows.start
+        weights = _tile_weights(kept, sampler, rows)
+        if scalars:
+            block[:, rows] = (p_scalar @ weights).reshape(len(scalars), n, width)
+        if disney.COLOR in varying:
+            maps[disney.COLOR][rows] = (p_color @ weights).T.reshape(n, width, 3)
+        if normals:
+            out.normal_map[rows] = _tile_normals(kept, sampler, rows, weights, "normal_map")
+        if spec_normals:
+            out.specular_normal_map[rows] = _tile_normals(
+                kept, sampler, rows, weights, "specular_normal_map"
+            )
+        if progress is not None:
+            progress(rows.stop, height)
+    return maps
+
+
+def _tile_weights(kept: list[Entry], sampler: MaskSampler, rows: slice) -> np.ndarray:
+    """Layer weights (L, texels of the tile), base first (:func:`.disney.stack_weights`)."""
+    n = rows.stop - rows.start
+    masks = [e.coverage(sampler, rows) for e in kept[1:]]
+    weights = np.empty((len(kept), n * sampler.width), dtype=np.float32)
+    for w, row in zip(disney.stack_weights(masks), weights, strict=True):
+        row[...] = np.reshape(w, -1) if np.ndim(w) else w
+    return weights
+
+
+def _tile_normals(kept, sampler, rows, weights, which: str) -> np.ndarray:
+    """Σ wᵢ nᵢ renormalised; layers without a map (or a specular map) count as flat."""
+    n = rows.stop - rows.start
+    total = np.zeros((n * sampler.width, 3), dtype=np.float32)
+    for entry, w in zip(kept, weights, strict=True):
+        tex = getattr(entry, which) or (entry.normal_map if which != "normal_map" else None)
+        if tex is None:
+            total[:, 2] += w
+        else:
+            total += w[:, None] * entry.normals(sampler, tex, rows).reshape(-1, 3)
+    length = np.linalg.norm(total, axis=1, keepdims=True)
+    flat = length[:, 0] < 1e-6  # opposite normals cancelled: the geometric normal remains
+    total[flat] = (0.0, 0.0, 1.0)
+    length[flat] = 1.0
+    return (total / length).reshape(n, sampler.width, 3)

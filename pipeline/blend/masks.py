@@ -1,0 +1,258 @@
+"""Evaluate any :data:`~lookdev.materials.layers.Mask` at any resolution.
+
+A mask evaluates to float32 (H, W) coverage in 0..1, in UV order: row ``r``, column ``c``
+is the texel centred on ``(u, v) = ((c + ½)/W, (r + ½)/H)``, so row 0 is v ≈ 0, the bottom
+of the image (see :mod:`.resample`).
+
+**The clamp.** Every mask is clamped to 0..1 *after* filtering. Filtering is linear and
+sees the data as stored, so a minified mask is the true average of the file; the clamp
+then keeps coverage meaningful: a blend ``lerp(below, layer, m)`` with ``m`` outside 0..1
+would extrapolate parameters past both layers (negative roughness, colours brighter than
+either). Float images (EXR) can hold values outside 0..1, and levels/contrast can push
+values out; both are clamped the same way.
+
+**Bounds before pixels.** :meth:`MaskSampler.bounds` gives a conservative (low, high) of a
+mask from its sources alone (a texture's min and max, interval arithmetic through the
+combinations), so the engine can fold uniform masks, drop zero layers and prune layers
+under full coverage without evaluating a single texel.
+
+>>> from lookdev.materials.layers import RampMask
+>>> MaskSampler((1, 4)).evaluate(RampMask(axis="u")).tolist()
+[[0.125, 0.375, 0.625, 0.875]]
+"""
+
+from __future__ import annotations
+
+from functools import reduce
+
+import numpy as np
+
+from lookdev.materials.layers import (
+    ConstantMask,
+    InvertMask,
+    LevelsMask,
+    Mask,
+    NoiseMask,
+    RampMask,
+    TextureMask,
+)
+
+from .resample import read_channels, resample, taps
+
+
+class MaskSampler:
+    """Evaluates masks for one output resolution, reading each texture once.
+
+    ``resolution`` is ``(height, width)``; ``where`` names the layer in error messages.
+    """
+
+    def __init__(self, resolution: tuple[int, int]):
+        self.height, self.width = resolution
+        self._images: dict[tuple, np.ndarray] = {}
+        self._ranges: dict[tuple, tuple[float, float]] = {}
+
+    def image(self, tex: TextureMask, count: int = 1, *, where: str | None = None) -> np.ndarray:
+        """The source channels of ``tex`` (cached), float32 (h, w, count) in UV order."""
+        key = (str(tex.path), tex.channel, count)
+        if key not in self._images:
+            self._images[key] = read_channels(tex, count, where=where)
+            self._ranges[key] = (float(self._images[key].min()), float(self._images[key].max()))
+        return self._images[key]
+
+    def lookup(
+        self, tex: TextureMask, count: int = 1, rows: slice | None = None, *, where=None
+    ) -> np.ndarray:
+        """Filtered texture values at the output texels of ``rows``: (n, W, count)."""
+        src = self.image(tex, count, where=where)
+        h, w = src.shape[:2]
+        (su, sv), (ou, ov) = tex.uv_scale, tex.uv_offset
+        v_taps = taps(self.height, h, sv, ov, tex.wrap, rows)
+        u_taps = taps(self.width, w, su, ou, tex.wrap)
+        return resample(src, v_taps, u_taps)
+
+    def evaluate(self, mask: Mask, rows: slice | None = None, *, where=None) -> np.ndarray:
+        """Coverage of ``mask`` on output rows ``rows`` (all rows by default), float32 (n, W)."""
+        rows = rows or slice(0, self.height)
+        n = len(range(*rows.indices(self.height)))
+        out = self._node(mask, rows, n, where)
+        if np.ndim(out) == 0:
+            return np.full((n, self.width), out, dtype=np.float32)
+        return np.clip(out, 0.0, 1.0, out=out).astype(np.float32, copy=False)
+
+    def _node(self, mask: Mask, rows: slice, n: int, where) -> np.ndarray | float:
+        """One node's values before the final clamp; constants stay scalars."""
+        if isinstance(mask, ConstantMask):
+            return np.float32(mask.value)
+        if isinstance(mask, TextureMask):
+            value = np.clip(self.lookup(mask, 1, rows, where=where)[..., 0], 0.0, 1.0)
+            return 1.0 - value if mask.invert else value
+        if isinstance(mask, NoiseMask):
+            u, v = self._uv(rows)
+            return fractal_noise(mask, u, v, self.height, self.width)
+        if isinstance(mask, RampMask):
+            u, v = self._uv(rows)
+            return np.broadcast_to(ramp(mask, u, v), (n, self.width)).astype(np.float32)
+        if isinstance(mask, InvertMask):
+            return 1.0 - self._node(mask.input, rows, n, where)
+        if isinstance(mask, LevelsMask):
+            return levels(mask, self._node(mask.input, rows, n, where))
+        values = [self._node(m, rows, n, where) for m in mask.inputs]
+        return combine(mask.kind, values)
+
+    def _uv(self, rows: slice) -> tuple[np.ndarray, np.ndarray]:
+        """Texel-centre UVs of ``rows``: u as (1, W), v as (n, 1), float64."""
+        u = (np.arange(self.width) + 0.5) / self.width
+        v = (np.arange(self.height)[rows] + 0.5) / self.height
+        return u[None, :], v[:, None]
+
+    def bounds(self, mask: Mask, *, where=None) -> tuple[float, float]:
+        """A conservative (low, high) of the mask's values at this resolution.
+
+        Exact for constants and combinations of constants; a texture's range is that of
+        its stored texels (clamped, inverted; 0 included where ``wrap="black"`` reads past
+        the edge). Reads textures, never evaluates a full mask.
+        """
+        if isinstance(mask, ConstantMask):
+            return mask.value, mask.value
+        if isinstance(mask, TextureMask):
+            return self._texture_bounds(mask, where)
+        if isinstance(mask, NoiseMask):
+            return 0.0, 1.0
+        if isinstance(mask, RampMask):
+            return _ramp_bounds(mask, self.height, self.width)
+        if isinstance(mask, InvertMask):
+            lo, hi = self.bounds(mask.input, where=where)
+            return 1.0 - hi, 1.0 - lo
+        if isinstance(mask, LevelsMask):
+            lo, hi = self.bounds(mask.input, where=where)
+            return float(levels(mask, np.float64(lo))), float(levels(mask, np.float64(hi)))
+        parts = [self.bounds(m, where=where) for m in mask.inputs]
+        lows, highs = zip(*parts, strict=True)
+        return float(combine(mask.kind, list(lows))), float(combine(mask.kind, list(highs)))
+
+    def _texture_bounds(self, tex: TextureMask, where) -> tuple[float, float]:
+        self.image(tex, 1, where=where)
+        lo, hi = (min(max(x, 0.0), 1.0) for x in self._ranges[(str(tex.path), tex.channel, 1)])
+        if tex.wrap == "black" and self._reads_outside(tex):
+            lo = 0.0
+        return (1.0 - hi, 1.0 - lo) if tex.invert else (lo, hi)
+
+    def _reads_outside(self, tex: TextureMask) -> bool:
+        h, w = self.image(tex).shape[:2]
+        (su, sv), (ou, ov) = tex.uv_scale, tex.uv_offset
+        v_w = taps(self.height, h, sv, ov, "black")[1].sum(axis=1)
+        u_w = taps(self.width, w, su, ou, "black")[1].sum(axis=1)
+        return bool((v_w < 1 - 1e-6).any() or (u_w < 1 - 1e-6).any())
+
+
+def combine(kind: str, values: list):
+    """Per-texel combination of masks; monotone in every input, so bounds map to bounds.
+
+    ``screen`` is ``1 − Π(1 − m)`` (Photoshop's screen, lighter than either input).
+
+    >>> combine("screen", [0.5, 0.5]), combine("multiply", [0.5, 0.5])
+    (0.75, 0.25)
+    """
+    if kind == "multiply":
+        return reduce(lambda a, b: a * b, values)
+    if kind == "screen":
+        return 1.0 - reduce(lambda a, b: a * b, [1.0 - v for v in values])
+    if kind == "max":
+        return reduce(np.maximum, values)
+    return reduce(np.minimum, values)
+
+
+def levels(mask: LevelsMask, m):
+    """Photoshop-style levels (see :class:`~lookdev.materials.layers.LevelsMask`).
+
+    >>> float(levels(LevelsMask(input=1.0, low=0.25, high=0.75), np.float64(0.5)))
+    0.5
+    """
+    v = np.clip((m - mask.low) / (mask.high - mask.low), 0.0, 1.0) ** (1.0 / mask.gamma)
+    v = np.clip((v - 0.5) * mask.contrast + 0.5, 0.0, 1.0)
+    return mask.out_low + (mask.out_high - mask.out_low) * v
+
+
+def ramp(mask: RampMask, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Gradient from 0 at ``start`` to 1 at ``end`` along u, v or the radius from (½, ½)."""
+    if mask.axis == "radial":
+        return _ramp_profile(mask, np.hypot(u - 0.5, v - 0.5))
+    return _ramp_profile(mask, u if mask.axis == "u" else v)
+
+
+def _ramp_profile(mask: RampMask, t: np.ndarray) -> np.ndarray:
+    """The ramp as a function of its coordinate; ``smooth`` is smoothstep ``3t² − 2t³``."""
+    t = np.clip((t - mask.start) / (mask.end - mask.start), 0.0, 1.0)
+    return t * t * (3.0 - 2.0 * t) if mask.interpolation == "smooth" else t
+
+
+def _ramp_bounds(mask: RampMask, height: int, width: int) -> tuple[float, float]:
+    """Exact range of a ramp over the texel centres (it is monotone in its coordinate)."""
+    u = (np.array([0, width - 1]) + 0.5) / width
+    v = (np.array([0, height - 1]) + 0.5) / height
+    if mask.axis == "radial":
+        du = 0.0 if width % 2 else 0.5 / width  # a texel centre sits on u = ½ when W is odd
+        dv = 0.0 if height % 2 else 0.5 / height
+        t = np.array([np.hypot(du, dv), np.hypot(u[0] - 0.5, v[0] - 0.5)])
+    else:
+        t = u if mask.axis == "u" else v
+    values = _ramp_profile(mask, t)
+    return float(values.min()), float(values.max())
+
+
+def fractal_noise(mask: NoiseMask, u: np.ndarray, v: np.ndarray, height: int, width: int):
+    """Tileable fractal value noise (fBm), float32 in 0..1, deterministic in ``seed``.
+
+    Octave k is value noise on a lattice of ``P_k = max(1, round(scale · lacunarity^k))``
+    cells per unit (periodic in P_k, hence tileable with period 1), quintic-interpolated,
+    weighted ``gain^k``; the sum is divided by Σ gain^k so it stays in 0..1. Octaves
+    whose lattice is finer than the output can resolve (P_k > min(H, W)/2, the Nyquist
+    limit) are replaced by their mean ½: that is the filtered value of an octave that
+    would only alias.
+    """
+    nyquist = min(height, width) / 2.0
+    total = np.zeros(np.broadcast_shapes(u.shape, v.shape), dtype=np.float64)
+    norm = 0.0
+    for k in range(mask.octaves):
+        amp = mask.gain**k
+        period = max(1, round(mask.scale * mask.lacunarity**k))
+        octave = 0.5 if period > nyquist else _value_noise(u, v, period, mask.seed, k)
+        total += amp * octave
+        norm += amp
+    return (total / norm).astype(np.float32)
+
+
+def _value_noise(u: np.ndarray, v: np.ndarray, period: int, seed: int, octave: int):
+    """Periodic value noise: hashed lattice values, quintic fade, bilinear mix."""
+    x, y = u * period, v * period
+    x0, y0 = np.floor(x), np.floor(y)
+    fx, fy = _fade(x - x0), _fade(y - y0)
+    x0, y0 = x0.astype(np.int64) % period, y0.astype(np.int64) % period
+    x1, y1 = (x0 + 1) % period, (y0 + 1) % period
+
+    def corner(ix, iy):
+        return _hash01(ix, iy, seed, octave)
+
+    bottom = corner(x0, y0) * (1 - fx) + corner(x1, y0) * fx
+    top = corner(x0, y1) * (1 - fx) + corner(x1, y1) * fx
+    return bottom * (1 - fy) + top * fy
+
+
+def _fade(t: np.ndarray) -> np.ndarray:
+    """Perlin's quintic ``6t⁵ − 15t⁴ + 10t³`` (C2 across lattice cells)."""
+    return t * t * t * (t * (t * 6.0 - 15.0) + 10.0)
+
+
+def _hash01(ix: np.ndarray, iy: np.ndarray, seed: int, octave: int) -> np.ndarray:
+    """Lattice value in [0, 1) from integer coordinates: a 32-bit integer avalanche hash.
+
+    Platform independent (wrapping uint32 arithmetic), so a seed means the same mask on
+    every machine.
+    """
+    h = np.uint32((seed * 0x9E3779B1 ^ octave * 0x85EBCA77) & 0xFFFFFFFF)
+    h = h ^ (ix.astype(np.uint32) * np.uint32(0xC2B2AE3D))
+    h = h ^ (iy.astype(np.uint32) * np.uint32(0x27D4EB2F))
+    for shift, mul in ((16, 0x7FEB352D), (15, 0x846CA68B)):
+        h = (h ^ (h >> np.uint32(shift))) * np.uint32(mul)
+    h = h ^ (h >> np.uint32(16))
+    return h.astype(np.float64) / 4294967296.0
