@@ -98,6 +98,9 @@ class PresetFile(BaseModel):
 
     @model_validator(mode="after")
     def _fields_fit_the_model(self) -> PresetFile:
+        if self.model is not None and self.model != "layered" and self.model not in MODELS:
+            allowed = ", ".join([*MODELS, "layered"])
+            raise ValueError(f"model {self.model!r} is not installed; allowed: {allowed}")
         if self.model is None and self.extends is None:
             raise ValueError(
                 "'model' is required (disney, pixar or layered) unless 'extends' is given"
