@@ -43,12 +43,18 @@ def _root(
 
 
 def _register() -> None:
-    from . import bench, export, plot, presets
+    from . import bench, export, export_usd, plot, presets, proof
+    from . import blend as blend_cli
 
     app.add_typer(bench.app, name="bench")
+    app.command("blend")(blend_cli.blend)
     app.add_typer(export.app, name="export")
+    export.app.command("usd")(export_usd.export_usd)
+    app.add_typer(export_usd.import_app, name="import")
+    app.add_typer(export_usd.validate_app, name="validate")
     app.add_typer(presets.app, name="presets")
     app.command("plot")(plot.plot)
+    app.command("proof")(proof.proof)
 
 
 _register()

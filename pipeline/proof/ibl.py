@@ -23,7 +23,6 @@ import hashlib
 import json
 import math
 import os
-import tempfile
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,6 +31,8 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from lookdev.materials.errors import LookdevError
+
+from .contact import ProofImageError, write_exr
 
 GENERATOR_VERSION = 1  # bump when the generator's maths changes: invalidates the cache
 DEFAULT_WIDTH = 512
@@ -265,24 +266,6 @@ def _key(defn: IblDefinition, width: int) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:12]
 
 
-def write_exr(pixels: np.ndarray, path: Path) -> Path:
-    """Write (H, W, C) float32 as an EXR atomically: a temporary name, then a rename."""
-    import OpenImageIO as oiio
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(suffix=".exr", prefix=f".{path.stem}.", dir=path.parent)
-    os.close(fd)
-    try:
-        buf = oiio.ImageBuf(np.ascontiguousarray(pixels, dtype=np.float32))
-        if not buf.write(tmp, oiio.FLOAT):
-            raise IblError(f"cannot write: {buf.geterror()}", where=str(path))
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return path
-
-
 def resolve(name_or_path: str | Path, width: int = DEFAULT_WIDTH) -> Path:
     """The lat-long file of an IBL: a user's .exr/.hdr as given, a built-in generated once.
 
@@ -299,8 +282,8 @@ def resolve(name_or_path: str | Path, width: int = DEFAULT_WIDTH) -> Path:
     if not out.is_file():
         try:
             write_exr(generate(defn, width), out)
-        except OSError as exc:
-            raise IblError(f"cannot write the IBL cache ({exc.strerror})", where=str(out)) from None
+        except ProofImageError as exc:
+            raise IblError(f"cannot cache the IBL ({exc.message})", where=str(out)) from None
     return out
 
 

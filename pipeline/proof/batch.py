@@ -1,0 +1,315 @@
+"""Batch proofs: materials × IBLs, one turntable each, on any ``concurrent.futures.Executor``.
+
+Layout of an output folder::
+
+    OUT/manifest.json                    the batch: one entry per material × IBL
+    OUT/<material>/<ibl>/frame_NNN.exr   scene-linear frames
+    OUT/<material>/<ibl>/frame_NNN.png   the same through the proof view transform
+    OUT/<material>/<ibl>/contact.png     all frames of the turntable, labelled
+    OUT/<material>/<ibl>/manifest.json   every frame: files (size, SHA-256), render
+                                         time, noise estimate; the settings' key
+
+A job (one material under one IBL) loads its scene once and renders only the frames its
+manifest does not vouch for: a frame counts as done when its manifest entry exists, the
+settings key matches, and both files have the recorded size and hash. Files are written
+under temporary names and renamed, and a frame enters the manifest only after both of its
+files are complete, so an interruption never leaves a frame that looks finished.
+
+A local process pool runs jobs by default; ``Client(address).get_executor()`` runs them on
+a Dask cluster (the output folder must then be shared by the workers).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import multiprocessing
+import os
+import traceback
+from collections.abc import Callable, Iterator
+from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
+from contextlib import contextmanager
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lookdev.materials.errors import LookdevError
+
+from . import contact, tonemap
+from .turntable import Frame, frames
+
+MANIFEST = "manifest.json"
+FORMAT_VERSION = 1
+
+
+class ProofError(LookdevError):
+    """A proof cannot run as asked (output folder, settings, scheduler)."""
+
+
+@dataclass(frozen=True)
+class Settings:
+    """What every turntable of a batch shares."""
+
+    element_frames: int = 8
+    light_frames: int = 8
+    spp: int = 32
+    resolution: tuple[int, int] = (192, 96)
+    exposure: float = 0.0  # display only: applied by the view transform, not the render
+
+    def frames(self) -> list[Frame]:
+        return frames(self.element_frames, self.light_frames)
+
+
+@dataclass
+class Job:
+    """One material under one IBL; everything a worker needs, picklable."""
+
+    material: Any  # lookdev.library.Material
+    ibl: str
+    environment: np.ndarray
+    folder: Path
+    settings: Settings
+    key: str = field(init=False)
+
+    def __post_init__(self) -> None:
+        h = hashlib.sha256()
+        h.update(json.dumps([FORMAT_VERSION, asdict(self.settings)], sort_keys=True).encode())
+        h.update(self.material.model_dump_json().encode())
+        h.update(np.ascontiguousarray(self.environment).tobytes())
+        self.key = h.hexdigest()[:16]
+
+
+# -- manifests -----------------------------------------------------------------------------
+def file_entry(path: Path) -> dict[str, Any]:
+    """``{"file", "size", "sha256"}`` of a written file."""
+    data = path.read_bytes()
+    return {"file": path.name, "size": len(data), "sha256": hashlib.sha256(data).hexdigest()}
+
+
+def _still_valid(folder: Path, entry: dict[str, Any]) -> bool:
+    path = folder / entry["file"]
+    try:
+        return path.stat().st_size == entry["size"] and file_entry(path) == entry
+    except (OSError, KeyError, TypeError):
+        return False
+
+
+def read_manifest(folder: Path, key: str) -> dict[int, dict[str, Any]]:
+    """Frames of ``folder``'s manifest still valid under settings ``key``, by index."""
+    try:
+        doc = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return {}
+    if not isinstance(doc, dict) or doc.get("key") != key:
+        return {}
+    done = {}
+    for entry in doc.get("frames", []):
+        files = [entry.get("exr"), entry.get("png")]
+        if all(isinstance(f, dict) and _still_valid(folder, f) for f in files):
+            done[int(entry["index"])] = entry
+    return done
+
+
+def write_json(doc: dict[str, Any], path: Path) -> None:
+    """Write ``doc`` as JSON atomically (a temporary name, then a rename)."""
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp.write_text(json.dumps(doc, indent=2) + "\n", encoding="utf-8")
+    os.replace(tmp, path)
+
+
+# -- one job (runs in a worker) ------------------------------------------------------------
+def run_job(job: Job) -> dict[str, Any]:
+    """Render the frames of ``job`` that are not done yet; its manifest, as written."""
+    from lookdev.pipeline.variant import use_mitsuba
+
+    variant = use_mitsuba()
+    folder = job.folder
+    folder.mkdir(parents=True, exist_ok=True)
+    done = read_manifest(folder, job.key)
+    todo = [f for f in job.settings.frames() if f.index not in done]
+    doc = {
+        "material": job.material.name,
+        "model": job.material.model,
+        "ibl": job.ibl,
+        "key": job.key,
+        "variant": variant,
+        "settings": asdict(job.settings),
+        "frames": [done[i] for i in sorted(done)],
+    }
+    rendered = 0
+    if todo:
+        for entry in _render(job, todo):
+            doc["frames"] = sorted([*doc["frames"], entry], key=lambda e: e["index"])
+            write_json(doc, folder / MANIFEST)
+            rendered += 1
+    doc["contact_sheet"] = file_entry(_sheet(job, doc))
+    write_json(doc, folder / MANIFEST)
+    return doc | {"rendered": rendered, "skipped": len(done)}
+
+
+def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
+    """Build the scene once, then render and write each frame; yields manifest entries."""
+    from .turntable import Turntable, material_bsdf, render_frame
+
+    bsdf, depth = material_bsdf(job.material)
+    table = Turntable(bsdf, job.environment, job.settings.resolution, depth)
+    for frame in todo:
+        r = render_frame(table, frame, job.settings.spp, seed=frame.index)
+        stem = job.folder / f"frame_{frame.index:03d}"
+        exr = contact.write_exr(r.image, stem.with_suffix(".exr"))
+        display = tonemap.view(r.image, job.settings.exposure)
+        png = contact.write_png(display, stem.with_suffix(".png"))
+        yield {
+            "index": frame.index,
+            "kind": frame.kind,
+            "angle": frame.angle,
+            "exr": file_entry(exr),
+            "png": file_entry(png),
+            "seconds": round(r.seconds, 4),
+            "noise_rmse": r.noise_rmse,
+            "noise_relative": r.noise_relative,
+        }
+
+
+def _sheet(job: Job, doc: dict[str, Any]) -> Path:
+    import OpenImageIO as oiio
+
+    images, labels = [], []
+    for entry in doc["frames"]:
+        buf = oiio.ImageBuf(str(job.folder / entry["png"]["file"]))
+        images.append(buf.get_pixels(oiio.FLOAT)[..., :3])
+        labels.append(f"{entry['kind']} {entry['angle']:.0f}°")
+    title = f"{job.material.name} × {job.ibl}  ({job.settings.spp} spp)"
+    columns = max(job.settings.element_frames, job.settings.light_frames)
+    sheet = contact.contact_sheet(images, labels, title, columns)
+    return contact.write_png(sheet, job.folder / "contact.png")
+
+
+# -- a batch (runs in the parent) ----------------------------------------------------------
+def check_writable(out: Path) -> None:
+    """Fail early, in one line, when ``out`` cannot hold the proofs."""
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        probe = out / f".lookdev-write-test-{os.getpid()}"
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as exc:
+        raise ProofError(
+            f"output folder is not writable ({exc.strerror or exc})", where=str(out)
+        ) from None
+
+
+def _slug(name: str) -> str:
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or "unnamed"
+
+
+def make_jobs(
+    materials: list[Any], environments: list[Any], out: Path, settings: Settings
+) -> list[Job]:
+    """Every material under every environment (``ibl.Environment``), in that order."""
+    return [
+        Job(m, env.name, env.pixels, out / _slug(m.name) / _slug(env.name), settings)
+        for m in materials
+        for env in environments
+    ]
+
+
+@contextmanager
+def executor_for(scheduler: str | None, workers: int | None) -> Iterator[Executor]:
+    """A Dask cluster's executor for ``scheduler``, else a local process pool.
+
+    Local workers are spawned, not forked: a forked Dr.Jit/LLVM runtime is not safe.
+    """
+    if scheduler:
+        try:
+            from distributed import Client
+
+            client = Client(scheduler, timeout="10s")
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise ProofError(f"cannot reach the scheduler ({exc})", where=scheduler) from None
+        try:
+            yield client.get_executor()
+        finally:
+            client.close()
+        return
+    ctx = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=workers or default_workers(), mp_context=ctx) as pool:
+        yield pool
+
+
+def default_workers() -> int:
+    """Half the cores (Dr.Jit threads each render across all of them), at least one."""
+    return max(1, (os.cpu_count() or 1) // 2)
+
+
+def run_batch(
+    jobs: list[Job],
+    executor: Executor,
+    on_done: Callable[[Job, dict[str, Any]], None] | None = None,
+) -> list[dict[str, Any]]:
+    """Run ``jobs`` on ``executor``; their manifests in job order.
+
+    The first failing job cancels those not started and its error is raised (a
+    :class:`LookdevError` keeps its one line).
+    """
+    futures: dict[Future, int] = {executor.submit(run_job, job): i for i, job in enumerate(jobs)}
+    results: list[dict[str, Any] | None] = [None] * len(jobs)
+    try:
+        for fut in as_completed(futures):
+            i = futures[fut]
+            results[i] = _result(fut, jobs[i])
+            if on_done is not None:
+                on_done(jobs[i], results[i])
+    except BaseException:
+        for fut in futures:
+            fut.cancel()
+        raise
+    return [r for r in results if r is not None]
+
+
+def _result(fut: Future, job: Job) -> dict[str, Any]:
+    """A job's manifest; a crash becomes one line, its traceback goes to ``error.log``."""
+    try:
+        return fut.result()
+    except LookdevError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - any worker crash is reported the same way
+        log = job.folder / "error.log"
+        job.folder.mkdir(parents=True, exist_ok=True)
+        log.write_text("".join(traceback.format_exception(exc)), encoding="utf-8")
+        first = str(exc).splitlines()[0] if str(exc) else ""
+        raise ProofError(
+            f"rendering failed ({type(exc).__name__}: {first}); traceback in {log}",
+            where=f"{job.material.name} × {job.ibl}",
+        ) from None
+
+
+def summary(out: Path, jobs: list[Job], results: list[dict[str, Any]], seconds: float) -> dict:
+    """The batch manifest: one entry per job, with totals; written to ``OUT/manifest.json``."""
+    entries = []
+    for job, doc in zip(jobs, results, strict=True):
+        times = [f["seconds"] for f in doc["frames"]]
+        noise = [f["noise_relative"] for f in doc["frames"]]
+        entries.append(
+            {
+                "material": doc["material"],
+                "ibl": doc["ibl"],
+                "folder": str(job.folder.relative_to(out)),
+                "frames": len(doc["frames"]),
+                "rendered": doc["rendered"],
+                "skipped": doc["skipped"],
+                "render_seconds": round(sum(times), 3),
+                "mean_noise_relative": float(np.mean(noise)) if noise else None,
+                "contact_sheet": str(job.folder.relative_to(out) / "contact.png"),
+            }
+        )
+    doc = {
+        "version": FORMAT_VERSION,
+        "wall_seconds": round(seconds, 3),
+        "settings": asdict(jobs[0].settings) if jobs else {},
+        "proofs": entries,
+    }
+    write_json(doc, out / MANIFEST)
+    return doc

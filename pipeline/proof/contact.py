@@ -1,0 +1,180 @@
+"""Labelled contact sheets of proof frames (OpenImageIO).
+
+A sheet is a title bar, then the frames in a grid, each with its label underneath.
+Text is drawn with OpenImageIO's ``ImageBufAlgo.render_text`` (FreeType, the DroidSans
+fonts OpenImageIO ships with); where no font can be found, a built-in 3×5 pixel font
+still labels every frame, so a sheet is never unlabelled.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from lookdev.materials.errors import LookdevError
+
+BACKGROUND = 0.08
+TEXT = (0.92, 0.92, 0.92)
+GAP = 4
+_UMASK = os.umask(0o022)
+os.umask(_UMASK)
+
+# 3×5 glyphs, rows top to bottom, '#' = ink. Lower case is drawn as upper case.
+_GLYPHS = {
+    "A": ".#.#.#####.##.#",
+    "B": "##.#.###.#.###.",
+    "C": ".###..#..#...##",
+    "D": "##.#.##.##.###.",
+    "E": "####..###..####",
+    "F": "####..###..#...",
+    "G": ".###..#.##.#.##",
+    "H": "#.##.#####.##.#",
+    "I": "###.#..#..#.###",
+    "J": "..#..#..##.#.#.",
+    "K": "#.##.###.#.##.#",
+    "L": "#..#..#..#..###",
+    "M": "#.#####.##.##.#",
+    "N": "##.#.##.##.##.#",
+    "O": ".#.#.##.##.#.#.",
+    "P": "##.#.###.#..#..",
+    "Q": ".#.#.##.##.#..#",
+    "R": "##.#.###.#.##.#",
+    "S": ".###...#...###.",
+    "T": "###.#..#..#..#.",
+    "U": "#.##.##.##.####",
+    "V": "#.##.##.##.#.#.",
+    "W": "#.##.##.#####.#",
+    "X": "#.##.#.#.#.##.#",
+    "Y": "#.##.#.#..#..#.",
+    "Z": "###..#.#.#..###",
+    "0": "####.##.##.####",
+    "1": ".#.##..#..#.###",
+    "2": "##...#.#.#..###",
+    "3": "##...#.#...###.",
+    "4": "#.##.####..#..#",
+    "5": "####..##...###.",
+    "6": ".###..####.####",
+    "7": "###..#..#.#..#.",
+    "8": "####.#####.####",
+    "9": "####.####..###.",
+    ".": "............#..",
+    ",": "..........#.#..",
+    "-": "......###......",
+    "_": "............###",
+    "/": "..#..#.#.#..#..",
+    ":": "....#.....#....",
+    "×": "...#.#.#.#.#...",
+    "°": "###.#.###......",
+    "(": ".#.#..#..#...#.",
+    ")": ".#...#..#..#.#.",
+    "+": "....#.###.#....",
+    " ": "...............",
+}
+
+
+class ProofImageError(LookdevError):
+    """A proof image (frame, sheet) cannot be assembled or written."""
+
+
+def _glyph(ch: str) -> np.ndarray:
+    rows = _GLYPHS.get(ch.upper(), _GLYPHS["-"])
+    return np.array([c == "#" for c in rows], dtype=bool).reshape(5, 3)
+
+
+def bitmap_text(text: str, scale: int) -> np.ndarray:
+    """A boolean ink mask (5·scale, 4·scale·len) of ``text`` in the built-in 3×5 font.
+
+    >>> bitmap_text("A1", 1).shape
+    (5, 8)
+    """
+    cells = [np.pad(_glyph(ch), ((0, 0), (0, 1))) for ch in text] or [np.zeros((5, 4), bool)]
+    ink = np.concatenate(cells, axis=1)
+    return np.kron(ink, np.ones((scale, scale), dtype=bool))
+
+
+def draw_text(canvas: np.ndarray, x: int, y: int, text: str, size: int) -> None:
+    """Draw ``text`` with its baseline at (x, y) into a float (H, W, 3) canvas, in place.
+
+    FreeType through OpenImageIO when a font is found, else the built-in bitmap font.
+    """
+    import OpenImageIO as oiio
+
+    buf = oiio.ImageBuf(np.ascontiguousarray(canvas, dtype=np.float32))
+    if oiio.ImageBufAlgo.render_text(buf, x, y, text, size, "DroidSans", TEXT):
+        canvas[...] = buf.get_pixels(oiio.FLOAT)
+        return
+    scale = max(1, size // 6)
+    ink = bitmap_text(text, scale)
+    top = max(0, y - ink.shape[0])
+    region = canvas[top : top + ink.shape[0], x : x + ink.shape[1]]
+    region[ink[: region.shape[0], : region.shape[1]]] = TEXT
+
+
+def contact_sheet(
+    images: list[np.ndarray], labels: list[str], title: str, columns: int
+) -> np.ndarray:
+    """Frames (H, W, 3) in [0, 1] on a grid with a label under each and a title on top."""
+    if not images or len(images) != len(labels):
+        raise ProofImageError("a contact sheet needs one label per frame and a frame")
+    h, w = images[0].shape[:2]
+    columns = max(1, min(columns, len(images)))
+    rows = -(-len(images) // columns)
+    label_h = max(12, h // 8)
+    title_h = max(16, h // 5)
+    cell_h, cell_w = h + label_h + GAP, w + GAP
+    sheet = np.full((title_h + rows * cell_h + GAP, columns * cell_w + GAP, 3), BACKGROUND)
+    for i, (img, label) in enumerate(zip(images, labels, strict=True)):
+        r, c = divmod(i, columns)
+        y, x = title_h + r * cell_h, GAP + c * cell_w
+        sheet[y : y + h, x : x + w] = img[..., :3]
+        draw_text(sheet, x + 2, y + h + label_h - 3, label, max(8, label_h - 3))
+    draw_text(sheet, GAP + 2, title_h - 4, title, max(10, title_h - 6))
+    return sheet.astype(np.float32)
+
+
+def _atomic_write(path: Path, suffix: str, write) -> Path:
+    """Call ``write(tmp)`` on a hidden temporary beside ``path``, then rename it over.
+
+    A frame is either complete under its name or absent: an interruption leaves only a
+    hidden temporary, which nothing reads.
+    """
+    path = Path(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(suffix=suffix, prefix=f".{path.stem}.", dir=path.parent)
+        os.close(fd)
+    except OSError as exc:
+        raise ProofImageError(f"cannot write ({exc.strerror})", where=str(path)) from None
+    try:
+        error = write(tmp)
+        if error is not None:
+            raise ProofImageError(f"cannot write: {error}", where=str(path))
+        os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp makes 0600; a frame is a normal file
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return path
+
+
+def write_exr(pixels: np.ndarray, path: Path) -> Path:
+    """Write scene-linear (H, W, C) pixels as a float EXR, atomically."""
+    import OpenImageIO as oiio
+
+    buf = oiio.ImageBuf(np.ascontiguousarray(pixels, dtype=np.float32))
+    return _atomic_write(
+        path, ".exr", lambda tmp: None if buf.write(tmp, oiio.FLOAT) else buf.geterror()
+    )
+
+
+def write_png(display: np.ndarray, path: Path) -> Path:
+    """Write display-referred [0, 1] RGB as an 8-bit PNG, atomically."""
+    import OpenImageIO as oiio
+
+    from .tonemap import to_8bit
+
+    buf = oiio.ImageBuf(np.ascontiguousarray(to_8bit(display)))
+    return _atomic_write(path, ".png", lambda tmp: None if buf.write(tmp) else buf.geterror())
