@@ -62,7 +62,8 @@ def dielectric(xp: Any, cos_i: Any, eta: Any) -> Any:
     c_i = xp.minimum(xp.abs(cos_i), 1.0)
     sin2_t = (1.0 - c_i * c_i) / (eta * eta)
     c_t = xp.safe_sqrt(1.0 - sin2_t)
-    r_par = (eta * c_i - c_t) / (eta * c_i + c_t)
-    r_perp = (c_i - eta * c_t) / (c_i + eta * c_t)
+    # Both denominators vanish only at grazing incidence with η = 1, which is TIR here.
+    r_par = (eta * c_i - c_t) / xp.maximum(eta * c_i + c_t, xp.tiny)
+    r_perp = (c_i - eta * c_t) / xp.maximum(c_i + eta * c_t, xp.tiny)
     f = 0.5 * (r_par * r_par + r_perp * r_perp)
     return xp.select(sin2_t >= 1.0, 1.0, f)

@@ -144,12 +144,14 @@ def _gauss_cells(pdf_at, cells: np.ndarray) -> np.ndarray:
     return np.einsum("nij,i,j->n", vals, _GL_W, _GL_W) * hc * hp
 
 
-def _split(cells: np.ndarray) -> np.ndarray:
-    """Each cell → its four quarters, as rows 4k..4k+3."""
-    c0, c1, p0, p1 = cells.T
-    cm, pm = 0.5 * (c0 + c1), 0.5 * (p0 + p1)
-    quads = [(c0, cm, p0, pm), (c0, cm, pm, p1), (cm, c1, p0, pm), (cm, c1, pm, p1)]
-    return np.stack([np.stack(q, axis=-1) for q in quads], axis=1).reshape(-1, 4)
+def _halves(cells: np.ndarray, axis: int) -> np.ndarray:
+    """Each cell → its two halves along cos θ (axis 0) or φ (axis 1), as rows 2k, 2k+1."""
+    lo, hi = cells[:, 2 * axis], cells[:, 2 * axis + 1]
+    mid = 0.5 * (lo + hi)
+    a, b = cells.copy(), cells.copy()
+    a[:, 2 * axis + 1] = mid
+    b[:, 2 * axis] = mid
+    return np.stack([a, b], axis=1).reshape(-1, 4)
 
 
 def _counts_in(cells: np.ndarray, c: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -166,9 +168,13 @@ def _counts_in(cells: np.ndarray, c: np.ndarray, p: np.ndarray) -> np.ndarray:
 
 
 def _integrate_bins(
-    pdf_at, res: int, c: np.ndarray, p: np.ndarray, *, tol: float, max_depth: int = 12
+    pdf_at, res: int, c: np.ndarray, p: np.ndarray, *, tol: float, max_depth: int = 40
 ) -> np.ndarray:
-    """∫ pdf over every bin, by adaptive quadrature (see the module docstring)."""
+    """∫ pdf over every bin, by adaptive quadrature (see the module docstring).
+
+    A cell is halved along the axis whose halving changes its estimate most, so a peak
+    at the pole (narrow in cos θ only) costs two cells per level, not four.
+    """
     n_c, n_p = res, 2 * res
     ec = np.linspace(-1.0, 1.0, n_c + 1)
     ep = np.linspace(0.0, TWO_PI, n_p + 1)
@@ -179,19 +185,27 @@ def _integrate_bins(
     total = np.zeros(n_c * n_p)
     n = max(len(c), 1)
     for depth in range(max_depth):
-        kids = _split(cells)
-        fine = _gauss_cells(pdf_at, kids)
-        fine_sum = fine.reshape(-1, 4).sum(axis=1)
-        converged = np.abs(fine_sum - coarse) <= tol
+        kids = [_halves(cells, axis) for axis in (0, 1)]
+        fine = [_gauss_cells(pdf_at, k) for k in kids]
+        sums = [f.reshape(-1, 2).sum(axis=1) for f in fine]
+        err = [np.abs(s - coarse) for s in sums]
+        converged = np.maximum(err[0], err[1]) <= tol
         if depth < max_depth - 1 and len(cells) < 50_000:
             # A cell with samples its quadrature cannot see: the peak fell between nodes.
             seen = _counts_in(cells, c, p)
-            converged &= ~((seen >= 3) & (fine_sum * n < 0.1 * seen))
+            converged &= ~((seen >= 3) & (sums[0] * n < 0.1 * seen))
         else:
             converged[:] = True
-        np.add.at(total, owner[converged], fine_sum[converged])
+        np.add.at(total, owner[converged], sums[0][converged])
         if converged.all():
             break
-        keep = np.repeat(~converged, 4)
-        cells, coarse, owner = kids[keep], fine[keep], np.repeat(owner[~converged], 4)
+        axis = (err[1] > err[0]).astype(int)
+        keep = ~converged
+        pick = np.where(axis[keep, None] == 1, 1, 0)
+        both_kids = np.stack([k.reshape(-1, 2, 4) for k in kids], axis=1)  # (m, axis, 2, 4)
+        both_fine = np.stack([f.reshape(-1, 2) for f in fine], axis=1)  # (m, axis, 2)
+        idx = np.nonzero(keep)[0]
+        cells = both_kids[idx, pick[:, 0]].reshape(-1, 4)
+        coarse = both_fine[idx, pick[:, 0]].reshape(-1)
+        owner = np.repeat(owner[idx], 2)
     return total.reshape(n_c, n_p)
