@@ -59,6 +59,17 @@ def batch(tmp_path: Path) -> Path:
                             rng.integers(0, 255, (16, 16, 3), dtype=np.uint8),
                         ).name
                     )
+            if material == "gold":  # frames as objects, as the proof module writes them
+                frames = [
+                    {
+                        "path": f,
+                        "kind": "element",
+                        "angle": 120.0 * k,
+                        "seconds": 0.5,
+                        "noise_relative": 0.01 * (k + 1),
+                    }
+                    for k, f in enumerate(frames)
+                ]
             manifest = {
                 "material": material,
                 "ibl": ibl,
@@ -82,6 +93,8 @@ def test_manifests_become_entries_with_their_frames(batch):
         ("gold", "sunset"),
     ]
     assert all(len(e.frames) == 3 for e in entries)
+    assert [c for _, c in entries[2].frames] == ["element 0°", "element 120°", "element 240°"]
+    assert [c for _, c in entries[0].frames] == ["frame_000", "frame_001", "frame_002"]
 
 
 def test_time_noise_table_has_every_scalar_of_the_manifests(batch):
@@ -89,6 +102,11 @@ def test_time_noise_table_has_every_scalar_of_the_manifests(batch):
     assert columns[:2] == ["material", "ibl"]
     assert {"spp", "timing.seconds", "timing.per_frame", "noise.relative_mse"} <= set(columns)
     assert rows[0][columns.index("noise.relative_mse")] == "0.0123"
+    # per-frame numbers are summarised: times summed, noise averaged
+    gold = rows[2]
+    assert gold[columns.index("frames.seconds (sum)")] == "1.5"
+    assert gold[columns.index("frames.noise_relative (mean)")] == "0.02"
+    assert gold[columns.index("frames")] == "3"
 
 
 def test_exr_frames_get_srgb_thumbnails(batch, tmp_path):

@@ -32,7 +32,7 @@ import numpy as np  # noqa: E402
 from lookdev.materials.bsdf import Model, evaluate  # noqa: E402
 from lookdev.materials.errors import LookdevError  # noqa: E402
 
-from .albedo import albedo_monte_carlo, albedo_quadrature, albedo_tabulated  # noqa: E402
+from .albedo import albedo_monte_carlo, albedo_tabulated  # noqa: E402
 from .sphere import REC709_Y, ibl_sphere, point_light_sphere  # noqa: E402
 
 VIEWS = ("slice", "albedo", "polar", "sphere")
@@ -150,29 +150,29 @@ def draw_slice(ax: Any, subject: Subject, *, exposure: float = 0.0, n: int = 128
 
 
 # -- albedo --------------------------------------------------------------------------
+ALBEDO_SAMPLES = 2048
+
+
 def albedo_curves(subject: Subject, n_theta: int = 46) -> list:
-    """Quadrature, and where they exist the Monte Carlo and tabulated curves, 0..89.5°."""
+    """The albedo curve(s) drawn, 0..89.5°: Monte Carlo, and the shipped table if any.
+
+    The curve is the model's own importance-sampled estimate: unbiased at any roughness,
+    where a fixed quadrature grid misses the narrow peaks of glossy lobes (``lookdev
+    bench error`` measures by how much).
+    """
     theta = np.radians(np.linspace(0.0, 89.5, n_theta))
-    curves = [albedo_quadrature(subject.model, subject.params, theta, n_mu=96, n_phi=96)]
-    curves.append(albedo_monte_carlo(subject.model, subject.params, theta[::5], n_samples=4096))
+    mc = albedo_monte_carlo(subject.model, subject.params, theta, n_samples=ALBEDO_SAMPLES)
     table = albedo_tabulated(subject.model, subject.params, theta)
-    return curves + ([table] if table is not None else [])
+    return [mc] + ([table] if table is not None else [])
 
 
 def draw_albedo(ax: Any, subject: Subject) -> None:
-    quad, mc, *table = albedo_curves(subject)
+    mc, *table = albedo_curves(subject)
+    deg = np.degrees(mc.theta)
     for c, colour in enumerate(CHANNEL_COLOURS):
-        ax.plot(np.degrees(quad.theta), quad.albedo[:, c], color=colour, lw=1.6, label="RGB"[c])
-        ax.errorbar(
-            np.degrees(mc.theta),
-            mc.albedo[:, c],
-            yerr=2 * mc.stderr[:, c],
-            fmt="o",
-            ms=3,
-            color=colour,
-            alpha=0.7,
-            label="MC ±2σ" if c == 0 else None,
-        )
+        ax.plot(deg, mc.albedo[:, c], color=colour, lw=1.6, label="RGB"[c])
+        lo, hi = mc.albedo[:, c] - 2 * mc.stderr[:, c], mc.albedo[:, c] + 2 * mc.stderr[:, c]
+        ax.fill_between(deg, lo, hi, color=colour, alpha=0.2, lw=0, label="±2σ" if c == 0 else None)
         if table:
             ax.plot(
                 np.degrees(table[0].theta),
@@ -183,9 +183,9 @@ def draw_albedo(ax: Any, subject: Subject) -> None:
                 label="table" if c == 0 else None,
             )
     ax.set_xlim(0, 90)
-    ax.set_ylim(0, max(1.05, float(quad.albedo.max()) * 1.1))
+    ax.set_ylim(0, max(1.05, float(mc.albedo.max()) * 1.1))
     ax.set_xlabel("incidence angle θ (°)")
-    ax.set_ylabel("directional albedo")
+    ax.set_ylabel(f"directional albedo (MC, {ALBEDO_SAMPLES} spp)")
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small", loc="lower left")
 
@@ -207,17 +207,40 @@ def polar_curves(
     return theta_o, np.array(rows)
 
 
+POLAR_DECADES = 4
+
+
 def draw_polar(ax: Any, subject: Subject, incidence_deg: Sequence[float] = (0, 30, 60, 80)) -> None:
+    """Luminance of f on a logarithmic radius spanning :data:`POLAR_DECADES` decades.
+
+    A glossy peak is thousands of times its surroundings; on a linear radius it would
+    flatten every other curve and every diffuse material to a dot.
+    """
     theta_o, lum = polar_curves(subject.model, subject.params, incidence_deg)
-    top = float(np.percentile(lum, 99.5)) or 1.0
+    top = math.log10(max(float(lum.max()), 1e-12))
+    floor = top - POLAR_DECADES
     for ti, row in zip(incidence_deg, lum, strict=True):
-        ax.plot(theta_o, np.minimum(row, top * 1.5), lw=1.4, label=f"θi = {ti:g}°")
+        r = np.log10(np.maximum(row, 10.0**floor)) - floor
+        ax.plot(theta_o, r, lw=1.4, label=f"θi = {ti:g}°")
     ax.set_theta_zero_location("N")
     ax.set_theta_direction(-1)
     ax.set_thetamin(-90)
     ax.set_thetamax(90)
-    ax.set_rmax(top * 1.5)
-    ax.legend(fontsize="x-small", loc="lower right")
+    ax.set_rmax(POLAR_DECADES * 1.02)
+    ticks = np.arange(1, POLAR_DECADES + 1)
+    ax.set_rticks(ticks)
+    labels = [f"{10.0 ** (floor + t):.1g}" if t % 2 == 0 else "" for t in ticks]
+    ax.set_yticklabels(labels, fontsize="x-small")
+    ax.text(
+        0.5,
+        -0.02,
+        "f, luminance (log radius)",
+        transform=ax.transAxes,
+        ha="center",
+        va="top",
+        fontsize="x-small",
+    )
+    ax.legend(fontsize="x-small", loc="upper left", bbox_to_anchor=(-0.12, 1.12))
 
 
 # -- sphere --------------------------------------------------------------------------

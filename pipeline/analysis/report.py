@@ -44,7 +44,7 @@ class Entry:
     data: dict[str, Any]
     material: str
     ibl: str
-    frames: list[Path] = field(default_factory=list)
+    frames: list[tuple[Path, str]] = field(default_factory=list)  # (file, caption)
 
 
 # -- reading a batch -----------------------------------------------------------------
@@ -64,19 +64,37 @@ def read_manifests(batch_dir: Path) -> list[Entry]:
     return sorted(entries, key=lambda e: (e.material, e.ibl))
 
 
-def _frames(folder: Path, data: dict[str, Any]) -> list[Path]:
-    """Frame files a manifest lists (any key holding paths), else the images beside it."""
+def _frame_lists(data: dict[str, Any]) -> list[list[Any]]:
+    """Lists under keys naming frames (``frames``, ``element_frames`` …)."""
+    return [v for k, v in data.items() if "frame" in k and isinstance(v, list)]
+
+
+def _frames(folder: Path, data: dict[str, Any]) -> list[tuple[Path, str]]:
+    """(file, caption) of the frames a manifest lists, else of the images beside it.
+
+    A listed frame is a path or an object with ``path`` (or ``file``) and, for the
+    caption, ``label`` or ``kind`` and ``angle``.
+    """
     listed = []
-    for key, value in data.items():
-        if "frame" in key and isinstance(value, list):
-            for item in value:
-                p = item.get("path") if isinstance(item, dict) else item
-                if isinstance(p, str):
-                    listed.append(p if Path(p).is_absolute() else folder / p)
-    paths = [Path(p) for p in listed] or sorted(
-        p for p in folder.iterdir() if p.suffix.lower() in (*WEB_IMAGES, ".exr")
-    )
-    return [p for p in paths if p.is_file() and "contact" not in p.name]
+    for frames in _frame_lists(data):
+        for item in frames:
+            info = item if isinstance(item, dict) else {}
+            p = info.get("path") or info.get("file") if info else item
+            if isinstance(p, str):
+                path = Path(p) if Path(p).is_absolute() else folder / p
+                listed.append((path, _caption(info, path)))
+    if not listed:
+        images = (p for p in folder.iterdir() if p.suffix.lower() in (*WEB_IMAGES, ".exr"))
+        listed = [(p, p.stem) for p in sorted(images)]
+    return [(p, c) for p, c in listed if p.is_file() and "contact" not in p.name]
+
+
+def _caption(info: dict[str, Any], path: Path) -> str:
+    if "label" in info:
+        return str(info["label"])
+    if "kind" in info and "angle" in info:
+        return f"{info['kind']} {float(info['angle']):.0f}°"
+    return path.stem
 
 
 def contact_sheets(batch_dir: Path) -> list[Path]:
@@ -107,14 +125,37 @@ def table_rows(entries: Iterable[Entry]) -> tuple[list[str], list[list[str]]]:
 
 
 def _scalars(data: dict[str, Any], prefix: str = "") -> dict[str, Any]:
-    """Numbers, strings and booleans of a manifest, nested keys joined with dots."""
+    """Numbers, strings and booleans of a manifest, nested keys joined with dots.
+
+    Per-frame numbers are summarised: times (keys with ``seconds`` or ``time``) summed,
+    everything else (noise …) averaged, e.g. ``frames.seconds (sum)``.
+    """
     out: dict[str, Any] = {}
     for k, v in data.items():
         name = f"{prefix}{k}"
         if isinstance(v, dict):
             out.update(_scalars(v, f"{name}."))
+        elif "frame" in k and isinstance(v, list):
+            out.update(_frame_summary(v, name))
         elif isinstance(v, bool | int | float) or (isinstance(v, str) and len(v) < 60):
             out[name] = v
+    return out
+
+
+def _frame_summary(frames: list[Any], name: str) -> dict[str, float]:
+    numbers: dict[str, list[float]] = {}
+    for item in frames:
+        for k, v in item.items() if isinstance(item, dict) else ():
+            if (
+                isinstance(v, int | float)
+                and not isinstance(v, bool)
+                and k not in ("index", "angle")
+            ):
+                numbers.setdefault(k, []).append(float(v))
+    out: dict[str, Any] = {f"{name}": len(frames)} if frames else {}
+    for k, vs in numbers.items():
+        timed = "seconds" in k or "time" in k
+        out[f"{name}.{k} ({'sum' if timed else 'mean'})"] = sum(vs) if timed else sum(vs) / len(vs)
     return out
 
 
@@ -230,7 +271,9 @@ def render_page(batch_dir: Path, entries: list[Entry], sheets: list[Path], plots
         for e in (e for e in entries if e.material == material):
             parts.append(f"<h3>{esc(e.ibl)}</h3><div class=strip>")
             parts += [
-                _img(web_image(f, out), batch_dir, f"{material} {e.ibl} {f.stem}") for f in e.frames
+                f"<figure>{_img(web_image(f, out), batch_dir, f'{material} {e.ibl} {cap}')}"
+                f"<figcaption>{esc(cap)}</figcaption></figure>"
+                for f, cap in e.frames
             ]
             parts.append("</div>")
     parts.append("</body></html>")

@@ -25,14 +25,16 @@ import numpy as np
 from lookdev.materials.bsdf import Model, density, draw, evaluate
 
 REC709_Y = np.array([0.2126, 0.7152, 0.0722])
+MARGIN = 1.08
 
 
 def sphere_normals(resolution: int) -> tuple[np.ndarray, np.ndarray]:
     """World normals (H, W, 3) of the visible hemisphere and the disk mask (H, W).
 
-    Row 0 is the top of the image (+y), pixel centres sample the [-1, 1]² square.
+    Row 0 is the top of the image (+y); pixel centres sample the square
+    [−MARGIN, MARGIN]², so the sphere's silhouette sits inside the frame.
     """
-    c = (np.arange(resolution) + 0.5) / resolution * 2.0 - 1.0
+    c = ((np.arange(resolution) + 0.5) / resolution * 2.0 - 1.0) * MARGIN
     x, y = np.meshgrid(c, -c)
     r2 = x * x + y * y
     inside = r2 < 1.0
@@ -136,7 +138,7 @@ def ibl_sphere(
     environment: np.ndarray,
     *,
     resolution: int = 96,
-    spp: int = 32,
+    spp: int = 64,
     seed: int = 0,
 ) -> np.ndarray:
     """Radiance image (H, W, 3) of the sphere lit by a lat-long environment (H', W', 3).
