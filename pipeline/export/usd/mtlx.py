@@ -18,6 +18,7 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
+from .live import mixed_input
 from .names import SURFACE_IDS, Slot, table_for
 from .network import (
     Connection,
@@ -77,13 +78,26 @@ def build(source: Source) -> Network:
     nodes: list[Node] = []
     node_id = SURFACE_IDS[("mtlx", source.model)]
     table = table_for("mtlx", source.model)
-    inputs = surface_inputs(source, table, node_defaults(node_id), nodes, _texture)
+    inputs = surface_inputs(source, table, node_defaults(node_id), nodes, _live_or_baked(source))
     extra = ""
     if source.normal_map is not None:
         extra = f"{node_id} has no normal input: the normal map is not applied"
     note = loss_note(source, node_id, {s.param for s in table}, extra)
     surface = Node(SURFACE, node_id, inputs, {"out": "token"}, {"loss": note})
     return Network("mtlx", Connection(SURFACE, "out"), [surface, *nodes])
+
+
+def _live_or_baked(source: Source):
+    """The texture factory: a live mix chain where the layers are known, else the map."""
+
+    def texture(nodes: list[Node], slot: Slot, image: Image) -> tuple[str, Any]:
+        if source.layers:
+            chain = mixed_input(nodes, slot, source.layers, "mtlx")
+            if chain is not None:
+                return chain
+        return _texture(nodes, slot, image)
+
+    return texture
 
 
 def _texture(nodes: list[Node], slot: Slot, image: Image) -> tuple[str, Any]:

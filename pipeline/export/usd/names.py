@@ -118,7 +118,7 @@ PREVIEW_DISNEY: tuple[Slot, ...] = (
     Slot("metallic", "metallic", "float"),
     Slot("roughness", "roughness", "float"),
     # F0 = ((ior-1)/(ior+1))² in the spec's dielectric; Burley §5.4 F0 = 0.08·specular.
-    Slot("ior", "ior", "float", lobe="dielectric", texture_linear=None),
+    Slot("ior", "ior", "float", lobe="dielectric"),
     # The spec's clearcoat is a white GGX lobe with F0 0.04 scaled by `clearcoat`;
     # Burley weights his 0.25·clearcoat, so scale by 0.25 to keep the reflected energy.
     Slot(

@@ -86,6 +86,7 @@ class Image:
     path: Path
     pixels: np.ndarray | None = None
     write: bool = False
+    origin: Path | None = None  # a file written elsewhere (a bake) to copy to ``path``
 
 
 @dataclass
@@ -104,6 +105,7 @@ class Source:
     normal_map: Image | None = None
     spelling: str = "specular"
     description: str = ""
+    layers: list[Any] = field(default_factory=list)  # live.LiveLayer, bottom first
 
     @property
     def lobes(self) -> dict[str, bool]:

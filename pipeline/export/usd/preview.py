@@ -18,10 +18,11 @@ from .textures import converted
 
 SURFACE = "preview_surface"
 ST_READER = "preview_st"
-LOBE_SHAPES = (
-    "lobe shapes differ: GGX for Burley's GTR1 clearcoat, the surface's own diffuse "
-    "for Burley's retro-reflective one"
-)
+SHAPE_NOTES = {
+    "clearcoat": "the clearcoat is GGX here, Burley's GTR1 (App. B.2) there",
+    "diffuse": "the diffuse has no retro-reflection (Burley §5.3)",
+}
+"""Lobes whose shape the surface changes, though their weight is kept."""
 
 
 @cache
@@ -47,7 +48,9 @@ def build(source: Source) -> Network:
     if source.normal_map is not None:
         inputs["normal"] = _normal(nodes, source.normal_map)
     mapped = {s.param for s in table}
-    note = loss_note(source, "UsdPreviewSurface", mapped, LOBE_SHAPES)
+    lobes = source.lobes
+    shapes = "; ".join(text for lobe, text in SHAPE_NOTES.items() if lobes[lobe])
+    note = loss_note(source, "UsdPreviewSurface", mapped, shapes)
     surface = Node(SURFACE, "UsdPreviewSurface", inputs, {"surface": "token"})
     surface.custom["loss"] = note
     return Network("universal", Connection(SURFACE, "surface"), [surface, *nodes])

@@ -9,6 +9,7 @@ succeeded, so a failure leaves no partial file (:class:`Staging`).
 from __future__ import annotations
 
 import os
+import shutil
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -164,6 +165,13 @@ class Staging:
     """Files written under temporary names, renamed into place together on commit."""
 
     moves: list[tuple[Path, Path]] = field(default_factory=list)
+    created: list[Path] = field(default_factory=list)
+
+    def folder(self, path: Path) -> None:
+        """Create ``path`` (and parents) if missing; an abort removes what it created."""
+        missing = [p for p in (path, *path.parents) if not p.exists()]
+        path.mkdir(parents=True, exist_ok=True)
+        self.created += reversed(missing)
 
     def temp_for(self, final: Path) -> Path:
         fd, name = tempfile.mkstemp(prefix=f".{final.stem}.", suffix=final.suffix, dir=final.parent)
@@ -180,7 +188,11 @@ class Staging:
     def abort(self) -> None:
         for tmp, _ in self.moves:
             tmp.unlink(missing_ok=True)
+        for folder in reversed(self.created):
+            if folder.is_dir() and not any(folder.iterdir()):
+                folder.rmdir()
         self.moves.clear()
+        self.created.clear()
 
 
 def check_writable(path: Path) -> None:
@@ -278,8 +290,12 @@ def _check_names(specs: list[MaterialSpec], out: Path) -> None:
 def _write_all(specs, images, out, mtlx_path, package, split_dir, staging) -> list[Path]:
     for image in images:
         if image.write:
+            staging.folder(image.path.parent)
             target = image.path if package else staging.temp_for(image.path)
-            write_image(target, image.pixels)
+            if image.origin is not None:
+                shutil.copyfile(image.origin, target)
+            else:
+                write_image(target, image.pixels)
     files = [out, *(i.path for i in images if i.write and not package)]
     if split_dir is not None:
         files += _write_split(specs, out, Path(split_dir), staging)

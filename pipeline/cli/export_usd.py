@@ -1,0 +1,254 @@
+"""``lookdev export usd``, ``lookdev import usd`` and ``lookdev validate usd``."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from enum import StrEnum
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from .common import console, print_json, table
+
+import_app = typer.Typer(
+    help="Read materials written by other tools back into presets.", no_args_is_help=True
+)
+validate_app = typer.Typer(
+    help="Check exported files the way the tools that read them will.", no_args_is_help=True
+)
+
+
+class Context(StrEnum):
+    universal = "universal"
+    mtlx = "mtlx"
+    ri = "ri"
+
+
+def export_usd(
+    presets: Annotated[
+        list[str] | None,
+        typer.Argument(
+            help="Preset names or .toml files (several make a library).", show_default=False
+        ),
+    ] = None,
+    output: Annotated[
+        Path,
+        typer.Option("--output", "-o", help="USD file: .usda, .usdc, .usd, or .usdz (packaged)."),
+    ] = Path("materials.usda"),
+    context: Annotated[
+        list[Context] | None,
+        typer.Option(
+            "--context",
+            "-c",
+            help="Render context to write; repeat for several (default: all three).",
+        ),
+    ] = None,
+    mtlx_file: Annotated[
+        Path | None,
+        typer.Option("--mtlx", help="Also write the MaterialX networks as a standalone .mtlx."),
+    ] = None,
+    bake_maps: Annotated[
+        bool,
+        typer.Option("--bake", help="Layered presets: bake blended parameter maps and read those."),
+    ] = False,
+    resolution: Annotated[
+        int, typer.Option("--map-resolution", min=1, max=16384, help="Texels a side of baked maps.")
+    ] = 1024,
+    package: Annotated[
+        bool, typer.Option("--package", help="Write a .usdz holding the stage and its textures.")
+    ] = False,
+    split: Annotated[
+        Path | None,
+        typer.Option(
+            "--split",
+            help="One file per material in this folder; -o becomes a library that references "
+            "them, with a variant set 'preset' on /Look to switch between them.",
+        ),
+    ] = None,
+    all_presets: Annotated[
+        bool, typer.Option("--all", help="Export every preset of the library.")
+    ] = False,
+    library: Annotated[
+        list[Path] | None,
+        typer.Option("--library", "-L", help="Extra preset folders searched before the built-ins."),
+    ] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+) -> None:
+    """Write presets as UsdShade materials that DCCs and their renderers read.
+
+    Each preset becomes /Materials/NAME with up to three render contexts: [bold]universal[/]
+    (UsdPreviewSurface, read everywhere; what it cannot express is named in the surface's
+    customData), [bold]mtlx[/] (MaterialX ND_disney_principled) and [bold]ri[/] (RenderMan
+    PxrDisneyBsdf). Only what a material needs is written: inputs at the target's
+    default and lobes without weight are left out. Layered presets are blended and their
+    varying parameters baked to EXR maps beside the file (UsdPreviewSurface has no mix
+    node). With several presets, /Look carries a variant set that switches between them.
+
+    Examples:
+
+      lookdev export usd gold -o gold.usda
+
+      lookdev export usd gold copper glass_clear -o metals.usda --context universal
+
+      lookdev export usd --all -o library.usda --split materials/ --mtlx library.mtlx
+
+      lookdev export usd rusty_iron -o rust.usdz --package
+    """
+    from lookdev.library import Library, load_material
+    from lookdev.pipeline.export.usd.network import CONTEXTS, ExportError
+    from lookdev.pipeline.export.usd.sources import source_for
+    from lookdev.pipeline.export.usd.writer import export_usd as write
+
+    lib = Library(library or None)
+    names = list(presets or [])
+    if all_presets:
+        names += [n for n in lib.names() if n not in names]
+    if not names:
+        raise ExportError("name at least one preset, or give --all", field="PRESETS")
+    contexts = tuple(c.value for c in context) if context else CONTEXTS
+    out = output.expanduser()
+    with tempfile.TemporaryDirectory(prefix=".lookdev-bake-", dir=_existing(out)) as scratch:
+        textures = f"{out.stem}_textures"
+        texture_dir = Path(scratch, textures) if package else out.parent / textures
+        sources = []
+        for name in _progress(names, "reading presets", as_json):
+            material = load_material(name, lib)
+            sources.append(
+                source_for(material, texture_dir, resolution, scratch=Path(scratch), bake=bake_maps)
+            )
+        result = write(
+            sources, out, contexts=contexts, mtlx_path=mtlx_file, package=package, split_dir=split
+        )
+    summary = {
+        "output": str(result.files[0]),
+        "files": [str(p) for p in result.files],
+        "materials": result.materials,
+        "contexts": list(contexts),
+        "textures": [str(p) for p in result.images],
+    }
+    if as_json:
+        print_json(summary)
+        return
+    console.print(
+        f"wrote [bold]{result.files[0]}[/]: {len(result.materials)} materials, "
+        f"contexts {', '.join(contexts)}, {len(result.images)} textures"
+    )
+    for extra in result.files[1:]:
+        console.print(f"  {extra}", highlight=False)
+
+
+def _existing(out: Path) -> str:
+    """The output's folder if it exists (scratch space beside it), else the system temp."""
+    return str(out.parent) if out.parent.is_dir() and os.access(out.parent, os.W_OK) else None
+
+
+def _progress(items: list[str], label: str, quiet: bool):
+    if quiet or len(items) < 8:
+        return items
+    from rich.progress import track
+
+    return track(items, description=label, console=console, transient=True)
+
+
+@import_app.command("usd")
+def import_usd(
+    file: Annotated[Path, typer.Argument(help="USD file with UsdShade materials.")],
+    output: Annotated[
+        Path | None,
+        typer.Option(
+            "--output",
+            "-o",
+            help="Preset .toml to write (a folder when the file holds several materials); "
+            "default: print the TOML.",
+        ),
+    ] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+) -> None:
+    """Read materials from a USD file back into presets.
+
+    Reads UsdPreviewSurface networks from any tool, and lookdev's own MaterialX and
+    RenderMan networks, which carry every parameter. A parameter fed by a texture is
+    listed with its map's path (a preset holds constants; bake the map into a layered
+    preset to use it).
+
+    Examples:
+
+      lookdev import usd gold.usda
+
+      lookdev import usd library.usda -o imported/
+    """
+    from lookdev.pipeline.export.usd.presets import write_presets
+    from lookdev.pipeline.export.usd.reader import import_usd as read
+
+    found = read(file.expanduser())
+    written = write_presets(found, output)
+    if as_json:
+        print_json(
+            {
+                "file": str(file),
+                "materials": [
+                    {
+                        "name": m.name,
+                        "model": m.model,
+                        "params": m.params,
+                        "maps": {k: str(v) for k, v in m.maps.items()},
+                        "contexts": m.contexts,
+                        "loss": m.loss,
+                    }
+                    for m in found
+                ],
+                "written": [str(p) for p in written],
+            }
+        )
+        return
+    if output is None:
+        from lookdev.pipeline.export.usd.presets import preset_toml
+
+        for m in found:
+            typer.echo(preset_toml(m))
+        return
+    for path in written:
+        console.print(f"wrote [bold]{path}[/]")
+
+
+@validate_app.command("usd")
+def validate_usd(
+    file: Annotated[Path, typer.Argument(help="USD file to check.")],
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+) -> None:
+    """Run every validator usd-core registers, and MaterialX's own check on mtlx networks.
+
+    usd-core cannot know MaterialX (ND_*) or RenderMan (Pxr*) shader ids, so their
+    MissingShaderIdInRegistry errors are expected and listed apart; every other error
+    fails. Exit code 0 when valid, 1 when not.
+    """
+    from lookdev.pipeline.export.usd.validate import validate_usd as check
+
+    report = check(file.expanduser())
+    if as_json:
+        print_json(
+            {
+                "file": report.path,
+                "ok": report.ok,
+                "validators": report.validators,
+                "errors": report.errors,
+                "warnings": report.warnings,
+                "allowed": report.allowed,
+                "mtlx_networks": report.mtlx_networks,
+            }
+        )
+    else:
+        rows = [
+            ["errors", len(report.errors)],
+            ["warnings", len(report.warnings)],
+            ["expected (MaterialX/RenderMan ids)", len(report.allowed)],
+            ["MaterialX networks checked", report.mtlx_networks],
+        ]
+        console.print(table(f"{file} — {report.validators} validators", ["check", "count"], rows))
+        for line in report.errors + report.warnings:
+            console.print(f"  {line}", markup=False, highlight=False)
+        console.print("[green]valid[/]" if report.ok else "[red]not valid[/]")
+    if not report.ok:
+        raise typer.Exit(1)

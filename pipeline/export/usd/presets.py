@@ -1,0 +1,79 @@
+"""Imported materials as preset files (TOML), written safely.
+
+A preset holds constants; a parameter a texture fed in the USD file is kept as a
+comment naming the map, so nothing read is silently dropped.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import tempfile
+from pathlib import Path
+
+from lookdev.library import PresetFile, dump_preset
+
+from .network import ExportError
+from .reader import Imported
+
+
+def preset_name(name: str) -> str:
+    """A valid preset name for an imported material name.
+
+    >>> preset_name("Car Paint (red)")
+    'Car_Paint_red'
+    """
+    safe = re.sub(r"[^A-Za-z0-9_-]+", "_", name).strip("_-")[:100]
+    return safe or "imported"
+
+
+def preset_toml(material: Imported) -> str:
+    """The preset file text of one imported material."""
+    preset = PresetFile(
+        name=preset_name(material.name),
+        model=material.model,
+        description=f"Imported from USD ({', '.join(material.contexts)}).",
+        params=dict(material.params),
+    )
+    text = dump_preset(preset)
+    notes = [
+        f"# map: {k} = {str(v)!r} (constant here: the map's mean is not known)"
+        for k, v in sorted(material.maps.items())
+    ]
+    notes += [f"# loss: {line}" for line in material.loss]
+    return text + ("\n" + "\n".join(notes) + "\n" if notes else "")
+
+
+def write_presets(found: list[Imported], output: Path | None) -> list[Path]:
+    """Write each material to ``output`` (a .toml for one, a folder for several)."""
+    if output is None:
+        return []
+    output = output.expanduser()
+    if output.suffix == ".toml":
+        if len(found) != 1:
+            raise ExportError(
+                f"the file holds {len(found)} materials; give a folder with -o", where=str(output)
+            )
+        targets = [output]
+    else:
+        if not output.is_dir():
+            raise ExportError("folder does not exist (or give a .toml file)", where=str(output))
+        targets = [output / f"{preset_name(m.name)}.toml" for m in found]
+    texts = [preset_toml(m) for m in found]
+    for path in targets:
+        if not path.parent.is_dir() or not os.access(path.parent, os.W_OK):
+            raise ExportError("folder does not exist or is not writable", where=str(path))
+    for path, text in zip(targets, texts, strict=True):
+        _write_atomic(path, text)
+    return targets
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".toml", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as handle:
+            handle.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise

@@ -1,0 +1,94 @@
+"""Library materials → :class:`~.network.Source`: constants, or baked blends.
+
+A disney material is all constants. A layered one goes through the blending engine
+(issue 5): :func:`lookdev.pipeline.blend.blend` gives constants where uniform and maps
+where a parameter varies, :func:`lookdev.pipeline.blend.bake` writes those maps as EXRs
+beside the exported file, and the networks read them. UsdPreviewSurface has no mix node,
+so the universal context always reads the baked parameter maps.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lookdev.materials.params import DisneyParams
+
+from .lobes import canonical
+from .names import specular_to_ior
+from .network import ExportError, Image, Source, source_from_params
+
+SUPPORTED = ("disney",)
+
+
+def source_for(
+    material: Any, texture_dir: Path, resolution: int, *, scratch: Path, bake: bool = True
+) -> Source:
+    """The :class:`Source` of a library material; layered ones are blended and baked.
+
+    Maps are baked into ``scratch`` and copied to ``texture_dir`` by the writer, so an
+    export that fails leaves nothing behind. ``bake=False`` also records the layer stack
+    so the MaterialX context mixes the layers live (:mod:`.live`); the universal and
+    RenderMan contexts read the baked maps.
+    """
+    if material.model != "layered":
+        _check_model(material.model, material.name)
+        return source_from_params(
+            material.name, material.model, material.params, material.description
+        )
+    source = baked_source(material, texture_dir, resolution, scratch)
+    if not bake:
+        from .live import live_stack
+
+        source.layers = live_stack(material, texture_dir, resolution)
+    return source
+
+
+def _check_model(model: str, name: str) -> None:
+    if model not in SUPPORTED:
+        raise ExportError(
+            f"USD export of {model!r} materials is not implemented yet; "
+            f"supported: {', '.join(SUPPORTED)}",
+            where=name,
+            field="model",
+        )
+
+
+def baked_source(material: Any, texture_dir: Path, resolution: int, scratch: Path) -> Source:
+    """Blend ``material``, bake its varying parameters, and read the maps from there."""
+    from lookdev.pipeline.blend import bake, blend
+
+    blended = blend(material, resolution)
+    _check_model(blended.model, material.name)
+    files = bake(blended, scratch)
+
+    def image(name: str, array: np.ndarray) -> Image:
+        return Image(texture_dir / files[name].name, np.flipud(array), True, files[name])
+
+    maps = {name: image(name, array) for name, array in blended.maps.items()}
+    if "specular" in maps:  # the universal surface reads the same F0 as an IOR
+        ior = np.vectorize(specular_to_ior, otypes=[np.float32])(maps["specular"].pixels)
+        maps["ior"] = Image(texture_dir / f"{material.name}_ior.exr", ior, write=True)
+    normal = None if blended.normal_map is None else image("normal_map", blended.normal_map)
+    return Source(
+        material.name,
+        blended.model,
+        _constants(blended),
+        maps=maps,
+        normal_map=normal,
+        spelling="specular",
+        description=material.description,
+    )
+
+
+def _constants(blended) -> dict[str, Any]:
+    """Canonical values: the constants, and for mapped parameters their mean (a fallback)."""
+    data = dict(blended.constants)
+    for name, array in blended.maps.items():
+        mean = np.asarray(array, dtype=np.float64).reshape(-1, *np.shape(array)[2:]).mean(axis=0)
+        data[name] = tuple(float(x) for x in mean) if np.ndim(mean) else float(mean)
+    if "ior" in data and "specular" in data:
+        del data["specular"]
+    return canonical(DisneyParams.parse(data, where=blended.name))
