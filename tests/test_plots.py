@@ -179,3 +179,49 @@ def test_cli_plots_presets_side_by_side(cli, tmp_path, view):
         "materials": ["gold", "plaster"],
     }
     assert out.read_bytes()[:4] == b"\x89PNG"
+
+
+# -- the shipped models, checked the same way -----------------------------------------
+def _preset(name: str) -> P.Subject:
+    _needs_disney()
+    return P.subject_for(name)
+
+
+def test_metal_with_roughness_0_2_slice_peaks_at_theta_h_zero():
+    gold = _preset("gold")
+    assert gold.params.metallic == 1.0 and gold.params.roughness == 0.2
+    _, td, f = P.brdf_slice(gold.model, gold.params, n=90)
+    for c in range(3):
+        assert np.all(np.argmax(f[:, :, c], axis=1) == 0)  # every θd row, every channel
+
+
+@pytest.mark.parametrize("incidence", [0.0, 30.0, 60.0])
+def test_metal_polar_peak_is_at_the_mirror_direction(incidence):
+    gold = _preset("gold")
+    theta_o, lum = P.polar_curves(gold.model, gold.params, [incidence], n=1441)
+    # G and 1/cos θo lean the peak of f a little past the mirror direction, growing to
+    # grazing (0.2° at 60°); the mirror direction itself is the D peak.
+    assert math.degrees(theta_o[np.argmax(lum[0])]) == pytest.approx(incidence, abs=0.3)
+
+
+def test_disney_albedo_sampler_and_quadrature_agree_on_a_rough_material():
+    from lookdev.pipeline.analysis.albedo import albedo_monte_carlo, albedo_quadrature
+
+    plaster = _preset("plaster")
+    theta = np.radians([0.0, 30.0, 60.0, 80.0])
+    q = albedo_quadrature(plaster.model, plaster.params, theta, n_mu=128, n_phi=128)
+    mc = albedo_monte_carlo(plaster.model, plaster.params, theta, n_samples=8192)
+    assert np.all(np.abs(mc.albedo - q.albedo) <= 5 * mc.stderr + 1e-3)
+
+
+@pytest.mark.parametrize("r", [0.05, 0.3, 1.0])
+def test_sheen_albedo_table_agrees_with_quadrature(r):
+    from lookdev.materials import sheen
+    from lookdev.pipeline.analysis.albedo import albedo_quadrature, albedo_tabulated
+
+    p = sheen.SheenParams(roughness=r, color=(1.0, 0.5, 0.25))
+    theta = np.radians([0.0, 30.0, 60.0, 80.0])
+    q = albedo_quadrature(sheen.MODEL, p, theta, n_mu=256, n_phi=128).albedo
+    t = albedo_tabulated(sheen.MODEL, p, theta).albedo
+    np.testing.assert_allclose(t, q, atol=5e-4)
+    np.testing.assert_allclose(t[:, 1] / t[:, 0], 0.5)  # F scales the table per channel
