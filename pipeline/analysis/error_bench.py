@@ -65,7 +65,7 @@ class Settings:
 
     @classmethod
     def quick(cls) -> Settings:
-        return cls((1, 4, 16), 128, 16, (8, 16, 32), (64, 256), 128, (8, 32), 512, 2000)
+        return cls((1, 4, 16), 128, 16, (8, 16, 32), (64, 256), 128, (4, 16), 512, 2000)
 
 
 @dataclass

@@ -123,42 +123,6 @@ def bench_albedo(
 
 
 # -- Conty-Kulla Λ -------------------------------------------------------------------
-def projected_area(cos_theta: np.ndarray, r: float, nodes: int, split: bool = True) -> np.ndarray:
-    """∫ ⟨ω·m⟩ D(m) dm for Conty-Kulla's D (eq. 2), by Gauss-Legendre over θm.
-
-    The φm integral is closed-form: ∫ max(0, a cos φ + b) dφ = 2(a sin φ0 + b φ0) with
-    cos φ0 = −b/a clamped, where a = sin θ sin θm and b = cos θ cos θm. Its kink at
-    θm = π/2 − θ is where Gauss-Legendre converges slowly; ``split`` integrates either
-    side of it separately, which is how the reference converges to machine precision.
-    Then Λ(θ) = projected_area / cos θ − 1 (Heitz 2014, eq. 17).
-    """
-    ct = np.atleast_1d(np.asarray(cos_theta, dtype=np.float64))[:, None]
-    st = np.sqrt(np.clip(1.0 - ct * ct, 0.0, 1.0))
-    x, w = np.polynomial.legendre.leggauss(nodes)
-    kink = np.clip(math.pi / 2 - np.arccos(ct), 0.0, math.pi / 2) if split else None
-    pieces = (
-        [(np.zeros_like(ct), kink), (kink, np.full_like(ct, math.pi / 2))]
-        if split
-        else [(np.zeros_like(ct), np.full_like(ct, math.pi / 2))]
-    )
-    total = np.zeros(ct.shape[0])
-    for lo, hi in pieces:
-        tm = lo + (hi - lo) * 0.5 * (x + 1.0)
-        a, b = st * np.sin(tm), ct * np.cos(tm)
-        phi0 = np.arccos(np.clip(-b / np.where(a > 0, a, 1.0), -1.0, 1.0))
-        phi0 = np.where(a > 0, phi0, np.where(b > 0, math.pi, 0.0))
-        ring = 2.0 * (a * np.sin(phi0) + b * phi0)
-        d = (2.0 + 1.0 / r) * np.power(np.sin(tm), 1.0 / r) / (2.0 * math.pi)
-        total += (hi - lo)[:, 0] * 0.5 * ((ring * d * np.sin(tm)) @ w)
-    return total
-
-
-def lambda_numerical(cos_theta: np.ndarray, r: float, nodes: int, split: bool = True) -> np.ndarray:
-    """Λ(θ) of Conty-Kulla's D from the projected-area identity, numerically."""
-    ct = np.atleast_1d(np.asarray(cos_theta, dtype=np.float64))
-    return projected_area(ct, r, nodes, split) / ct - 1.0
-
-
 LAMBDA_COS = np.linspace(0.02, 1.0, 50)
 LAMBDA_ROUGHNESS = (0.1, 0.3, 0.5, 1.0)
 
@@ -166,14 +130,18 @@ LAMBDA_ROUGHNESS = (0.1, 0.3, 0.5, 1.0)
 def bench_lambda(
     fit: Callable[[np.ndarray, float], np.ndarray] | None,
     *,
-    nodes: Sequence[int] = (8, 16, 32, 64, 128),
+    nodes: Sequence[int] = (4, 8, 16, 32),
     reference_nodes: int = 2048,
 ) -> list[Row]:
-    """The Λ fit and plain Gauss-Legendre against the split, converged integral."""
+    """The Λ fit, and the projected-area integral at a ladder of Gauss-Legendre nodes,
+    against that integral converged (:func:`lookdev.pipeline.analysis.sheen_fit.
+    lambda_integrated`, Heitz 2014: 1 + Λ(ω) = ∫ ⟨ω·m⟩ D(m) dm / cos θ)."""
+    from .sheen_fit import lambda_integrated
+
     rows = []
     n_eval = len(LAMBDA_COS)
     for r in LAMBDA_ROUGHNESS:
-        ref = lambda_numerical(LAMBDA_COS, r, reference_nodes)
+        ref = lambda_integrated(LAMBDA_COS, r, reference_nodes)
         case = f"r = {r:g}"
         if fit is not None:
             value, t = timed(lambda r=r: np.asarray(fit(LAMBDA_COS, r), dtype=np.float64))
@@ -181,9 +149,9 @@ def bench_lambda(
                 Row("lambda", case, "fit (eq. 3)", "Table 1", relative_rms(value, ref), t, n_eval)
             )
         for n in nodes:
-            value, t = timed(lambda n=n, r=r: lambda_numerical(LAMBDA_COS, r, n, split=False))
+            value, t = timed(lambda n=n, r=r: lambda_integrated(LAMBDA_COS, r, n))
             rows.append(
-                Row("lambda", case, "numerical", f"{n} nodes", relative_rms(value, ref), t, n_eval)
+                Row("lambda", case, "integral", f"{n} nodes", relative_rms(value, ref), t, n_eval)
             )
     return rows
 
