@@ -61,6 +61,10 @@ class Settings:
     def frames(self) -> list[Frame]:
         return frames(self.element_frames, self.light_frames)
 
+    def as_json(self) -> dict[str, Any]:
+        """The settings as they read back from a manifest (lists, not tuples)."""
+        return json.loads(json.dumps(asdict(self)))
+
 
 @dataclass
 class Job:
@@ -75,7 +79,7 @@ class Job:
 
     def __post_init__(self) -> None:
         h = hashlib.sha256()
-        h.update(json.dumps([FORMAT_VERSION, asdict(self.settings)], sort_keys=True).encode())
+        h.update(json.dumps([FORMAT_VERSION, self.settings.as_json()], sort_keys=True).encode())
         h.update(self.material.model_dump_json().encode())
         h.update(np.ascontiguousarray(self.environment).tobytes())
         self.key = h.hexdigest()[:16]
@@ -135,7 +139,7 @@ def run_job(job: Job) -> dict[str, Any]:
         "ibl": job.ibl,
         "key": job.key,
         "variant": variant,
-        "settings": asdict(job.settings),
+        "settings": job.settings.as_json(),
         "frames": [done[i] for i in sorted(done)],
     }
     rendered = 0
@@ -308,7 +312,7 @@ def summary(out: Path, jobs: list[Job], results: list[dict[str, Any]], seconds: 
     doc = {
         "version": FORMAT_VERSION,
         "wall_seconds": round(seconds, 3),
-        "settings": asdict(jobs[0].settings) if jobs else {},
+        "settings": jobs[0].settings.as_json() if jobs else {},
         "proofs": entries,
     }
     write_json(doc, out / MANIFEST)

@@ -10,8 +10,9 @@ Every IBL of a batch is brought to one resolution and its exposure is folded int
 pixels (:func:`load`): in Mitsuba 3.9 a new envmap resolution or ``scale`` compiles a new
 kernel, while new pixel values of the same size do not (DESIGN.md, Proofing).
 
-Lat-long convention (Mitsuba's ``envmap``): pixel (u, v) looks along
-``(sin φ sin θ, cos θ, −cos φ sin θ)`` with φ = 2πu, θ = πv; row 0 is the zenith (+y).
+Lat-long convention (Mitsuba's ``envmap``): (u, v) looks along
+``(sin φ sin θ, cos θ, −cos φ sin θ)`` with φ = 2πu, θ = πv; row 0 is the zenith (+y)
+(see :func:`directions` for where exactly each pixel sits).
 Light directions in the definitions are (azimuth, elevation) in degrees with azimuth 0
 towards the camera (+z: a front light), 90 from the camera's right (+x), 180 behind the
 subject (a rim light).
@@ -151,18 +152,24 @@ def definition(name: str) -> IblDefinition:
 
 # -- generation ----------------------------------------------------------------------------
 def directions(width: int) -> tuple[np.ndarray, np.ndarray]:
-    """Unit directions (H, W, 3) of lat-long pixel centres and their solid angles (H, W).
+    """Unit directions (H, W, 3) where Mitsuba's envmap shows each pixel; solid angles (H, W).
+
+    Mitsuba 3.9's envmap puts column i at u = (i + ½)/W but row j at v = j/(H − 1): the
+    first row is the zenith itself and the last the nadir (measured in tests/test_ibl.py).
+    Solid angles are the trapezoid rule's weights on that grid.
 
     >>> d, omega = directions(64)
-    >>> round(float(omega.sum()), 3) == round(4 * math.pi, 3)
-    True
+    >>> bool(abs(omega.sum() - 4 * math.pi) < 0.05), d[0, 0].round(6).tolist()
+    (True, [0.0, 1.0, -0.0])
     """
     height = width // 2
     phi = (np.arange(width) + 0.5) / width * 2.0 * math.pi
-    theta = (np.arange(height) + 0.5) / height * math.pi
+    theta = np.arange(height) / (height - 1) * math.pi
     st, ct = np.sin(theta)[:, None], np.cos(theta)[:, None]
     d = np.stack(np.broadcast_arrays(np.sin(phi) * st, ct, -np.cos(phi) * st), axis=-1)
-    omega = (2.0 * math.pi / width) * (math.pi / height) * np.broadcast_to(st, (height, width))
+    omega = (
+        (2.0 * math.pi / width) * (math.pi / (height - 1)) * np.broadcast_to(st, (height, width))
+    )
     return d, omega
 
 

@@ -1,0 +1,211 @@
+"""Turntables and batch proofs, rendered tiny (32×16, 4 spp, a few frames)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from lookdev.pipeline.proof import batch, ibl, turntable
+
+pytestmark = pytest.mark.render
+
+TINY = batch.Settings(element_frames=2, light_frames=1, spp=4, resolution=(32, 16))
+DIFFUSE = {"type": "diffuse", "reflectance": {"type": "rgb", "value": 0.5}}
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path_factory, monkeypatch):
+    monkeypatch.setenv("LOOKDEV_CACHE", str(tmp_path_factory.getbasetemp() / "cache"))
+
+
+@pytest.fixture(scope="module")
+def mitsuba():
+    from lookdev.pipeline.variant import use_mitsuba
+
+    use_mitsuba()
+    import mitsuba as mi
+
+    return mi
+
+
+@pytest.fixture(scope="module")
+def gold():
+    from lookdev.library import load_material
+
+    return load_material("gold")
+
+
+def _table(mitsuba, bsdf=DIFFUSE, resolution=(32, 16)):
+    return turntable.Turntable(bsdf, ibl.load("studio", 64).pixels, resolution, 3)
+
+
+# -- turntable -----------------------------------------------------------------------------
+def test_frames_turn_the_element_then_the_lighting():
+    got = [(f.index, f.kind, f.angle) for f in turntable.frames(3, 2)]
+    assert got == [
+        (0, "element", 0.0),
+        (1, "element", 120.0),
+        (2, "element", 240.0),
+        (3, "light", 0.0),
+        (4, "light", 180.0),
+    ]
+
+
+def test_rotations_move_the_picture_and_a_full_turn_brings_it_back(mitsuba):
+    table = _table(mitsuba)
+
+    def shot(kind, angle):
+        table.set_frame(turntable.Frame(0, kind, angle))
+        return table.render(4, seed=7)
+
+    rest = shot("light", 0.0)
+    assert np.abs(shot("light", 90.0) - rest).mean() > 1e-3
+    assert shot("light", 360.0) == pytest.approx(rest, abs=1e-4)
+    assert np.abs(shot("element", 90.0) - rest).mean() > 1e-4  # the tilted cup turns
+    assert shot("element", 360.0) == pytest.approx(rest, abs=1e-3)
+
+
+def test_frames_after_the_first_reuse_every_compiled_kernel(mitsuba):
+    import drjit as dr
+
+    table = _table(mitsuba)
+    dr.set_flag(dr.JitFlag.KernelHistory, True)
+    try:
+        turntable.render_frame(table, turntable.Frame(0, "element", 0.0), 4)
+        dr.kernel_history()  # drain the first frame's compilations
+        for frame in turntable.frames(2, 2)[1:]:
+            turntable.render_frame(table, frame, 4)
+        jit = [k for k in dr.kernel_history() if str(k["type"]).endswith("JIT")]
+    finally:
+        dr.set_flag(dr.JitFlag.KernelHistory, False)
+    assert jit and all(k["cache_hit"] for k in jit)
+
+
+def test_half_sample_noise_estimate_matches_the_true_error(mitsuba):
+    table = _table(mitsuba, resolution=(48, 24))
+    frame = turntable.Frame(0, "element", 0.0)
+    table.set_frame(frame)
+    reference = table.render(1024, seed=99) @ turntable.REC709_Y
+    r = turntable.render_frame(table, frame, 8)
+    true_rmse = float(np.sqrt(np.mean((r.image @ turntable.REC709_Y - reference) ** 2)))
+    assert 0.7 < r.noise_rmse / true_rmse < 1.4
+    assert r.seconds > 0 and r.noise_relative > 0
+
+
+# -- jobs and resumption -------------------------------------------------------------------
+def _job(material, out, settings=TINY, name="studio"):
+    env = ibl.load(name, 64)
+    return batch.make_jobs([material], [env], out, settings)[0]
+
+
+def test_a_job_writes_frames_sheet_and_manifest(mitsuba, gold, tmp_path):
+    doc = batch.run_job(_job(gold, tmp_path))
+    folder = tmp_path / "gold" / "studio"
+    assert doc["rendered"] == 3 and doc["skipped"] == 0
+    manifest = json.loads((folder / "manifest.json").read_text())
+    assert [f["kind"] for f in manifest["frames"]] == ["element", "element", "light"]
+    for f in manifest["frames"]:
+        assert f["seconds"] > 0 and f["noise_rmse"] > 0
+        assert (folder / f["exr"]["file"]).stat().st_size == f["exr"]["size"]
+    assert (folder / "contact.png").is_file()
+    assert not [p for p in folder.iterdir() if p.name.startswith(".")], "temporaries left"
+
+
+def test_a_rerun_skips_verified_frames_and_redoes_damaged_ones(mitsuba, gold, tmp_path):
+    job = _job(gold, tmp_path)
+    batch.run_job(job)
+    again = batch.run_job(job)
+    assert again["rendered"] == 0 and again["skipped"] == 3
+    folder = tmp_path / "gold" / "studio"
+    (folder / "frame_000.exr").unlink()
+    with open(folder / "frame_002.png", "ab") as f:
+        f.write(b"x")  # same name, wrong size and hash
+    repaired = batch.run_job(job)
+    assert repaired["rendered"] == 2 and repaired["skipped"] == 1
+    assert len(repaired["frames"]) == 3
+
+
+def test_changed_settings_render_everything_again(mitsuba, gold, tmp_path):
+    batch.run_job(_job(gold, tmp_path))
+    more = batch.Settings(element_frames=2, light_frames=1, spp=6, resolution=(32, 16))
+    assert batch.run_job(_job(gold, tmp_path, more))["rendered"] == 3
+
+
+def test_a_batch_runs_on_a_dask_cluster(mitsuba, gold, tmp_path):
+    from distributed import Client, LocalCluster
+
+    envs = [ibl.load(n, 64) for n in ("studio", "overcast")]
+    jobs = batch.make_jobs([gold], envs, tmp_path, TINY)
+    seen = []
+    with (
+        LocalCluster(n_workers=1, processes=False, threads_per_worker=1) as cluster,
+        Client(cluster) as client,
+    ):
+        results = batch.run_batch(jobs, client.get_executor(), on_done=lambda j, d: seen.append(j))
+    assert [r["ibl"] for r in results] == ["studio", "overcast"] and len(seen) == 2
+    doc = batch.summary(tmp_path, jobs, results, 1.0)
+    assert [p["frames"] for p in doc["proofs"]] == [3, 3]
+    assert json.loads((tmp_path / "manifest.json").read_text()) == doc
+
+
+def test_a_crashing_job_is_one_line_with_its_traceback_kept(gold, tmp_path, monkeypatch):
+    from concurrent.futures import ThreadPoolExecutor
+
+    def crash(job, todo):
+        raise RuntimeError("kernel exploded\nsecond line")
+        yield
+
+    monkeypatch.setattr(batch, "_render", crash)
+    with ThreadPoolExecutor(1) as pool, pytest.raises(batch.ProofError) as info:
+        batch.run_batch([_job(gold, tmp_path)], pool)
+    message = str(info.value)
+    assert message.startswith("gold × studio: rendering failed (RuntimeError: kernel exploded)")
+    assert "\n" not in message
+    assert "second line" in (tmp_path / "gold" / "studio" / "error.log").read_text()
+
+
+# -- the command ---------------------------------------------------------------------------
+def test_proof_command_runs_on_a_dask_scheduler(cli, tmp_path):
+    from distributed import LocalCluster
+
+    out = tmp_path / "proofs"
+    args = ["gold", "--ibl", "sunset", "-n", "1", "-m", "1", "-s", "2", "-r", "32", "16"]
+    with LocalCluster(n_workers=1, processes=False, threads_per_worker=1) as cluster:
+        r = cli("proof", *args, "--ibl-width", "64", "-o", str(out), "--json", "--scheduler",
+                cluster.scheduler_address)  # fmt: skip
+    assert r.code == 0, r.err
+    doc = json.loads(r.out)
+    assert doc["proofs"][0]["material"] == "gold" and doc["proofs"][0]["frames"] == 2
+    assert (out / "gold" / "sunset" / "contact.png").is_file()
+
+
+def test_proof_command_default_executor_is_a_process_pool(cli, tmp_path):
+    out = tmp_path / "p"
+    r = cli("proof", "gold", "--ibl", "studio", "-n", "1", "-m", "0", "-s", "2", "-r", "16", "8",
+            "--ibl-width", "32", "-o", str(out), "-j", "1")  # fmt: skip
+    assert r.code == 0, r.err
+    assert "gold" in r.out and (out / "manifest.json").is_file()
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["no_such_preset"], "no_such_preset"),
+        (["gold", "--ibl", "missing.exr"], "missing.exr: no such IBL file"),
+        (["gold", "--ibl", "JUNK"], "cannot decode"),
+        (["gold", "-o", "FILE/sub"], "not writable"),
+    ],
+)
+def test_bad_input_is_one_line_exit_2_and_leaves_no_frames(cli, tmp_path, args, message):
+    junk = tmp_path / "junk.exr"
+    junk.write_bytes(b"\x76\x2f\x31\x01garbage")
+    (tmp_path / "file").write_text("a file, not a folder")
+    args = [str(junk) if a == "JUNK" else a.replace("FILE", str(tmp_path / "file")) for a in args]
+    if "-o" not in args:
+        args += ["-o", str(tmp_path / "out")]
+    r = cli("proof", *args, "-n", "1", "-m", "0", "-s", "2", "-r", "16", "8")
+    assert r.code == 2 and message in r.err
+    assert len(r.err.strip().splitlines()) == 1 and "Traceback" not in r.err
+    assert not list(tmp_path.rglob("*.png")) and not list(tmp_path.rglob("frame_*"))
