@@ -1,0 +1,145 @@
+"""The lobe shapes of Smits' Wall-E/Up model, over the array shim (:mod:`.arrays`).
+
+Smits writes every lobe as π × BRDF ("a traditional diffuse BRDF is a constant [1]";
+his energy plots divide by π). Here every function is the BRDF itself, so a white
+traditional diffuse is 1/π and the hemispherical integrals are the plain ones.
+
+Transcription traps in the seed (DESIGN.md): ``(1 - cos)5`` is (1 − cos)⁵; ``FrnBlend``
+and ``FrnlBlend`` are one function; ``PSpecular``'s trailing ``4`` divides.
+
+>>> from lookdev.materials.arrays import NumpyOps
+>>> xp = NumpyOps()
+>>> float(frn_blend(xp, 0.04, 1.0, 1.0)), float(frn_blend(xp, 0.04, 1.0, 0.0))
+(0.04, 1.0)
+>>> round(float(power_specular(xp, 1.0, 1.0)), 4)  # ln 10 / sin²35°
+6.999
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+INV_PI = 1.0 / math.pi
+LN_10 = math.log(10.0)
+DEG = math.pi / 180.0
+CONE_MIN_DEG = 0.5
+"""The tightest highlight cone (degrees): Smits' powerR is infinite at roughness 0, and he
+takes "0 (or epsilon in practice)". 0.5° is about the sun's disc: a mirror for any proof
+resolution, and its power (3.0e4) keeps exp(−p sin²θ) and p itself well inside float32."""
+POWER_MIN = 1e-12
+"""powerS is exactly 0 at roughness 0, where weightS = p/(1 − e^(−p)) is 0/0 (limit 1).
+Flooring p here changes the lobe by 1e-12 relative: below float64's own rounding of 1."""
+
+
+def frn_blend(xp: Any, normal: Any, grazing: Any, cos_theta: Any) -> Any:
+    """Smits' generalised Schlick: Mix[normal, grazing, (1 − cos θ)⁵]."""
+    c = xp.clip(cos_theta, 0.0, 1.0)
+    t = (1.0 - c) * (1.0 - c)
+    return xp.lerp(normal, grazing, t * t * (1.0 - c))
+
+
+def p_diffuse(xp: Any, cos_u: Any, cos_v: Any, norm_refl: Any, grazing_refl: Any) -> Any:
+    """``PDiffuse`` / π: FrnBlend[1 − nRefl, 1 − gRefl, u·n] FrnBlend[…, v·n] / π."""
+    a, b = 1.0 - norm_refl, 1.0 - grazing_refl
+    return frn_blend(xp, a, b, cos_u) * frn_blend(xp, a, b, cos_v) * INV_PI
+
+
+def cone_power(xp: Any, falloff_log: Any, cone_deg: Any) -> Any:
+    """−log(falloff)/sin²(cone): the exponent at which the lobe falls to ``falloff``."""
+    s = xp.sin(xp.maximum(cone_deg, CONE_MIN_DEG) * DEG)
+    return falloff_log / (s * s)
+
+
+def power_specular(xp: Any, r: Any, cone_scale: Any = 1.0) -> Any:
+    """powerS[r] = −Log[0.1^r] / Sin[(30 r + 5)°]² (0 at r = 0: a flat, unused lobe)."""
+    return cone_power(xp, r * LN_10, (30.0 * r + 5.0) * cone_scale)
+
+
+def power_reflection(xp: Any, r: Any, cone_scale: Any = 1.0) -> Any:
+    """powerR[r] = −Log[0.1] / Sin[(10 r)°]², with the cone floored at CONE_MIN_DEG."""
+    return cone_power(xp, LN_10, (10.0 * r) * cone_scale)
+
+
+def weight(xp: Any, p: Any) -> Any:
+    """weightS = p / (1 − e^(−p)) through expm1, continuous into its limit 1 at p = 0."""
+    q = xp.maximum(p, POWER_MIN)
+    return q / -xp.expm1(-q)
+
+
+def distribution(xp: Any, sin2_h: Any, p: Any) -> Any:
+    """PSpecDist / π = weight · e^(−p sin²θh) / π, normalised: ∫ D cos θh dωh = 1."""
+    q = xp.maximum(p, POWER_MIN)
+    return weight(xp, q) * INV_PI * xp.exp(-q * sin2_h)
+
+
+def sin2_of(xp: Any, h: Any) -> Any:
+    """sin²θ of an unnormalised vector from its components (exact near the normal)."""
+    return (h[0] * h[0] + h[1] * h[1]) / xp.maximum(xp.dot(h, h), xp.tiny)
+
+
+def p_specular(xp: Any, wi: Any, wo: Any, p: Any, fn: Any, fg: Any) -> Any:
+    """``PSpecular`` / π: D(h) FrnBlend[N, G, u·h] / (4 ((n·u)² + (n·v)² − (n·u)(n·v))).
+
+    Both directions above the surface; the caller masks. Colour weights broadcast.
+    ``(n·u)² + (n·v)² − (n·u)(n·v)`` ≥ ((n·u)² + (n·v)²)/2 vanishes only when both
+    directions graze, and is floored at the dtype's tiny there.
+    """
+    h = xp.normalize(wi + wo)
+    ci, co = wi[2], wo[2]
+    denom = 4.0 * xp.maximum(ci * ci + co * co - ci * co, xp.tiny)
+    d = distribution(xp, sin2_of(xp, h), p)
+    return frn_blend(xp, fn, fg, xp.dot(wi, h)) * (d / denom)
+
+
+# -- sampling the Gaussian-of-sin distribution --------------------------------------------
+def sample_half_vector(xp: Any, p: Any, u1: Any, u2: Any) -> Any:
+    """h with density D(h) cos θh: sin²θh = −log(1 − u (1 − e^(−p))) / p, φ = 2πu2.
+
+    The density of s = sin²θ is p e^(−ps)/(1 − e^(−p)) on [0, 1]; its inverse CDF goes
+    through log1p/expm1 so it stays exact as p → 0 (s → u, the flat lobe).
+    """
+    q = xp.maximum(p, POWER_MIN)
+    s = xp.clip(-xp.log1p(u1 * xp.expm1(-q)) / q, 0.0, 1.0)
+    sin_t = xp.sqrt(s)
+    phi = 2.0 * math.pi * u2
+    return xp.vec3(sin_t * xp.cos(phi), sin_t * xp.sin(phi), xp.safe_sqrt(1.0 - s))
+
+
+def half_vector_pdf(xp: Any, wi: Any, wo: Any, p: Any) -> Any:
+    """Solid-angle density of wi = reflect(wo, h) with h ~ D cos θh: D cos θh / 4|wo·h|."""
+    h = xp.normalize(wi + wo)
+    d = distribution(xp, sin2_of(xp, h), p)
+    return d * xp.abs(h[2]) / xp.maximum(4.0 * xp.abs(xp.dot(wo, h)), xp.tiny)
+
+
+def reflect(xp: Any, w: Any, h: Any) -> Any:
+    """Mirror w about h (both unit): 2 (w·h) h − w."""
+    return h * (2.0 * xp.dot(w, h)) - w
+
+
+def cosine_hemisphere(xp: Any, u1: Any, u2: Any) -> Any:
+    """Malley's method: a uniform disk point lifted onto the upper hemisphere."""
+    r = xp.sqrt(u1)
+    phi = 2.0 * math.pi * u2
+    return xp.vec3(r * xp.cos(phi), r * xp.sin(phi), xp.safe_sqrt(1.0 - u1))
+
+
+# -- transmission geometry ----------------------------------------------------------------
+def back_view(xp: Any, wo: Any, eta: Any) -> Any:
+    """Smits' transmitted-lobe view, in the back side's own frame (its normal is +z).
+
+    The view is refracted into the surface by the IOR (total internal reflection cannot
+    happen from outside), wt = −wo/η + n (cos θo/η − cos θt); reflecting wt off the
+    surface gives the back-side view whose mirror direction is wt. Seen from the back
+    (z ↦ −z) that view is simply −wt, and a lobe evaluated there with the back-side
+    light (wi.x, wi.y, −wi.z) is centred on the refracted direction.
+    """
+    co = wo[2]
+    cos_t = xp.safe_sqrt(1.0 - (1.0 - co * co) / (eta * eta))
+    return xp.vec3(wo[0] / eta, wo[1] / eta, cos_t)
+
+
+def to_back(xp: Any, w: Any) -> Any:
+    """The same direction expressed in the back side's frame (z ↦ −z)."""
+    return xp.vec3(w[0], w[1], -w[2])
