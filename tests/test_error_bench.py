@@ -119,3 +119,33 @@ def test_cli_rejects_an_unknown_item_in_one_line(cli, tmp_path):
     assert res.code == 2
     assert "allowed render, albedo, lambda, precision" in res.err
     assert "Traceback" not in res.err
+
+
+def test_float32_overflow_where_float64_is_finite_is_an_infinite_error():
+    from lookdev.materials.bsdf import Model
+
+    def prepare(xp, params, **maps):
+        return {}
+
+    def eval_(xp, prepared, wi, wo):
+        v = xp.exp(100.0 * wi[2])  # e^100 ≈ 2.7e43: finite in float64, inf in float32
+        return xp.vec3(v, v, v)
+
+    steep = Model("steep", LAMBERT.params_type, prepare, eval_, LAMBERT.pdf, LAMBERT.sample)
+    f32 = M.bench_precision("steep", steep, LAMBERT.params_type(), n=200)[1]
+    assert f32.error == math.inf and "non-finite" in f32.setting
+
+
+def test_model_cases_cover_the_roughness_edges_and_every_optional_lobe():
+    from lookdev.materials.params import DisneyParams
+
+    disney = type("M", (), {"params_type": DisneyParams})()
+    labels = [label for label, _, _ in E.model_cases({"disney": disney})]
+    assert labels == [
+        "disney default",
+        "disney roughness 0",
+        "disney roughness 1",
+        "disney clearcoat 1",
+        "disney sheen 1",
+        "disney spec_trans 1",
+    ]

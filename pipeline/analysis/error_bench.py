@@ -102,15 +102,28 @@ def available_models() -> dict[str, Model]:
     return found
 
 
+EDGE_CASES = {"roughness": (0.0, 1.0)}
+LOBE_CASES = ("clearcoat", "sheen", "spec_trans")  # switched fully on, one at a time
+
+
 def model_cases(models: dict[str, Model]) -> list[tuple[str, Model, Any]]:
-    """(label, model, params): each model's defaults and its roughness extremes."""
+    """(label, model, params): each model's defaults, its roughness at 0 and 1 (the
+    edges themselves) and each optional lobe switched on, where the model has them."""
     cases = []
     for name, model in models.items():
         default = model.params_type()
+        fields = type(default).model_fields
         cases.append((f"{name} default", model, default))
-        if "roughness" in type(default).model_fields:
-            cases.append((f"{name} roughness 0", model, default.replace(roughness=0.0)))
-            cases.append((f"{name} roughness 1", model, default.replace(roughness=1.0)))
+        for param, values in EDGE_CASES.items():
+            if param in fields:
+                cases += [
+                    (f"{name} {param} {v:g}", model, default.replace(**{param: v})) for v in values
+                ]
+        cases += [
+            (f"{name} {lobe} 1", model, default.replace(**{lobe: 1.0}))
+            for lobe in LOBE_CASES
+            if lobe in fields
+        ]
     return cases
 
 
@@ -242,7 +255,6 @@ def plot_error_vs_time(report: Report, path: Path) -> Path:
         layout="constrained",
         squeeze=False,
     )
-    ylabel = {"render": "relative MSE", "precision": "max relative error"}
     for ax, item in zip(axes[0], items, strict=False):
         rows = [r for r in report.rows if r.item == item]
         for key in dict.fromkeys((r.case, r.method) for r in rows):
@@ -257,7 +269,7 @@ def plot_error_vs_time(report: Report, path: Path) -> Path:
                 )
         ax.set_title(item)
         ax.set_xlabel("seconds per call")
-        ax.set_ylabel(ylabel.get(item, "relative RMS error"))
+        ax.set_ylabel(ERROR_NAMES[item])
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize="xx-small")
     return save_figure(fig, path)
@@ -271,6 +283,26 @@ def write_outputs(report: Report, settings: Settings, out_dir: Path) -> dict[str
     tmp.write_text(json.dumps(report.to_json(settings), indent=2) + "\n")
     tmp.replace(js)
     return {"json": js, "plot": plot_error_vs_time(report, out_dir / "error_bench.png")}
+
+
+ERROR_NAMES = {
+    "render": "relative MSE",
+    "albedo": "relative RMS error",
+    "lambda": "relative RMS error",
+    "precision": "max relative error of float32",
+}
+TABLE_COLUMNS = ["case", "method", "setting", "error", "ms/call", "ns/eval"]
+
+
+def _table_row(r: Row) -> list[str]:
+    return [
+        r.case,
+        r.method,
+        r.setting,
+        f"{r.error:.3g}",
+        f"{r.seconds * 1e3:.3g}",
+        f"{r.seconds_per_evaluation * 1e9:.3g}",
+    ]
 
 
 def command(
@@ -310,17 +342,16 @@ def command(
     if as_json:
         print_json({**report.to_json(settings), "outputs": {k: str(v) for k, v in paths.items()}})
         return
-    rows = [
-        [r.item, r.case, r.method, r.setting, r.error, r.seconds, r.seconds_per_evaluation]
-        for r in report.rows
-    ]
-    console.print(
-        table(
-            "error against run time",
-            ["item", "case", "method", "setting", "error", "s/call", "s/eval"],
-            rows,
-        )
-    )
+    for item in ITEMS:
+        rows = [r for r in report.rows if r.item == item]
+        if rows:
+            console.print(
+                table(
+                    f"{item}: {ERROR_NAMES[item]} against time",
+                    TABLE_COLUMNS,
+                    [_table_row(r) for r in rows],
+                )
+            )
     for what, why in report.skipped.items():
         console.print(f"[yellow]skipped[/] {what}: {why}")
     console.print(

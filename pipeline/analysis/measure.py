@@ -186,7 +186,9 @@ def bench_precision(case: str, model: Model, params: Any, n: int = 20000) -> lis
     f32, t32 = timed(lambda: evaluate(model, params, wi, wo, dtype=np.float32))
     finite = np.isfinite(f64)
     scale = np.maximum(np.abs(f64), 1e-6 * max(float(np.abs(f64[finite]).max(initial=0)), 1e-30))
-    rel = np.where(finite, np.abs(f32.astype(np.float64) - f64) / scale, np.inf)
+    rel = np.where(finite, np.abs(f32.astype(np.float64) - f64) / scale, 0.0)
+    # float32 overflowing or NaN where float64 is finite is an infinite error, not a skip
+    rel = np.where(finite & ~np.isfinite(f32), np.inf, rel)
     bad32 = int((~np.isfinite(f32)).sum())
     note = f"{n + 5} pairs" + (f", {bad32} non-finite" if bad32 else "")
     return [
