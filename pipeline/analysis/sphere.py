@@ -83,50 +83,58 @@ def point_light_sphere(
 
 
 class LatLong:
-    """A lat-long environment in Mitsuba's convention, with luminance importance sampling.
+    """A lat-long environment where Mitsuba's ``envmap`` shows it, importance-sampled.
 
-    Texel (row, col) covers u = (col + ½)/W, v = (row + ½)/H; a direction is
-    (sin φ sin θ, cos θ, −cos φ sin θ) with φ = 2πu, θ = πv (y up, row 0 at the zenith).
+    Mitsuba 3.9 puts column i at u = (i + ½)/W and row j at v = j/(H − 1) (measured by
+    the proof module, :func:`lookdev.pipeline.proof.ibl.directions`); a direction is
+    (sin φ sin θ, cos θ, −cos φ sin θ) with φ = 2πu, θ = πv (y up, row 0 the zenith).
+    Row j therefore owns the band θ ∈ [π(j − ½)/(H − 1), π(j + ½)/(H − 1)] (half bands
+    at the poles); texels are chosen by luminance × solid angle, then a direction
+    uniformly in (φ, θ) within the texel.
     """
 
     def __init__(self, pixels: np.ndarray):
         self.pixels = np.asarray(pixels, dtype=np.float64)[..., :3]
         h, w = self.pixels.shape[:2]
-        sin_theta = np.sin((np.arange(h) + 0.5) / h * math.pi)
-        weight = np.maximum(self.pixels @ REC709_Y, 0.0) * sin_theta[:, None]
+        inner = (np.arange(1, h) - 0.5) / (h - 1) * math.pi
+        self.edges = np.concatenate([[0.0], inner, [math.pi]])
+        self.dphi = 2.0 * math.pi / w
+        omega = self.dphi * (np.cos(self.edges[:-1]) - np.cos(self.edges[1:]))
+        weight = np.maximum(self.pixels @ REC709_Y, 0.0) * omega[:, None]
         # A floor keeps every direction reachable, so MIS stays unbiased.
-        weight = weight + 1e-3 * max(float(weight.mean()), 1e-12) * sin_theta[:, None]
+        weight = weight + 1e-3 * max(float(weight.sum() / omega.sum() / w), 1e-12) * omega[:, None]
         self.pmf = (weight / weight.sum()).reshape(-1)
         self.cdf = np.cumsum(self.pmf)
         self.shape = (h, w)
 
-    def lookup(self, d: np.ndarray) -> np.ndarray:
-        """Radiance along world directions (..., 3), nearest texel."""
-        h, w = self.shape
-        u = (np.arctan2(d[..., 0], -d[..., 2]) / (2.0 * math.pi)) % 1.0
-        v = np.arccos(np.clip(d[..., 1], -1.0, 1.0)) / math.pi
-        col = np.minimum((u * w).astype(int), w - 1)
-        row = np.minimum((v * h).astype(int), h - 1)
-        return self.pixels[row, col]
-
-    def pdf(self, d: np.ndarray) -> np.ndarray:
-        """Solid-angle density of :meth:`sample` at world directions (..., 3)."""
+    def _texel(self, d: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(row, col, θ) of world directions (..., 3)."""
         h, w = self.shape
         u = (np.arctan2(d[..., 0], -d[..., 2]) / (2.0 * math.pi)) % 1.0
         theta = np.arccos(np.clip(d[..., 1], -1.0, 1.0))
         col = np.minimum((u * w).astype(int), w - 1)
-        row = np.minimum((theta / math.pi * h).astype(int), h - 1)
+        row = np.clip(np.searchsorted(self.edges, theta, side="right") - 1, 0, h - 1)
+        return row, col, theta
+
+    def lookup(self, d: np.ndarray) -> np.ndarray:
+        """Radiance along world directions (..., 3), nearest texel."""
+        row, col, _ = self._texel(d)
+        return self.pixels[row, col]
+
+    def pdf(self, d: np.ndarray) -> np.ndarray:
+        """Solid-angle density of :meth:`sample` at world directions (..., 3)."""
+        row, col, theta = self._texel(d)
+        dtheta = self.edges[row + 1] - self.edges[row]
         sin_theta = np.maximum(np.sin(theta), 1e-8)
-        # pdf over uv is pmf · H · W; dω = 2π² sin θ du dv.
-        return self.pmf[row * w + col] * h * w / (2.0 * math.pi**2 * sin_theta)
+        return self.pmf[row * self.shape[1] + col] / (self.dphi * dtheta * sin_theta)
 
     def sample(self, u: np.ndarray) -> np.ndarray:
-        """World directions for uniforms u (..., 3): u[0] picks a texel, u[1:] jitter in it."""
+        """World directions for uniforms u (..., 3): u[0] picks a texel, u[1:] place in it."""
         h, w = self.shape
         idx = np.minimum(np.searchsorted(self.cdf, u[..., 0] * self.cdf[-1]), h * w - 1)
         row, col = np.divmod(idx, w)
-        phi = 2.0 * math.pi * (col + u[..., 1]) / w
-        theta = math.pi * (row + u[..., 2]) / h
+        phi = self.dphi * (col + u[..., 1])
+        theta = self.edges[row] + u[..., 2] * (self.edges[row + 1] - self.edges[row])
         return np.stack(
             [np.sin(phi) * np.sin(theta), np.cos(theta), -np.cos(phi) * np.sin(theta)], axis=-1
         )
