@@ -27,9 +27,6 @@ CONE_MIN_DEG = 0.5
 """The tightest highlight cone (degrees): Smits' powerR is infinite at roughness 0, and he
 takes "0 (or epsilon in practice)". 0.5° is about the sun's disc: a mirror for any proof
 resolution, and its power (3.0e4) keeps exp(−p sin²θ) and p itself well inside float32."""
-POWER_MIN = 1e-12
-"""powerS is exactly 0 at roughness 0, where weightS = p/(1 − e^(−p)) is 0/0 (limit 1).
-Flooring p here changes the lobe by 1e-12 relative: below float64's own rounding of 1."""
 
 
 def frn_blend(xp: Any, normal: Any, grazing: Any, cos_theta: Any) -> Any:
@@ -61,15 +58,22 @@ def power_reflection(xp: Any, r: Any, cone_scale: Any = 1.0) -> Any:
     return cone_power(xp, LN_10, (10.0 * r) * cone_scale)
 
 
+def _floored(xp: Any, p: Any) -> Any:
+    """powerS is exactly 0 at roughness 0, where weightS = p/(1 − e^(−p)) is 0/0 (limit 1).
+    At the dtype's smallest normal number expm1(−p) = −p exactly, so the ratio is exactly
+    its limit there and the floor changes nothing else."""
+    return xp.maximum(p, xp.tiny)
+
+
 def weight(xp: Any, p: Any) -> Any:
     """weightS = p / (1 − e^(−p)) through expm1, continuous into its limit 1 at p = 0."""
-    q = xp.maximum(p, POWER_MIN)
+    q = _floored(xp, p)
     return q / -xp.expm1(-q)
 
 
 def distribution(xp: Any, sin2_h: Any, p: Any) -> Any:
     """PSpecDist / π = weight · e^(−p sin²θh) / π, normalised: ∫ D cos θh dωh = 1."""
-    q = xp.maximum(p, POWER_MIN)
+    q = _floored(xp, p)
     return weight(xp, q) * INV_PI * xp.exp(-q * sin2_h)
 
 
@@ -97,10 +101,12 @@ def sample_half_vector(xp: Any, p: Any, u1: Any, u2: Any) -> Any:
     """h with density D(h) cos θh: sin²θh = −log(1 − u (1 − e^(−p))) / p, φ = 2πu2.
 
     The density of s = sin²θ is p e^(−ps)/(1 − e^(−p)) on [0, 1]; its inverse CDF goes
-    through log1p/expm1 so it stays exact as p → 0 (s → u, the flat lobe).
+    through log1p/expm1 so it stays exact as p → 0, where s → u (the flat lobe); that
+    limit is taken outright where u (1 − e^(−p)) underflows.
     """
-    q = xp.maximum(p, POWER_MIN)
-    s = xp.clip(-xp.log1p(u1 * xp.expm1(-q)) / q, 0.0, 1.0)
+    q = _floored(xp, p)
+    x = u1 * xp.expm1(-q)
+    s = xp.clip(xp.select(x == 0.0, u1, -xp.log1p(x) / q), 0.0, 1.0)
     sin_t = xp.sqrt(s)
     phi = 2.0 * math.pi * u2
     return xp.vec3(sin_t * xp.cos(phi), sin_t * xp.sin(phi), xp.safe_sqrt(1.0 - s))
