@@ -4,7 +4,8 @@
 material's lobe weights follow Burley 2012 §5 and Schutte 2018 §3: the dielectric part
 is weighted ``1 - metallic``; sheen and subsurface sit on the diffuse, which is further
 weighted ``1 - spec_trans``; ``diff_trans`` and ``flatness`` exist only on thin surfaces.
-A parameter of a dead lobe has no effect, so it is neither written nor compared.
+A parameter of a dead lobe has no effect, so it is neither written nor compared. Weights
+are judged as USD stores them (float32).
 
 >>> from lookdev.materials.params import DisneyParams
 >>> on = active_lobes(canonical(DisneyParams(metallic=1.0, sheen=0.5)))
@@ -15,6 +16,8 @@ A parameter of a dead lobe has no effect, so it is neither written nor compared.
 from __future__ import annotations
 
 from typing import Any
+
+import numpy as np
 
 from lookdev.materials.params import DisneyParams
 
@@ -62,7 +65,7 @@ def active_lobes(values: dict[str, Any], model: str = "disney") -> dict[str, boo
     """lobe → whether it carries any weight, for canonical ``values`` of ``model``."""
     if model != "disney":
         raise KeyError(model)
-    v = values
+    v = {k: _stored(x) for k, x in values.items()}
     dielectric = v["metallic"] < 1.0
     diffuse = dielectric and v["spec_trans"] < 1.0
     spec_trans = dielectric and v["spec_trans"] > 0.0
@@ -82,6 +85,11 @@ def active_lobes(values: dict[str, Any], model: str = "disney") -> dict[str, boo
         "scatter": (spec_trans or subsurface) and not v["thin"] and v["scatter_distance"] > 0,
         "thin": bool(v["thin"]),
     }
+
+
+def _stored(x: Any) -> Any:
+    """A float as USD stores it (float32): a weight of 1e-50 is written, and read, as 0."""
+    return float(np.float32(x)) if isinstance(x, float) else x
 
 
 def effective(values: dict[str, Any], model: str = "disney", lobes: dict | None = None):

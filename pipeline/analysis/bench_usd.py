@@ -1,0 +1,173 @@
+"""``lookdev bench usd``: authoring 1,000 materials into one stage, fast path vs naive.
+
+Both paths author the *same* networks (:class:`~lookdev.pipeline.export.usd.network.MaterialSpec`,
+all three render contexts) into an in-memory stage:
+
+- fast: Sdf-level, the exporter's own :func:`~lookdev.pipeline.export.usd.writer.author`
+  (``Sdf.ChangeBlock``, ``Sdf.PrimSpec``, ``Sdf.AttributeSpec``);
+- naive: prim by prim through the high-level ``Usd``/``UsdShade`` API
+  (``UsdShade.Material.Define``, ``Shader.CreateInput(...).Set``, ``ConnectToSource``),
+  no change block, so every edit notifies and recomposes.
+
+Reported: materials per second of each, ``ratio_fast_to_naive`` (target ≥ 5), the time
+to build the networks (shared by both, not in either figure), and whether the two
+layers hold identical specs (``same_layers``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import numpy as np
+import typer
+
+from lookdev.materials.params import DisneyParams
+from lookdev.pipeline.export.usd.network import (
+    CONTEXT_OUTPUT,
+    CONTEXTS,
+    Connection,
+    MaterialSpec,
+    source_from_params,
+)
+from lookdev.pipeline.export.usd.writer import (
+    author,
+    material_spec,
+    new_layer,
+    prim_name,
+    usd_value,
+    value_types,
+)
+
+
+def command(
+    materials: Annotated[
+        int, typer.Option("--materials", "-n", min=1, max=100_000, help="Materials per stage.")
+    ] = 1000,
+    repeat: Annotated[int, typer.Option(min=1, max=20, help="Timed runs; the best counts.")] = 3,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+) -> None:
+    """Export N materials into one stage: Sdf-level authoring vs the naive Usd API.
+
+    Both author identical networks (UsdPreviewSurface, MaterialX and RenderMan contexts)
+    in the same run; the ratio of materials per second is the figure (target ≥ 5×).
+    """
+    from lookdev.pipeline.cli.common import console, print_json, table
+
+    result = run(materials, repeat=repeat)
+    if as_json:
+        print_json(result)
+        return
+    rows = [[k, v] for k, v in result.items()]
+    console.print(table(f"bench usd ({materials} materials)", ["measure", "value"], rows))
+
+
+def run(count: int, *, repeat: int = 3) -> dict[str, Any]:
+    """Every figure of the benchmark (see module doc)."""
+    import time
+
+    from lookdev.pipeline.cli.bench import best_time
+
+    t0 = time.perf_counter()
+    specs = bench_specs(count)
+    build_s = time.perf_counter() - t0
+    base = Path.cwd()
+    fast_s = best_time(lambda: author_fast(specs, base), repeat=repeat)
+    naive_s = best_time(lambda: author_naive(specs, base), repeat=max(1, repeat - 1))
+    naive_stage = author_naive(specs, base)  # keeps its root layer alive
+    same = _specs_of(author_fast(specs, base)) == _specs_of(naive_stage.GetRootLayer())
+    return {
+        "materials": count,
+        "contexts": len(CONTEXTS),
+        "shaders": sum(len(n.nodes) for s in specs for n in s.networks),
+        "build_networks_s": build_s,
+        "fast_s": fast_s,
+        "naive_s": naive_s,
+        "fast_materials_per_s": count / fast_s,
+        "naive_materials_per_s": count / naive_s,
+        "ratio_fast_to_naive": naive_s / fast_s,
+        "same_layers": same,
+    }
+
+
+def bench_specs(count: int, seed: int = 7) -> list[MaterialSpec]:
+    """``count`` varied Disney materials (metals, coats, sheen, glass …), all contexts."""
+    rng = np.random.default_rng(seed)
+    specs = []
+    for i in range(count):
+        r = rng.random(8)
+        params = DisneyParams(
+            base_color=tuple(float(x) for x in rng.random(3)),
+            metallic=float(r[0] > 0.7),
+            roughness=float(r[1]),
+            clearcoat=float(r[2] > 0.6) * float(r[3]),
+            sheen=float(r[4] > 0.7) * float(r[5]),
+            spec_trans=float(r[6] > 0.85),
+            specular=float(0.2 + 0.6 * r[7]),
+        )
+        specs.append(material_spec(source_from_params(f"m{i:05d}", "disney", params), CONTEXTS))
+    return specs
+
+
+def author_fast(specs: list[MaterialSpec], base: Path):
+    """The exporter's Sdf-level authoring into a new anonymous layer."""
+    layer = new_layer()
+    author(layer, specs, base)
+    return layer
+
+
+def author_naive(specs: list[MaterialSpec], base: Path):
+    """The same networks through ``UsdShade``, prim by prim, without a change block.
+
+    Returns the in-memory stage (its root layer lives as long as the stage).
+    """
+    from pxr import Sdf, Usd, UsdGeom, UsdShade
+
+    stage = Usd.Stage.CreateInMemory()
+    stage.SetDefaultPrim(UsdGeom.Scope.Define(stage, "/Materials").GetPrim())
+    UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
+    UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+    types = value_types()
+    for spec in specs:
+        path = Sdf.Path("/Materials").AppendChild(prim_name(spec.name))
+        material = UsdShade.Material.Define(stage, path)
+        material.GetPrim().SetCustomData({"lookdev": dict(spec.custom)})
+        for net in spec.networks:
+            shaders = {}
+            for node in net.nodes:
+                shader = UsdShade.Shader.Define(stage, path.AppendChild(node.name))
+                shader.CreateIdAttr(node.id)
+                if any(node.custom.values()):
+                    custom = {k: v for k, v in node.custom.items() if v}
+                    shader.GetPrim().SetCustomData({"lookdev": custom})
+                for name, kind in node.outputs.items():
+                    shader.CreateOutput(name, types[kind])
+                shaders[node.name] = shader
+            for node in net.nodes:
+                for name, (kind, value) in node.inputs.items():
+                    inp = shaders[node.name].CreateInput(name, types[kind])
+                    if isinstance(value, Connection):
+                        inp.ConnectToSource(shaders[value.node].GetOutput(value.output))
+                    else:
+                        inp.Set(usd_value(kind, value, base))
+            terminal = shaders[net.terminal.node].GetOutput(net.terminal.output)
+            output = material.CreateOutput(CONTEXT_OUTPUT[net.context], types["token"])
+            output.ConnectToSource(terminal)
+    return stage
+
+
+def _specs_of(layer) -> set[tuple[str, str, str]]:
+    """Every (prim, property, value or connections) of ``layer``: a layout-free digest."""
+    out = set()
+
+    def visit(path) -> None:
+        spec = layer.GetObjectAtPath(path)
+        if path.IsPropertyPath():
+            targets = getattr(spec, "connectionPathList", None)
+            links = (
+                str(list(targets.explicitItems) + list(targets.prependedItems)) if targets else ""
+            )
+            out.add((str(path), str(spec.typeName), f"{spec.default}|{links}"))
+
+    layer.Traverse(layer.pseudoRoot.path, visit)
+    return out

@@ -1,0 +1,144 @@
+"""Export → import recovers every parameter the written surfaces can express."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+pytest.importorskip("pxr")
+from pxr import Sdf, Usd, UsdShade  # noqa: E402
+
+from lookdev.library import Library, load_material  # noqa: E402
+from lookdev.materials.params import DisneyParams  # noqa: E402
+from lookdev.pipeline.export.usd.lobes import DEFAULTS, canonical, effective  # noqa: E402
+from lookdev.pipeline.export.usd.names import PREVIEW_DISNEY  # noqa: E402
+from lookdev.pipeline.export.usd.network import source_from_params  # noqa: E402
+from lookdev.pipeline.export.usd.reader import import_usd  # noqa: E402
+from lookdev.pipeline.export.usd.sources import source_for  # noqa: E402
+from lookdev.pipeline.export.usd.writer import export_usd  # noqa: E402
+
+PREVIEW_PARAMS = {s.param for s in PREVIEW_DISNEY} | {"specular"}
+"""What UsdPreviewSurface expresses: its table, with both spellings of the F0."""
+UNEXPRESSIBLE = {"sheen_model", "sheen_roughness"}
+"""No target has Conty-Kulla's sheen: MaterialX's and RenderMan's Disney sheen is Burley's."""
+
+unit = st.floats(0.0, 1.0)
+edge_unit = st.sampled_from([0.0, 1.0]) | unit  # the edges themselves, often
+disney = st.fixed_dictionaries(
+    {
+        "base_color": st.tuples(unit, unit, unit),
+        "metallic": edge_unit,
+        "roughness": edge_unit,
+        "subsurface": edge_unit,
+        "specular_tint": edge_unit,
+        "anisotropic": edge_unit,
+        "sheen": edge_unit,
+        "sheen_tint": edge_unit,
+        "clearcoat": st.sampled_from([0.0, 4.0]) | st.floats(0.0, 4.0),
+        "clearcoat_gloss": edge_unit,
+        "spec_trans": edge_unit,
+        "diff_trans": edge_unit,
+        "flatness": edge_unit,
+        "scatter_distance": st.sampled_from([0.0]) | st.floats(0.0, 10.0),
+        "thin": st.booleans(),
+    },
+    optional={"ior": st.floats(1.0, 3.0), "specular": st.floats(0.0, 2.0)},
+).filter(lambda d: not ("ior" in d and "specular" in d))
+
+
+def _round_trip(tmp: Path, params: DisneyParams, contexts) -> dict:
+    out = tmp / "rt.usda"
+    export_usd([source_from_params("m", "disney", params)], out, contexts=contexts)
+    (found,) = import_usd(out)
+    assert found.model == "disney"
+    return found.params
+
+
+def _assert_same(got: dict, want: DisneyParams, keys: set[str]) -> None:
+    """Effective values equal to float32 precision on ``keys`` (F0 compared as IOR)."""
+    a = effective(canonical(DisneyParams.parse(got)))
+    b = effective(canonical(want))
+    for k in sorted(keys):
+        if k == "specular":
+            continue  # one parameter with `ior`; compared there
+        if isinstance(b[k], str | bool):
+            assert a[k] == b[k], k
+        else:
+            np.testing.assert_allclose(a[k], b[k], rtol=2e-6, atol=2e-6, err_msg=k)
+
+
+@settings(
+    max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(data=disney)
+def test_universal_round_trip_recovers_what_it_expresses(tmp_path, data):
+    params = DisneyParams(**data)
+    got = _round_trip(tmp_path, params, ("universal",))
+    _assert_same(got, params, PREVIEW_PARAMS)
+    unexpressed = set(got) - PREVIEW_PARAMS
+    assert not unexpressed, f"read parameters the surface cannot hold: {unexpressed}"
+
+
+@settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(data=disney)
+def test_all_contexts_round_trip_recovers_every_parameter(tmp_path, data):
+    params = DisneyParams(**data)
+    got = _round_trip(tmp_path, params, ("universal", "mtlx", "ri"))
+    _assert_same(got, params, set(DEFAULTS["disney"]) - UNEXPRESSIBLE)
+
+
+def test_spelling_of_the_specular_comes_back(tmp_path):
+    assert _round_trip(tmp_path, DisneyParams(ior=1.33), ("universal",)) == {"ior": 1.33}
+    assert _round_trip(tmp_path, DisneyParams(specular=0.3), ("universal",)) == {
+        "specular": pytest.approx(0.3, rel=1e-6)
+    }
+
+
+@pytest.mark.parametrize("name", Library(use_env=False).names())
+def test_every_builtin_preset_round_trips(tmp_path, name):
+    material = load_material(name, Library(use_env=False))
+    if material.model == "layered":
+        pytest.skip("layered presets round-trip as maps (test_baked_maps_come_back_as_paths)")
+    got = _round_trip(tmp_path, material.params, ("universal", "mtlx", "ri"))
+    _assert_same(got, material.params, set(DEFAULTS["disney"]) - UNEXPRESSIBLE)
+
+
+def test_baked_maps_come_back_as_paths(tmp_path):
+    material = load_material("rusty_iron", Library(use_env=False))
+    scratch = tmp_path / "scratch"
+    scratch.mkdir()
+    source = source_for(material, tmp_path / "tex", 16, scratch=scratch, bake=True)
+    export_usd([source], tmp_path / "r.usda", contexts=("universal",))
+    (found,) = import_usd(tmp_path / "r.usda")
+    assert set(found.maps) == set(source.maps) - {"specular"}  # universal reads F0 as ior
+    for name, path in found.maps.items():
+        assert Path(path).resolve() == (tmp_path / "tex" / source.maps[name].path.name).resolve()
+
+
+def test_foreign_preview_surface_imports(tmp_path):
+    """A UsdPreviewSurface written by another tool, with a texture on its roughness."""
+    path = tmp_path / "foreign.usda"
+    stage = Usd.Stage.CreateNew(str(path))
+    material = UsdShade.Material.Define(stage, "/Looks/Ceramic")
+    surface = UsdShade.Shader.Define(stage, "/Looks/Ceramic/Surface")
+    surface.CreateIdAttr("UsdPreviewSurface")
+    surface.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set((0.9, 0.85, 0.8))
+    surface.CreateInput("ior", Sdf.ValueTypeNames.Float).Set(1.6)
+    tex = UsdShade.Shader.Define(stage, "/Looks/Ceramic/Rough")
+    tex.CreateIdAttr("UsdUVTexture")
+    tex.CreateInput("file", Sdf.ValueTypeNames.Asset).Set("./rough.png")
+    out = tex.CreateOutput("r", Sdf.ValueTypeNames.Float)
+    surface.CreateInput("roughness", Sdf.ValueTypeNames.Float).ConnectToSource(out)
+    material.CreateSurfaceOutput().ConnectToSource(surface.ConnectableAPI(), "surface")
+    stage.Save()
+    (found,) = import_usd(path)
+    assert found.name == "Ceramic"
+    assert found.params["base_color"] == (0.9, 0.85, 0.8)
+    assert found.params["specular"] == pytest.approx(((0.6 / 2.6) ** 2) / 0.08, rel=1e-6)
+    assert found.maps["roughness"].name == "rough.png"
