@@ -48,23 +48,34 @@ def layer_values(params: DisneyParams) -> dict[str, Any]:
     return values
 
 
-def stack_weights(masks: Sequence[Any]) -> list[Any]:
+def stack_weights(masks: Sequence[Any], out: np.ndarray | None = None) -> Any:
     """Weights of the layers of a stack whose masks above the base are ``masks``.
 
-    Returns ``[w₀, w₁, …]`` (base first), each broadcastable like the masks; they sum to 1.
+    Returns ``[w₀, w₁, …]`` (base first), broadcastable like the masks, summing to 1.
+    With ``out`` (shape (L, …)) the weights are written there, in place, and it is
+    returned. Top down, ``wᵢ = mᵢ · r`` then ``r ← r − wᵢ`` (= r (1 − mᵢ)), so mᵢ = 1
+    leaves exactly 0 for every layer below.
 
     >>> [float(w) for w in stack_weights([0.5, 1.0])]  # a full-coverage top hides all below
     [0.0, 0.0, 1.0]
     >>> [float(w) for w in stack_weights([0.5, 0.5])]
     [0.25, 0.25, 0.5]
     """
-    weights = []
+    weights: Any = [None] * (len(masks) + 1) if out is None else out
     remaining: Any = 1.0
-    for m in reversed(masks):
-        weights.append(m * remaining)
-        remaining = remaining * (1.0 - m)
-    weights.append(remaining)
-    return weights[::-1]
+    if out is not None:
+        remaining = out[0]
+        remaining.fill(1.0)
+    for i in range(len(masks), 0, -1):
+        if out is None:
+            weights[i] = masks[i - 1] * remaining
+            remaining = remaining - weights[i]
+        else:
+            np.multiply(masks[i - 1], remaining, out=out[i])
+            remaining -= out[i]
+    if out is None:
+        weights[0] = remaining
+    return weights
 
 
 def check_discrete(stack: Sequence[tuple[str, DisneyParams]]) -> dict[str, Any]:

@@ -32,7 +32,7 @@ import numpy as np
 from . import disney
 from .errors import BlendError
 from .masks import MaskSampler
-from .stack import Decision, Entry, prune, stack_of
+from .stack import Decision, Entry, prune_stack, stack_of
 
 TILE_TEXELS = 1 << 16
 """Texels per tile: a tile's temporaries (a few channels) stay within a CPU cache."""
@@ -101,33 +101,41 @@ def blend(
     resolution: int | tuple[int, int] = 1024,
     *,
     progress: Progress | None = None,
+    prune: bool = True,
+    images: dict | None = None,
 ) -> BlendedMaterial:
     """Blend a library :class:`~lookdev.library.Material` at ``resolution``.
 
     ``resolution`` is ``N`` (N × N) or ``(width, height)``. A non-layered material blends
     to constants and no maps. Disney stacks blend parameters (:mod:`.disney`); Pixar
-    stacks composite lobe weights (:mod:`.pixar`).
+    stacks composite lobe weights (:mod:`.pixar`). ``prune=False`` turns off every
+    saving (all layers, all parameters as maps) and exists to measure them. ``images``
+    caches decoded textures across calls (see :class:`.MaskSampler`).
     """
     width, height = (resolution, resolution) if isinstance(resolution, int) else resolution
     if width < 1 or height < 1:
         raise BlendError(f"resolution {width}x{height} must be at least 1x1", where=material.name)
-    sampler = MaskSampler((height, width))
+    sampler = MaskSampler((height, width), images)
     entries = stack_of(material)
-    kept, decisions = prune(entries, sampler)
     if entries[0].model == "pixar":
         from . import pixar
 
-        result = pixar.blend_stack(material.name, kept, sampler, progress)
-    else:
-        result = _blend_disney(material.name, kept, sampler, progress)
+        return pixar.blend_stack(material.name, entries, sampler, progress, prune=prune)
+    kept, decisions = prune_stack(entries, sampler, enabled=prune)
+    result = _blend_disney(material.name, kept, sampler, progress, naive=not prune)
     result.decisions = decisions + result.decisions
     return result
 
 
-def _blend_disney(name: str, kept: list[Entry], sampler: MaskSampler, progress) -> BlendedMaterial:
+def _blend_disney(
+    name: str, kept: list[Entry], sampler: MaskSampler, progress, *, naive: bool = False
+) -> BlendedMaterial:
     """Parameter blending of the kept layers (bottom first) into constants and maps."""
     values = [disney.layer_values(e.params) for e in kept]
-    constants, varying, inert = _plan(values, kept)
+    if naive:
+        constants, varying, inert = {}, set(values[0]), set()
+    else:
+        constants, varying, inert = _plan(values, kept)
     decisions = [Decision(kept[i].label, False, "sets what is already below it") for i in inert]
     kept = [e for i, e in enumerate(kept) if i not in inert]
     values = [v for i, v in enumerate(values) if i not in inert]
@@ -181,7 +189,12 @@ def _lerp(a: Any, b: Any, m: float) -> Any:
 
 
 def _disney_maps(kept, values, varying, sampler, progress, out: BlendedMaterial):
-    """Fill the varying parameter maps (and normal maps) tile by tile."""
+    """Fill the varying parameter maps (and normal maps) tile by tile.
+
+    Per tile: the layer weights (L, T), then every varying scalar as one matrix product
+    (S, L) @ (L, T) into a cache-sized buffer copied into the maps, and the colour as
+    (T, L) @ (L, 3) straight into the interleaved colour map.
+    """
     height, width = sampler.height, sampler.width
     scalars = [k for k in disney.SCALARS if k in varying]
     normals = any(e.normal_map is not None for e in kept)
@@ -191,7 +204,7 @@ def _disney_maps(kept, values, varying, sampler, progress, out: BlendedMaterial)
     block = np.empty((len(scalars), height, width), dtype=np.float32)
     maps = {k: block[i] for i, k in enumerate(scalars)}
     p_scalar = np.array([[v[k] for v in values] for k in scalars], dtype=np.float32)
-    p_color = np.array([v[disney.COLOR] for v in values], dtype=np.float32).T
+    p_color = np.array([v[disney.COLOR] for v in values], dtype=np.float32)
     if disney.COLOR in varying:
         maps[disney.COLOR] = np.empty((height, width, 3), dtype=np.float32)
     if normals:
@@ -199,14 +212,17 @@ def _disney_maps(kept, values, varying, sampler, progress, out: BlendedMaterial)
     if spec_normals:
         out.specular_normal_map = np.empty((height, width, 3), dtype=np.float32)
     rows_per_tile = max(1, TILE_TEXELS // width)
+    weights_buf = np.empty((len(kept), rows_per_tile * width), dtype=np.float32)
+    scalar_buf = np.empty((len(scalars), rows_per_tile * width), dtype=np.float32)
     for r0 in range(0, height, rows_per_tile):
         rows = slice(r0, min(height, r0 + rows_per_tile))
         n = rows.stop - rows.start
-        weights = _tile_weights(kept, sampler, rows)
+        weights = _tile_weights(kept, sampler, rows, weights_buf[:, : n * width])
         if scalars:
-            block[:, rows] = (p_scalar @ weights).reshape(len(scalars), n, width)
+            tile = np.matmul(p_scalar, weights, out=scalar_buf[:, : n * width])
+            block[:, rows] = tile.reshape(len(scalars), n, width)
         if disney.COLOR in varying:
-            maps[disney.COLOR][rows] = (p_color @ weights).T.reshape(n, width, 3)
+            np.matmul(weights.T, p_color, out=maps[disney.COLOR][rows].reshape(-1, 3))
         if normals:
             out.normal_map[rows] = _tile_normals(kept, sampler, rows, weights, "normal_map")
         if spec_normals:
@@ -218,14 +234,10 @@ def _disney_maps(kept, values, varying, sampler, progress, out: BlendedMaterial)
     return maps
 
 
-def _tile_weights(kept: list[Entry], sampler: MaskSampler, rows: slice) -> np.ndarray:
-    """Layer weights (L, texels of the tile), base first (:func:`.disney.stack_weights`)."""
-    n = rows.stop - rows.start
-    masks = [e.coverage(sampler, rows) for e in kept[1:]]
-    weights = np.empty((len(kept), n * sampler.width), dtype=np.float32)
-    for w, row in zip(disney.stack_weights(masks), weights, strict=True):
-        row[...] = np.reshape(w, -1) if np.ndim(w) else w
-    return weights
+def _tile_weights(kept: list[Entry], sampler: MaskSampler, rows: slice, out: np.ndarray):
+    """Layer weights into ``out`` (L, texels of the tile), base first (stack_weights)."""
+    masks = [np.reshape(e.coverage(sampler, rows), -1) for e in kept[1:]]
+    return disney.stack_weights(masks, out=out)
 
 
 def _tile_normals(kept, sampler, rows, weights, which: str) -> np.ndarray:

@@ -43,21 +43,24 @@ from .resample import read_channels, resample, taps
 class MaskSampler:
     """Evaluates masks for one output resolution, reading each texture once.
 
-    ``resolution`` is ``(height, width)``; ``where`` names the layer in error messages.
+    ``resolution`` is ``(height, width)``. ``images`` is a cache of decoded texture
+    channels, ``{key: (array, (min, max))}``; pass one dict to several samplers (other
+    resolutions, other materials sharing masks) to decode each file once.
     """
 
-    def __init__(self, resolution: tuple[int, int]):
+    def __init__(self, resolution: tuple[int, int], images: dict | None = None):
         self.height, self.width = resolution
-        self._images: dict[tuple, np.ndarray] = {}
-        self._ranges: dict[tuple, tuple[float, float]] = {}
+        self._images: dict[tuple, tuple[np.ndarray, tuple[float, float]]] = (
+            {} if images is None else images
+        )
 
     def image(self, tex: TextureMask, count: int = 1, *, where: str | None = None) -> np.ndarray:
         """The source channels of ``tex`` (cached), float32 (h, w, count) in UV order."""
         key = (str(tex.path), tex.channel, count)
         if key not in self._images:
-            self._images[key] = read_channels(tex, count, where=where)
-            self._ranges[key] = (float(self._images[key].min()), float(self._images[key].max()))
-        return self._images[key]
+            a = read_channels(tex, count, where=where)
+            self._images[key] = (a, (float(a.min()), float(a.max())))
+        return self._images[key][0]
 
     def lookup(
         self, tex: TextureMask, count: int = 1, rows: slice | None = None, *, where=None
@@ -132,7 +135,7 @@ class MaskSampler:
 
     def _texture_bounds(self, tex: TextureMask, where) -> tuple[float, float]:
         self.image(tex, 1, where=where)
-        lo, hi = (min(max(x, 0.0), 1.0) for x in self._ranges[(str(tex.path), tex.channel, 1)])
+        lo, hi = (min(max(x, 0.0), 1.0) for x in self._images[(str(tex.path), tex.channel, 1)][1])
         if tex.wrap == "black" and self._reads_outside(tex):
             lo = 0.0
         return (1.0 - hi, 1.0 - lo) if tex.invert else (lo, hi)

@@ -42,6 +42,8 @@ class Entry:
     source: str | None = None
     low: float = 1.0
     high: float = 1.0
+    per_texel: bool = False
+    """Evaluate the mask per texel even when its bounds say it is uniform (no pruning)."""
 
     @property
     def where(self) -> str:
@@ -50,7 +52,7 @@ class Entry:
     @property
     def uniform(self) -> bool:
         """True when the coverage is one number everywhere (``low == high``)."""
-        return self.low == self.high
+        return self.low == self.high and not self.per_texel
 
     def coverage(self, sampler: MaskSampler, rows: slice) -> np.ndarray | np.float32:
         """Mask × presence on output ``rows``: a scalar when uniform, else (n, W) float32."""
@@ -110,12 +112,13 @@ def _entry(index: int, layer: Any) -> Entry:
     )
 
 
-def prune(
+def prune_stack(
     entries: list[Entry],
     sampler: MaskSampler,
     *,
     base_opaque: bool = True,
     hides: Callable[[Entry], bool] = lambda entry: True,
+    enabled: bool = True,
 ) -> tuple[list[Entry], list[Decision]]:
     """Bound every layer's coverage, then drop the layers the result cannot show.
 
@@ -123,6 +126,8 @@ def prune(
     its parameters with, so its mask is not used). ``hides(entry)``: a full-coverage
     ``entry`` hides everything below it (always for Disney; Pixar only when opaque).
     Every texture is opened here, so a bad file is reported even on a dropped layer.
+    ``enabled=False`` keeps every layer and evaluates every mask per texel (the naive
+    engine, for measuring what pruning saves and for testing that it changes nothing).
     """
     for i, entry in enumerate(entries):
         if i == 0 and base_opaque:
@@ -132,6 +137,12 @@ def prune(
         for tex in (entry.normal_map, entry.specular_normal_map):
             if tex is not None:
                 sampler.image(tex, 3, where=entry.where)
+    if not enabled:
+        for entry in entries:
+            entry.per_texel = True
+        if base_opaque:
+            entries[0].low = entries[0].high = 1.0
+        return list(entries), [Decision(e.label, True, "pruning off") for e in entries]
     decisions: list[Decision] = []
     bottom = 0
     for i in range(len(entries) - 1, 0, -1):

@@ -1,0 +1,200 @@
+"""``lookdev bench blend``: the blending engine against the memory-bandwidth bound.
+
+The stack: a base and four Disney layers over it, each under its own float EXR texture
+mask (written with OpenImageIO into a temporary folder), with every continuous parameter
+different per layer, so all parameter maps vary. Measured in one run:
+
+- ``blend_s``: ``blend()`` at N × N with the masks already decoded (the engine itself);
+  ``blend_cold_s`` also decodes the four EXRs;
+- ``copy_s``: ``np.copy`` of as many bytes as the output holds (new memory, as the blend
+  writes into new memory): the bandwidth bound; ``copy_warm_s`` copies into memory
+  already touched, the bound without page faults;
+- ``ratio_blend_to_copy = blend_s / copy_s`` (target ≤ 4);
+- ``peak_to_output``: peak bytes allocated during a cold blend (``tracemalloc``, which sees
+  numpy's allocations but not OpenImageIO's decode buffers) over the output's bytes
+  (target < 2);
+- pruning: the same blend with ``prune=False`` on the built-in ``rusty_car_paint`` (maps
+  that need not vary) and on this stack with a full-coverage layer and a zero layer added
+  (layers that need not be blended).
+"""
+
+from __future__ import annotations
+
+import tempfile
+import tracemalloc
+from pathlib import Path
+from typing import Annotated, Any
+
+import numpy as np
+import OpenImageIO as oiio
+import typer
+
+from lookdev.materials.layers import TextureMask
+from lookdev.materials.params import DisneyParams
+from lookdev.pipeline.blend import blend
+from lookdev.pipeline.blend.disney import SCALARS
+
+LAYERS = 4
+PRUNING_PRESET = "rusty_car_paint"
+
+
+def command(
+    resolution: Annotated[
+        int, typer.Option("--resolution", "-r", min=16, max=8192, help="Texels per side.")
+    ] = 2048,
+    repeat: Annotated[int, typer.Option(min=1, max=20, help="Timed runs; the best counts.")] = 3,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+) -> None:
+    """Blend 4 texture-masked Disney layers into all parameter maps vs a numpy copy.
+
+    Reports the time against the memory-bandwidth bound measured in the same run
+    (target ≤ 4×), peak memory against the output size (target < 2×), and what pruning
+    saved on a preset where it applies.
+    """
+    from lookdev.pipeline.cli.common import console, print_json, table
+
+    with tempfile.TemporaryDirectory(prefix="lookdev-bench-blend-") as tmp:
+        result = run(resolution, Path(tmp), repeat=repeat)
+    if as_json:
+        print_json(result)
+        return
+    rows = [[k, v] for k, v in result.items() if not isinstance(v, dict)]
+    for name, saving in result["pruning"].items():
+        rows += [[f"pruning {name}: {k}", v] for k, v in saving.items()]
+    console.print(table(f"bench blend ({resolution}²)", ["measure", "value"], rows))
+
+
+def run(resolution: int, folder: Path, *, repeat: int = 3) -> dict[str, Any]:
+    """Every figure of the benchmark (see module doc) as one flat-ish dict."""
+    best_time = _best_time()
+    material = bench_material(folder, resolution)
+    images: dict = {}
+    out = blend(material, resolution, images=images)
+    blend_s = best_time(lambda: blend(material, resolution, images=images), repeat=repeat)
+    blend_cold_s = best_time(lambda: blend(material, resolution), repeat=max(1, repeat - 1))
+    copy_s, copy_warm_s = copy_times(out.nbytes, repeat)
+    peak = peak_bytes(lambda: blend(material, resolution))
+    return {
+        "resolution": resolution,
+        "layers": LAYERS,
+        "maps": len(out.maps),
+        "output_mb": out.nbytes / 1e6,
+        "blend_s": blend_s,
+        "blend_cold_s": blend_cold_s,
+        "copy_s": copy_s,
+        "copy_warm_s": copy_warm_s,
+        "ratio_blend_to_copy": blend_s / copy_s,
+        "ratio_blend_to_warm_copy": blend_s / copy_warm_s,
+        "ratio_cold_blend_to_copy": blend_cold_s / copy_s,
+        "peak_mb": peak / 1e6,
+        "peak_to_output": peak / out.nbytes,
+        "pruning": {
+            PRUNING_PRESET: pruning_saving(_library_material(PRUNING_PRESET), resolution, repeat),
+            "hidden+zero layers": pruning_saving(
+                with_prunable_layers(material, folder, resolution), resolution, repeat
+            ),
+        },
+    }
+
+
+def bench_material(folder: Path, resolution: int, *, seed: int = 1):
+    """A base and :data:`LAYERS` layers, every continuous parameter different per layer."""
+    from lookdev.library import Layer, Material
+
+    rng = np.random.default_rng(seed)
+    layers = [Layer(material=_random_disney("base", rng), name="base")]
+    for i in range(LAYERS):
+        path = write_mask(folder / f"mask{i}.exr", rng.random((resolution, resolution)))
+        layers.append(
+            Layer(material=_random_disney(f"l{i}", rng), mask=TextureMask(path=path), name=f"l{i}")
+        )
+    return Material(name="bench_blend", model="layered", layers=layers)
+
+
+def with_prunable_layers(material, folder: Path, resolution: int):
+    """``material`` plus a full-coverage layer over its base and a zero layer on top."""
+    from lookdev.library import Layer
+
+    rng = np.random.default_rng(2)
+    ones = write_mask(folder / "ones.exr", np.ones((resolution, resolution)))
+    zeros = write_mask(folder / "zeros.exr", np.zeros((resolution, resolution)))
+    hide = Layer(material=_random_disney("cover", rng), mask=TextureMask(path=ones), name="cover")
+    zero = Layer(material=_random_disney("none", rng), mask=TextureMask(path=zeros), name="none")
+    layers = [material.layers[0], hide, *material.layers[1:], zero]
+    return material.model_copy(update={"name": "bench_prunable", "layers": layers})
+
+
+def pruning_saving(material, resolution: int, repeat: int) -> dict[str, Any]:
+    """Time and bytes with pruning against without (``prune=False``)."""
+    best_time = _best_time()
+    images: dict = {}
+    pruned = blend(material, resolution, images=images)
+    naive = blend(material, resolution, images=images, prune=False)
+    pruned_s = best_time(lambda: blend(material, resolution, images=images), repeat=repeat)
+    naive_s = best_time(
+        lambda: blend(material, resolution, images=images, prune=False), repeat=repeat
+    )
+    return {
+        "layers_kept": sum(d.kept for d in pruned.decisions),
+        "layers_total": len(naive.decisions),
+        "maps": len(pruned.maps),
+        "maps_without": len(naive.maps),
+        "mb": pruned.nbytes / 1e6,
+        "mb_without": naive.nbytes / 1e6,
+        "s": pruned_s,
+        "s_without": naive_s,
+        "speedup": naive_s / pruned_s,
+    }
+
+
+def copy_times(nbytes: int, repeat: int) -> tuple[float, float]:
+    """Best times of copying ``nbytes`` into new memory and into memory already touched."""
+    best_time = _best_time()
+    src = np.ones(nbytes // 4, dtype=np.float32)
+    dst = np.zeros_like(src)
+    return (
+        best_time(lambda: np.copy(src), repeat=repeat),
+        best_time(lambda: np.copyto(dst, src), repeat=repeat),
+    )
+
+
+def peak_bytes(fn) -> int:
+    """Peak bytes traced by ``tracemalloc`` while ``fn`` runs (numpy allocations included)."""
+    tracemalloc.start()
+    try:
+        fn()
+        return tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+
+
+def write_mask(path: Path, values: np.ndarray) -> Path:
+    """A one-channel float EXR written with OpenImageIO."""
+    height, width = values.shape
+    buf = oiio.ImageBuf(oiio.ImageSpec(width, height, 1, oiio.FLOAT))
+    buf.set_pixels(oiio.ROI(0, width, 0, height, 0, 1, 0, 1), values.astype(np.float32))
+    if not buf.write(str(path)):
+        raise RuntimeError(f"cannot write {path}: {buf.geterror()}")
+    return path
+
+
+def _random_disney(name: str, rng: np.random.Generator):
+    from lookdev.library import Material
+
+    values: dict[str, Any] = {k: float(rng.uniform(0.05, 0.95)) for k in SCALARS}
+    values["base_color"] = tuple(float(x) for x in rng.uniform(0.05, 0.95, 3))
+    params = DisneyParams.parse(values)
+    return Material(name=name, model="disney", params=params)
+
+
+def _library_material(name: str):
+    from lookdev.library import Library
+
+    return Library(use_env=False).load(name)
+
+
+def _best_time():
+    # Imported when called: the CLI imports this module while it registers its commands.
+    from lookdev.pipeline.cli.bench import best_time
+
+    return best_time
