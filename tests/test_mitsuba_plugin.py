@@ -181,25 +181,27 @@ def test_unknown_parameter_is_one_line_error(mi, tiny):
 
 
 # -- the shipped models ------------------------------------------------------------------
-# (model, parameters, id): the grid of the issue, extremes included.
+# (model, parameters, id, sharpest α or None): the grid of the issue, extremes included.
 CASES = [
-    ("sheen", {"roughness": 0.0}, "sheen-r0"),
-    ("sheen", {"roughness": 0.3, "color": [0.9, 0.5, 0.3]}, "sheen-r0.3"),
-    ("sheen", {"roughness": 1.0, "terminator_softening": False}, "sheen-r1-reciprocal"),
-    ("disney", {"roughness": 0.0}, "disney-r0"),
-    ("disney", {"roughness": 1.0}, "disney-r1"),
-    ("disney", {"roughness": 0.3, "anisotropic": 1.0}, "disney-aniso1"),
-    ("disney", {"metallic": 1.0, "roughness": 0.2}, "disney-metal"),
-    ("disney", {"metallic": 0.0, "roughness": 0.5, "specular_tint": 1.0}, "disney-dielectric"),
-    ("disney", {"clearcoat": 1.0, "clearcoat_gloss": 1.0, "roughness": 0.6}, "disney-clearcoat1"),
-    ("disney", {"spec_trans": 1.0, "roughness": 0.1, "ior": 1.5}, "disney-glass"),
-    ("disney", {"spec_trans": 1.0, "roughness": 0.3, "thin": True}, "disney-thin-glass"),
-    ("disney", {"diff_trans": 0.7, "thin": True, "flatness": 0.5}, "disney-leaf"),
-    ("disney", {"sheen": 1.0, "sheen_tint": 0.5, "subsurface": 1.0}, "disney-sheen"),
+    ("sheen", {"roughness": 0.0}, "sheen-r0", None),
+    ("sheen", {"roughness": 0.3, "color": [0.9, 0.5, 0.3]}, "sheen-r0.3", None),
+    ("sheen", {"roughness": 1.0, "terminator_softening": False}, "sheen-r1-reciprocal", None),
+    ("disney", {"roughness": 0.0}, "disney-r0", 1e-3),
+    ("disney", {"roughness": 1.0}, "disney-r1", 1.0),
+    ("disney", {"roughness": 0.3, "anisotropic": 1.0}, "disney-aniso1", 0.028),
+    ("disney", {"metallic": 1.0, "roughness": 0.2}, "disney-metal", 0.04),
+    ("disney", {"metallic": 0.0, "roughness": 0.5, "specular_tint": 1.0}, "disney-tinted", 0.25),
+    ("disney", {"clearcoat": 1.0, "clearcoat_gloss": 1.0, "roughness": 0.6}, "disney-coat1", 1e-3),
+    ("disney", {"clearcoat": 1.0, "clearcoat_gloss": 0.5, "roughness": 0.6}, "disney-coat.5", 0.05),
+    ("disney", {"spec_trans": 1.0, "roughness": 0.1, "ior": 1.5}, "disney-glass", 0.01),
+    ("disney", {"spec_trans": 1.0, "roughness": 0.3, "thin": True}, "disney-thin-glass", 0.035),
+    ("disney", {"diff_trans": 0.7, "thin": True, "flatness": 0.5}, "disney-leaf", 0.25),
+    ("disney", {"sheen": 1.0, "sheen_tint": 0.5, "subsurface": 1.0}, "disney-sheen", 0.25),
     (
         "disney",
         {"sheen": 1.0, "sheen_model": "conty_kulla", "sheen_roughness": 0.5},
         "disney-ck-sheen",
+        0.25,
     ),
 ]
 # Views: normal incidence, 60°, nearly grazing (85°), and from below for transmitters.
@@ -209,6 +211,13 @@ VIEWS = {
     "85deg": (math.sin(math.radians(85)), 0.0, math.cos(math.radians(85))),
     "below": (0.3, 0.2, -0.93),
 }
+GLOBAL_MIN_ALPHA = 0.05  # narrower peaks need the zoomed chart (tests/_mitsuba_chi2.py)
+# float32: microfacet.sample_gtr takes sin θh as sqrt(1 − cos²θh), which at α = 1e-3 is
+# quantised to a few per cent near the peak (measured: 0.000977 vs 0.000998 at ξ = 0.05).
+GTR1_FLOAT32 = pytest.mark.xfail(
+    reason="GTR1 sampling loses sin θh to float32 at α = 1e-3 (materials/microfacet.py)",
+    strict=True,
+)
 
 
 def _case_params(model_name, values):
@@ -230,31 +239,66 @@ def _plugin(mi, params):
     return d
 
 
-CHI2_CASES = [
+def _views(values):
+    transmits = values.get("spec_trans") or values.get("diff_trans")
+    return [v for v in VIEWS if v != "below" or transmits]
+
+
+def _peaks(values, wi):
+    """(name, axis) of each narrow peak seen from ``wi``: mirror, refraction, or through."""
+    wi = _unit(wi)
+    peaks = [("mirror", np.array([-wi[0], -wi[1], wi[2]]))]
+    if values.get("spec_trans") and values.get("thin"):
+        peaks.append(("through", -wi))
+    elif values.get("spec_trans"):
+        eta = values.get("ior", 1.5) if wi[2] > 0 else 1.0 / values.get("ior", 1.5)
+        cos_t = -np.sign(wi[2]) * math.sqrt(1.0 - (1.0 - wi[2] ** 2) / eta**2)
+        peaks.append(("refract", -wi / eta + np.array([0.0, 0.0, wi[2] / eta + cos_t])))
+    return peaks
+
+
+GLOBAL_CASES = [
     pytest.param(model, values, view, id=f"{name}-{view}")
-    for model, values, name in CASES
-    for view in VIEWS
-    if view != "below" or values.get("spec_trans") or values.get("diff_trans")
+    for model, values, name, alpha in CASES
+    for view in _views(values)
+    if alpha is None or alpha >= GLOBAL_MIN_ALPHA
+]
+PEAK_CASES = [
+    pytest.param(
+        model,
+        values,
+        view,
+        peak,
+        min(max(12.0 * alpha, 0.01), 0.6),
+        id=f"{name}-{view}-{peak}",
+        marks=[GTR1_FLOAT32] if (name, view) == ("disney-coat1", "60deg") else [],
+    )
+    for model, values, name, alpha in CASES
+    if alpha is not None
+    for view in _views(values)
+    for peak, _ in _peaks(values, VIEWS[view])
 ]
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("model_name", "values", "view"), CHI2_CASES)
-def test_chi2_shipped_models(mi, model_name, values, view):
-    from mitsuba.chi2 import BSDFAdapter, ChiSquareTest, SphericalDomain
+@pytest.mark.parametrize(("model_name", "values", "view"), GLOBAL_CASES)
+def test_chi2_whole_sphere(mi, model_name, values, view):
+    from _mitsuba_chi2 import chi2
 
     _, params = _case_params(model_name, values)
-    d = _plugin(mi, params)
-    sample, pdf = BSDFAdapter(d["type"], d, wi=_unit(VIEWS[view]).tolist())
-    test = ChiSquareTest(
-        domain=SphericalDomain(),
-        sample_func=sample,
-        pdf_func=pdf,
-        sample_dim=3,
-        sample_count=200_000,
-        res=61,
-    )
-    assert test.run(), test.messages
+    passed, test = chi2(_plugin(mi, params), _unit(VIEWS[view]))
+    assert passed, test.messages
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("model_name", "values", "view", "peak", "radius"), PEAK_CASES)
+def test_chi2_zoomed_on_peak(mi, model_name, values, view, peak, radius):
+    from _mitsuba_chi2 import chi2
+
+    _, params = _case_params(model_name, values)
+    axis = dict(_peaks(values, VIEWS[view]))[peak]
+    passed, test = chi2(_plugin(mi, params), _unit(VIEWS[view]), axis=axis, radius=radius)
+    assert passed, test.messages
 
 
 @pytest.mark.parametrize(
@@ -315,8 +359,10 @@ def test_white_furnace_sphere_matches_numpy_albedo(mi, model_name, values):
     scene["ball"]["bsdf"] = _plugin(mi, params)
     image = np.array(mi.render(mi.load_dict(scene), seed=1))
     rows, cols = np.mgrid[14:18, 14:18]
-    theta = _pixel_view_angles(scene, rows, cols).ravel()
-    expected = albedo_monte_carlo(model, params, theta, n_samples=65536).albedo.mean(axis=0)
+    # The window's pixels see the sphere at three distinct angles (by symmetry).
+    theta, count = np.unique(np.round(_pixel_view_angles(scene, rows, cols), 9), return_counts=True)
+    albedo = albedo_monte_carlo(model, params, theta, n_samples=65536).albedo
+    expected = (albedo * count[:, None]).sum(axis=0) / count.sum()
     got = image[14:18, 14:18].reshape(-1, 3).mean(axis=0)
     np.testing.assert_allclose(got, expected, rtol=0.02, atol=2e-3)
 

@@ -236,8 +236,8 @@ def _plugin_class(variant: str) -> type:
         ) -> mi.Bool:
             """Directions in a hemisphere whose component the context asks for."""
             same_side = cos_view * cos_light > 0
-            want_r = ctx.is_enabled(self.components[0], 0)
-            want_t = ctx.is_enabled(self.components[1], self.component_index[1])
+            want_r = _is_enabled(ctx, self.components[0], self.component_index[0])
+            want_t = _is_enabled(ctx, self.components[1], self.component_index[1])
             return (same_side & want_r) | (~same_side & want_t)
 
         def eval(self, ctx, si, wo, active=True):
@@ -290,8 +290,15 @@ def _plugin_class(variant: str) -> type:
     return ModelBSDF
 
 
-def _union(flags: list[Any], flag: Any) -> Any:
-    return functools.reduce(lambda a, b: a | b, flags, flag.Empty)
+def _union(flags: list[Any], flag: Any) -> int:
+    return int(functools.reduce(lambda a, b: a | b, flags, flag.Empty))
+
+
+def _is_enabled(ctx: Any, component: int, index: int) -> bool:
+    """Mitsuba's ``BSDFContext::is_enabled`` for a union of flags (the binding takes one)."""
+    every_component = 0xFFFFFFFF
+    wanted = (ctx.type_mask & component) == component
+    return bool(component) and wanted and ctx.component in (every_component, index)
 
 
 def _leading(component: Any, flag: Any) -> int:
