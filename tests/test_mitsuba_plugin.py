@@ -405,3 +405,22 @@ def test_chi2_rejects_a_pdf_that_does_not_match_sampling(mi):
         res=61,
     )
     assert not test.run()
+
+
+def test_sampled_eta_follows_refraction(mi):
+    import drjit as dr
+
+    _, params = _case_params("disney", {"spec_trans": 1.0, "roughness": 0.2, "ior": 1.5})
+    bsdf = mi.load_dict(_plugin(mi, params))
+    n = 4096
+    for side, want in ((1.0, 1.5), (-1.0, 1.0 / 1.5)):
+        si = dr.zeros(mi.SurfaceInteraction3f, n)
+        si.wi = mi.Vector3f(0.0, 0.0, side)
+        rng = np.random.default_rng(5)
+        u = rng.random((3, n))
+        bs, value = bsdf.sample(mi.BSDFContext(), si, mi.Float(u[0]), mi.Point2f(u[1], u[2]))
+        eta, z = np.array(bs.eta), np.array(bs.wo)[2]
+        ok = np.array(bs.pdf) > 0
+        assert np.any(ok & (z * side < 0)) and np.any(ok & (z * side > 0))
+        np.testing.assert_allclose(eta[ok & (z * side < 0)], want, rtol=1e-6)
+        np.testing.assert_allclose(eta[ok & (z * side > 0)], 1.0)

@@ -269,8 +269,8 @@ def _plugin_class(variant: str) -> type:
             bs = dr.zeros(mi.BSDFSample3f)
             bs.wo = mi.Vector3f(wi)
             bs.pdf = mi.Float(pdf)
-            bs.eta = 1.0
             reflected = si.wi.z * bs.wo.z > 0
+            bs.eta = self._eta(prepared, si.wi.z, reflected)
             bs.sampled_component = dr.select(
                 reflected, mi.UInt32(self.component_index[0]), mi.UInt32(self.component_index[1])
             )
@@ -283,6 +283,19 @@ def _plugin_class(variant: str) -> type:
             value = dr.select(ok, mi.Spectrum(weight), 0.0)
             bs.pdf = dr.select(ok, bs.pdf, 0.0)
             return bs, value
+
+        def _eta(self, prepared: Any, cos_view: mi.Float, reflected: mi.Bool) -> mi.Float:
+            """Relative IOR along a sampled path (Mitsuba's Russian roulette tracks it).
+
+            Through a solid dielectric it is the model's ``prepared["eta"]`` going in and
+            its inverse going out; reflections and thin sheets do not bend the path.
+            """
+            eta = prepared.get("eta") if isinstance(prepared, dict) else None
+            solid = not getattr(self.params, "thin", False)
+            if eta is None or not solid or not self.components[1] & flag.GlossyTransmission:
+                return mi.Float(1.0)
+            crossing = dr.select(cos_view > 0, eta, 1.0 / eta)
+            return dr.select(reflected, 1.0, crossing)
 
         def to_string(self) -> str:
             return f"ModelBSDF[model={self.model.name!r}, lobes={self.m_flags!r}]"
