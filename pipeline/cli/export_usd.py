@@ -109,6 +109,7 @@ def export_usd(
         raise ExportError("name at least one preset, or give --all", field="PRESETS")
     contexts = tuple(c.value for c in context) if context else CONTEXTS
     out = output.expanduser()
+    package = package or out.suffix == ".usdz"
     with tempfile.TemporaryDirectory(prefix=".lookdev-bake-", dir=_existing(out)) as scratch:
         textures = f"{out.stem}_textures"
         texture_dir = Path(scratch, textures) if package else out.parent / textures
