@@ -117,7 +117,8 @@ def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
     thin = params.thin
     base = xp.color(maps.get("base_color", params.base_color))
     tint = tint_color(xp, base)
-    eta = xp.maximum(_eta(xp, params, maps), ETA_MIN)
+    eta = _eta(xp, params, maps)
+    eta = max(eta, ETA_MIN) if isinstance(eta, float) else xp.maximum(eta, ETA_MIN)
     w_d = (1.0 - p["metallic"]) * (1.0 - p["spec_trans"])
     w_g = (1.0 - p["metallic"]) * p["spec_trans"]
     a, b, c = _fresnel_terms(xp, p, base, tint, w_d, w_g, eta)
@@ -148,7 +149,8 @@ def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
     }
     if thin:
         # Burley 2015 Fig. 15 via Schutte: a thin sheet's transmission looks rougher.
-        r_t = xp.clip((0.65 * eta - 0.35) * p["roughness"], 0.0, 1.0)
+        r_t = (0.65 * eta - 0.35) * p["roughness"]
+        r_t = min(r_t, 1.0) if isinstance(r_t, float) else xp.minimum(r_t, 1.0)
         pr["tax"], pr["tay"] = mf.anisotropic_alphas(xp, r_t, p["anisotropic"])
     else:
         pr["tax"], pr["tay"] = ax, ay
@@ -210,18 +212,20 @@ def _normalise(xp: Any, est: dict[str, Any], lobes: tuple[str, ...]) -> dict[str
 
 # -- the frame: thin sheets are two-sided, a solid is seen from inside only through glass --
 def _orient(xp: Any, wi: Any, wo: Any) -> tuple[Any, Any, Any]:
-    """(wi, wo) mirrored so that wo is in the upper hemisphere, and the mirror sign."""
-    s = xp.select(wo[2] < 0.0, -1.0, 1.0)
+    """(wi, wo) mirrored so that wo is in the upper hemisphere, and the mirror sign ±1."""
+    one = xp.full(wo[2], 1.0)  # of the directions' dtype: float32 stays float32
+    s = xp.select(wo[2] < 0.0, -one, one)
     return xp.vec3(wi[0], wi[1], wi[2] * s), xp.vec3(wo[0], wo[1], wo[2] * s), s
 
 
 def _front(pr: dict[str, Any], s: Any) -> Any:
-    """Where the outside's lobes exist: everywhere on a thin sheet, else where wo.z > 0."""
-    return True if pr["thin"] else s > 0.0
+    """1 where the outside's lobes exist, 0 inside a solid; None on a (two-sided) thin sheet."""
+    return None if pr["thin"] else 0.5 + 0.5 * s
 
 
 def _pick(xp: Any, front: Any, outside: Any, inside: Any) -> Any:
-    return outside if front is True else xp.select(front, outside, inside)
+    """``outside`` where front is 1, ``inside`` where it is 0 (exactly: x·1 + y·0)."""
+    return outside if front is None else outside * front + inside * (1.0 - front)
 
 
 # -- lobes, in the oriented frame (wo.z ≥ 0) -------------------------------------------------
@@ -246,7 +250,7 @@ def _sheen(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, cos2_d: Any) -> Any:
     color = pr["sheen"] * pr["sheen_color"]
     if pr["sheen_model"] == "conty_kulla":
         ck = _conty_kulla()
-        return color * ck.lobe(xp, wi, wo, pr["sheen_r"], True)
+        return color * ck.lobe(xp, wi, wo, xp.asarray(pr["sheen_r"]), True)
     return color * fr.schlick_weight(xp, xp.sqrt(cos2_d))  # 2014 addendum
 
 
@@ -259,7 +263,8 @@ def _base_scale(xp: Any, pr: dict[str, Any], ci: Any, co: Any) -> Any:
     if "sheen" not in pr["lobes"] or pr["sheen_model"] != "conty_kulla":
         return 1.0
     color = pr["sheen"] * pr["sheen_color"]
-    return xp.maximum(_conty_kulla().base_scale(xp, ci, co, pr["sheen_r"], color), 0.0)
+    r = xp.asarray(pr["sheen_r"])  # an array of the model's dtype: float32 stays float32
+    return xp.maximum(_conty_kulla().base_scale(xp, ci, co, r, color), 0.0)
 
 
 def _specular(xp, pr, wi, wo, h, front) -> Any:
@@ -298,7 +303,8 @@ def _clearcoat(xp, pr, wi, wo, h) -> Any:
 def _transmission_half(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, etap: Any) -> Any:
     """Walter 2007's generalised half vector wi·η' + wo, turned to the upper side."""
     h = xp.normalize(wi * etap + wo)
-    return h * xp.select(h[2] < 0.0, -1.0, 1.0)
+    one = xp.full(h[2], 1.0)
+    return h * xp.select(h[2] < 0.0, -one, one)
 
 
 def _solid_transmission(xp, pr, wi, wo, etap) -> tuple[Any, Any]:

@@ -63,7 +63,9 @@ def gtr_d(xp: Any, gamma: float, a2: Any, cos2_h: Any, sin2_h: Any) -> Any:
     α = 10⁻³ the denominator is 10⁻⁶ and 1 − cos² would lose it in float32.
     """
     base = a2 * cos2_h + sin2_h
-    return gtr_norm(xp, gamma, a2) * xp.exp(-gamma * xp.log(base))
+    c = gtr_norm(xp, gamma, a2)
+    c = float(c) if isinstance(a2, float) else c  # a constant must not promote float32 arrays
+    return c * xp.exp(-gamma * xp.log(base))
 
 
 def gtr_sample_cos2(xp: Any, gamma: float, a2: Any, xi: Any) -> Any:
@@ -97,6 +99,10 @@ def anisotropic_alphas(xp: Any, roughness: Any, anisotropic: Any) -> tuple[Any, 
     Both are clamped below at :data:`ALPHA_MIN` (as the BRDF Explorer does).
     """
     a = roughness * roughness
+    if isinstance(a, float) and isinstance(anisotropic, float):
+        # Constants stay Python floats, so they fold into float32 arrays without promoting.
+        aspect = math.sqrt(1.0 - 0.9 * anisotropic)
+        return max(a / aspect, ALPHA_MIN), max(a * aspect, ALPHA_MIN)
     if xp.known_zero(anisotropic):
         a = xp.maximum(a, ALPHA_MIN)
         return a, a
