@@ -9,6 +9,7 @@ saves a screenshot. No port is opened and nothing leaves the machine.
 from __future__ import annotations
 
 import base64
+import fcntl
 import json
 import os
 import select
@@ -148,8 +149,12 @@ class DevTools:
         self._r, from_browser_w = os.pipe()
 
         def wire():  # in the child: fd 3 reads our commands, fd 4 writes replies
-            os.dup2(to_browser_r, 3)
-            os.dup2(from_browser_w, 4)
+            # Copy both above 10 first: either may already sit on 3 or 4, and dup2 onto
+            # itself would keep the close-on-exec flag.
+            a = fcntl.fcntl(to_browser_r, fcntl.F_DUPFD, 10)
+            b = fcntl.fcntl(from_browser_w, fcntl.F_DUPFD, 10)
+            os.dup2(a, 3)
+            os.dup2(b, 4)
 
         self.proc = subprocess.Popen(
             [
@@ -320,3 +325,43 @@ def test_page_opens_in_chromium_without_errors_or_broken_images(batch, tmp_path)
         assert not seen[problem], (problem, seen[problem])
     assert len(seen["images"]) >= 13  # a contact sheet and 12 frames, plus any plots
     assert shot.read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.render
+@needs_chromium
+def test_lookdev_proof_report_writes_a_page_that_opens_cleanly(cli, tmp_path):
+    out = tmp_path / "proofs"
+    res = cli(
+        "proof",
+        "gold",
+        "plaster",
+        "--ibl",
+        "studio",
+        "-n",
+        "2",
+        "-m",
+        "1",
+        "--spp",
+        "4",
+        "-r",
+        "32",
+        "16",
+        "-o",
+        str(out),
+        "-j",
+        "1",
+        "--report",
+        "--json",
+    )
+    assert res.code == 0, res.err
+    index = Path(json.loads(res.out)["report"])
+    assert index == out.resolve() / "index.html"
+    text = index.read_text()
+    for expected in ("gold", "plaster", "studio", "frames.noise_relative (mean)", "contact.png"):
+        assert expected in text
+    seen = open_in_chromium(index, tmp_path / "profile")
+    (out / "report" / "screenshot.png").write_bytes(seen["screenshot"])
+    for problem in ("console", "exceptions", "log", "failed", "remote", "broken"):
+        assert not seen[problem], (problem, seen[problem])
+    # 2 contact sheets, 2 × 3 frames, 2 × 4 plots
+    assert len(seen["images"]) == 2 + 6 + 8

@@ -30,6 +30,8 @@ from lookdev.materials.errors import LookdevError
 REPORT_DIR = "report"
 WEB_IMAGES = (".png", ".jpg", ".jpeg", ".gif", ".webp", ".svg")
 PLOT_VIEWS = ("slice", "albedo", "polar", "sphere")
+# Manifest fields that identify files rather than describe the proof.
+NOT_IN_TABLE = frozenset({"key", "sha256", "size", "file", "version", "contact_sheet"})
 
 
 class ReportError(LookdevError):
@@ -58,6 +60,8 @@ def read_manifests(batch_dir: Path) -> list[Entry]:
             raise ReportError(f"unreadable manifest: {exc}", where=str(path)) from None
         if not isinstance(data, dict):
             raise ReportError("a manifest must be a JSON object", where=str(path))
+        if "proofs" in data:  # the batch's own manifest: its jobs have their own
+            continue
         material = str(data.get("material") or data.get("name") or path.parent.parent.name)
         ibl = str(data.get("ibl") or path.parent.name)
         entries.append(Entry(path, data, material, ibl, _frames(path.parent, data)))
@@ -72,14 +76,16 @@ def _frame_lists(data: dict[str, Any]) -> list[list[Any]]:
 def _frames(folder: Path, data: dict[str, Any]) -> list[tuple[Path, str]]:
     """(file, caption) of the frames a manifest lists, else of the images beside it.
 
-    A listed frame is a path or an object with ``path`` (or ``file``) and, for the
-    caption, ``label`` or ``kind`` and ``angle``.
+    A listed frame is a path, or an object naming its file as ``path``, ``file``, or a
+    file entry ``png``/``exr`` (``{"file": …}``, as :mod:`lookdev.pipeline.proof.batch`
+    writes them; the PNG is preferred, it went through the proof's view transform); for
+    the caption, ``label`` or ``kind`` and ``angle``.
     """
     listed = []
     for frames in _frame_lists(data):
         for item in frames:
             info = item if isinstance(item, dict) else {}
-            p = info.get("path") or info.get("file") if info else item
+            p = _frame_file(info) if info else item
             if isinstance(p, str):
                 path = Path(p) if Path(p).is_absolute() else folder / p
                 listed.append((path, _caption(info, path)))
@@ -87,6 +93,15 @@ def _frames(folder: Path, data: dict[str, Any]) -> list[tuple[Path, str]]:
         images = (p for p in folder.iterdir() if p.suffix.lower() in (*WEB_IMAGES, ".exr"))
         listed = [(p, p.stem) for p in sorted(images)]
     return [(p, c) for p, c in listed if p.is_file() and "contact" not in p.name]
+
+
+def _frame_file(info: dict[str, Any]) -> str | None:
+    for key in ("path", "file", "png", "exr"):
+        value = info.get(key)
+        value = value.get("file") if isinstance(value, dict) else value
+        if isinstance(value, str):
+            return value
+    return None
 
 
 def _caption(info: dict[str, Any], path: Path) -> str:
@@ -133,6 +148,8 @@ def _scalars(data: dict[str, Any], prefix: str = "") -> dict[str, Any]:
     out: dict[str, Any] = {}
     for k, v in data.items():
         name = f"{prefix}{k}"
+        if k in NOT_IN_TABLE:
+            continue
         if isinstance(v, dict):
             out.update(_scalars(v, f"{name}."))
         elif "frame" in k and isinstance(v, list):
@@ -199,10 +216,17 @@ def web_image(src: Path, out_dir: Path, exposure: float = 0.0) -> Path:
     return dst
 
 
-def material_plots(materials: Iterable[str], out_dir: Path, library: Any = None) -> dict:
-    """``{material: {view: png}}``; a material that cannot be loaded gets no plots."""
-    from .plots import figure, save_figure, subject_for
+def material_plots(
+    materials: Iterable[str], out_dir: Path, library: Any = None, ibl: str | None = None
+) -> dict:
+    """``{material: {view: png}}``; the sphere also under ``ibl`` (one of the batch's).
 
+    A material that cannot be loaded here (a preset that has since been removed) gets no
+    plots; its frames and numbers are still shown.
+    """
+    from .plots import figure, load_environment, save_figure, subject_for
+
+    environment = _environment(ibl, load_environment)
     result: dict[str, dict[str, Path]] = {}
     for name in materials:
         try:
@@ -211,11 +235,27 @@ def material_plots(materials: Iterable[str], out_dir: Path, library: Any = None)
             continue
         result[name] = {
             view: save_figure(
-                figure([subject], view, resolution=64), out_dir / "plots" / f"{name}_{view}.png"
+                figure(
+                    [subject],
+                    view,
+                    resolution=64,
+                    environment=environment if view == "sphere" else None,
+                    ibl_name=ibl or "",
+                ),
+                out_dir / "plots" / f"{name}_{view}.png",
             )
             for view in PLOT_VIEWS
         }
     return result
+
+
+def _environment(ibl: str | None, load: Any) -> np.ndarray | None:
+    if ibl is None:
+        return None
+    try:
+        return load(ibl, 128)
+    except LookdevError:
+        return None
 
 
 # -- the page -------------------------------------------------------------------------
@@ -228,7 +268,7 @@ th:first-child,td:first-child,th:nth-child(2),td:nth-child(2){text-align:left}
 .strip{display:flex;flex-wrap:wrap;gap:6px}.strip img{height:128px;background:#000}
 .plots img{height:260px;background:#fff;margin:4px}
 figure{margin:0}figcaption{font-size:12px;color:#999}
-img.sheet{max-width:100%}
+img.sheet{width:100%;max-width:960px}
 """
 
 
@@ -290,7 +330,8 @@ def write_report(batch_dir: str | Path, *, library: Any = None, plots: bool = Tr
         raise ReportError("no manifest.json found: is this a proof batch?", where=str(batch_dir))
     out = batch_dir / REPORT_DIR
     out.mkdir(exist_ok=True)
-    made = material_plots(dict.fromkeys(e.material for e in entries), out, library) if plots else {}
+    materials = dict.fromkeys(e.material for e in entries)
+    made = material_plots(materials, out, library, entries[0].ibl) if plots else {}
     page = render_page(batch_dir, entries, contact_sheets(batch_dir), made)
     index = batch_dir / "index.html"
     tmp = index.with_name(".index.html.tmp")

@@ -98,6 +98,14 @@ def proof(
     as_json: Annotated[
         bool, typer.Option("--json", help="Print the batch manifest as one JSON object.")
     ] = False,
+    report: Annotated[
+        bool,
+        typer.Option(
+            "--report",
+            help="Also write OUTPUT/index.html: contact sheets, time/noise table, each "
+            "material's BRDF plots and its frames; static, opens from disk.",
+        ),
+    ] = False,
 ) -> None:
     """Render turntable proofs: every PRESET under every --ibl.
 
@@ -143,6 +151,10 @@ def proof(
 
         results = batch.run_batch(jobs, executor, on_done=done)
     doc = batch.summary(output, jobs, results, time.perf_counter() - start)
+    if report:
+        from lookdev.pipeline.analysis.report import write_report
+
+        doc["report"] = str(write_report(output, library=lib))
     if as_json:
         print_json(doc)
         return
@@ -161,6 +173,8 @@ def proof(
     columns = ["material", "ibl", "rendered", "skipped", "render s", "noise (rel)", "sheet"]
     console.print(table(f"proofs in {output}", columns, rows))
     console.print(f"{doc['wall_seconds']:.1f} s; manifest: {output / batch.MANIFEST}")
+    if report:
+        console.print(f"review page: {doc['report']}")
 
 
 def _progress() -> Progress:
