@@ -234,3 +234,17 @@ def test_sheen_albedo_table_agrees_with_quadrature(r):
     t = albedo_tabulated(sheen.MODEL, p, theta).albedo
     np.testing.assert_allclose(t, q, atol=5e-4)
     np.testing.assert_allclose(t[:, 1] / t[:, 0], 0.5)  # F scales the table per channel
+
+
+def test_layered_preset_is_plotted_at_its_centre_texel():
+    _needs_disney()
+    from lookdev.library import load_material
+    from lookdev.pipeline.blend import blend
+
+    subject = P.subject_for("rusty_iron")
+    blended = blend(load_material("rusty_iron"), P.LAYERED_RESOLUTION)
+    assert blended.maps, "rusty_iron should vary across the surface"
+    n = P.LAYERED_RESOLUTION // 2
+    assert subject.label == "rusty_iron (centre texel)"
+    assert subject.params == blended.params_at(n, n)
+    assert subject.model is P.model_named(blended.model)

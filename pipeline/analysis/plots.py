@@ -64,12 +64,15 @@ def model_named(name: str) -> Model:
     raise PlotError(f"no reflectance model named {name!r} is installed", field="model")
 
 
+LAYERED_RESOLUTION = 64
+
+
 def subject_for(name_or_path: str, library: Any = None) -> Subject:
     """Load a preset (name or file) from ``library`` (a Library; None = default) and make
     it plottable.
 
-    A layered preset is blended first; views show its parameters at the texture's
-    centre (uv 0.5, 0.5) unless the blend is uniform.
+    A layered preset is blended first (at :data:`LAYERED_RESOLUTION`); views show its
+    parameters at the centre texel unless the blend is uniform.
     """
     from lookdev.library import load_material
 
@@ -78,12 +81,12 @@ def subject_for(name_or_path: str, library: Any = None) -> Subject:
         return Subject(material.name, model_named(material.model), material.params)
     from lookdev.pipeline.blend import blend
 
-    blended = blend(material, 64)
+    blended = blend(material, LAYERED_RESOLUTION)
+    model = model_named(blended.model)
     if not blended.maps:
-        return Subject(material.name, model_named(blended.model), blended.to_params())
-    return Subject(
-        f"{material.name} (uv 0.5, 0.5)", model_named(blended.model), blended.params_at(0.5, 0.5)
-    )
+        return Subject(material.name, model, blended.to_params())
+    h, w = next(iter(blended.maps.values())).shape[:2]
+    return Subject(f"{material.name} (centre texel)", model, blended.params_at(h // 2, w // 2))
 
 
 def load_environment(name_or_path: str, width: int = 256) -> np.ndarray:
