@@ -15,7 +15,7 @@ from lookdev.materials.params import DisneyParams
 
 def write_image(path: Path, pixels: np.ndarray, fmt=oiio.FLOAT, names=None) -> Path:
     """Write ``pixels`` (rows as stored in the file: top row first; (H, W) or (H, W, C))."""
-    pixels = np.asarray(pixels, dtype=np.float32)
+    pixels = np.ascontiguousarray(pixels, dtype=np.float32)
     if pixels.ndim == 2:
         pixels = pixels[..., None]
     height, width, channels = pixels.shape
@@ -23,7 +23,7 @@ def write_image(path: Path, pixels: np.ndarray, fmt=oiio.FLOAT, names=None) -> P
     if names:
         spec.channelnames = tuple(names)
     buf = oiio.ImageBuf(spec)
-    buf.set_pixels(oiio.ROI(0, width, 0, height, 0, 1, 0, channels), pixels)
+    assert buf.set_pixels(oiio.ROI(0, width, 0, height, 0, 1, 0, channels), pixels)
     assert buf.write(str(path)), buf.geterror()
     return path
 
