@@ -1,0 +1,279 @@
+"""``lookdev bench eval``: the Disney BSDF on numpy, on Dr.Jit, and Mitsuba's ``principled``.
+
+One run evaluates f(wi, wo) of the full Disney BSDF on N random direction pairs (viewer
+above the surface, light anywhere on the sphere, so transmission is exercised), split
+over :data:`PARAM_SETS` (eight materials that between them switch on every lobe):
+
+- ``numpy``: :data:`lookdev.materials.disney.MODEL` on the numpy backend, float32 and
+  float64, channel-first arrays prepared beforehand (the layout change of the public
+  wrappers is not evaluation);
+- ``drjit``: the same Python model traced by Dr.Jit (LLVM), forced with ``dr.eval`` and
+  waited for; the first call (tracing + kernel compilation) is reported on its own and
+  excluded from the throughput;
+- ``mitsuba``: the C++ ``principled`` plugin with the nearest parameters (see
+  :func:`principled_dict`; the two models differ where DESIGN.md says), same pairs.
+
+Reported: evaluations per second of each and the throughput ratios
+``ratio_drjit_to_mitsuba`` (target ≥ 0.5) and ``ratio_numpy_to_mitsuba`` (target ≥ 0.1,
+with the faster numpy dtype, named in ``numpy_dtype``).
+
+The helpers :func:`principled_dict` and :func:`principled_eval` are also what the tests
+use to compare the two models where they coincide.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Annotated, Any
+
+import numpy as np
+import typer
+
+from lookdev.materials import disney
+from lookdev.materials.arrays import NumpyOps
+from lookdev.materials.params import DisneyParams
+
+PARAM_SETS: dict[str, DisneyParams] = {
+    "plastic": DisneyParams(base_color=(0.6, 0.2, 0.1), roughness=0.4),
+    "gold": DisneyParams(base_color=(1.0, 0.77, 0.34), metallic=1.0, roughness=0.25),
+    "brushed": DisneyParams(base_color=(0.9, 0.9, 0.9), metallic=1.0, anisotropic=0.8),
+    "car_paint": DisneyParams(base_color=(0.1, 0.2, 0.6), roughness=0.5, clearcoat=1.0),
+    "velvet": DisneyParams(base_color=(0.5, 0.1, 0.3), roughness=0.9, sheen=1.0, sheen_tint=0.0),
+    "skin": DisneyParams(base_color=(0.8, 0.5, 0.4), roughness=0.6, subsurface=0.7),
+    "glass": DisneyParams(base_color=(1.0, 1.0, 1.0), roughness=0.1, spec_trans=1.0, ior=1.5),
+    "mixed": DisneyParams(
+        base_color=(0.3, 0.6, 0.3), metallic=0.3, roughness=0.7, spec_trans=0.4, sheen=0.5
+    ),
+}
+
+
+# -- Mitsuba's principled, for comparison ------------------------------------------------
+def principled_dict(p: DisneyParams) -> dict[str, Any]:
+    """Mitsuba ``principled`` parameters nearest to ``p``.
+
+    Mitsuba's names: ``spec_tint`` for specular_tint, ``eta`` for ior, and ``flatness``
+    for what is Burley 2012's ``subsurface`` blend (Mitsuba's formula is the BRDF
+    Explorer's subsurface; it has no thin mode). Parameters Mitsuba lacks
+    (diff_trans, thin, our thin ``flatness``) cannot be passed.
+    """
+    out: dict[str, Any] = {
+        "type": "principled",
+        "base_color": {"type": "rgb", "value": list(p.base_color)},
+    }
+    for ours, theirs in [
+        ("roughness", "roughness"),
+        ("anisotropic", "anisotropic"),
+        ("metallic", "metallic"),
+        ("specular_tint", "spec_tint"),
+        ("sheen", "sheen"),
+        ("sheen_tint", "sheen_tint"),
+        ("clearcoat", "clearcoat"),
+        ("clearcoat_gloss", "clearcoat_gloss"),
+        ("spec_trans", "spec_trans"),
+        ("subsurface", "flatness"),
+    ]:
+        value = float(getattr(p, ours))
+        if value != 0.0 or ours in ("roughness", "clearcoat_gloss"):
+            out[theirs] = value
+    if p.uses_ior:
+        out["eta"] = float(p.ior)
+    else:
+        out["specular"] = float(p.specular)
+    return out
+
+
+def _vectors(mi: Any, a: np.ndarray) -> Any:
+    """(N, 3) numpy → mi.Vector3f."""
+    a = np.asarray(a, dtype=np.float32)
+    return mi.Vector3f(*(mi.Float(np.ascontiguousarray(a[:, k])) for k in range(3)))
+
+
+def principled_eval(bsdf: Any, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
+    """f(wi, wo) of a Mitsuba BSDF without the cosine, our naming, shape (N, 3).
+
+    Mitsuba's ``si.wi`` is our viewer ``wo`` and its ``wo`` our light ``wi``; its
+    ``eval`` returns f times |cos| of that light direction, divided out here.
+    """
+    import drjit as dr
+    import mitsuba as mi
+
+    si = dr.zeros(mi.SurfaceInteraction3f, len(wi))
+    si.wi = _vectors(mi, wo)
+    value = bsdf.eval(mi.BSDFContext(), si, _vectors(mi, wi))
+    f = np.array(value).reshape(3, -1).T.astype(np.float64)
+    cos = np.abs(np.asarray(wi, dtype=np.float32)[:, 2]).astype(np.float64)
+    return np.where(cos[:, None] > 0, f / np.maximum(cos[:, None], 1e-30), 0.0)
+
+
+# -- the benchmark ---------------------------------------------------------------------------
+def direction_pairs(n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """(wi, wo), each (n, 3): wo uniform on the upper hemisphere, wi on the whole sphere."""
+    rng = np.random.default_rng(seed)
+    wi = rng.normal(size=(n, 3))
+    wo = rng.normal(size=(n, 3))
+    wo[:, 2] = np.abs(wo[:, 2])
+    return (
+        wi / np.linalg.norm(wi, axis=1, keepdims=True),
+        wo / np.linalg.norm(wo, axis=1, keepdims=True),
+    )
+
+
+def _split(n: int) -> list[slice]:
+    edges = np.linspace(0, n, len(PARAM_SETS) + 1).astype(int)
+    return [slice(a, b) for a, b in zip(edges[:-1], edges[1:], strict=True)]
+
+
+def _numpy_runner(wi: np.ndarray, wo: np.ndarray, dtype: Any):
+    xp = NumpyOps(dtype)
+    parts = [(xp.asarray(wi[s].T), xp.asarray(wo[s].T)) for s in _split(len(wi))]
+
+    def run() -> list[Any]:
+        model = disney.MODEL
+        return [
+            model.eval(xp, model.prepare(xp, p), a, b)
+            for p, (a, b) in zip(PARAM_SETS.values(), parts, strict=True)
+        ]
+
+    return run
+
+
+def _drjit_runner(wi: np.ndarray, wo: np.ndarray):
+    import drjit as dr
+    import mitsuba as mi
+
+    from lookdev.materials.arrays import DrJitOps
+
+    xp = DrJitOps.for_mitsuba()
+    parts = [(_vectors(mi, wi[s]), _vectors(mi, wo[s])) for s in _split(len(wi))]
+    dr.eval(parts)
+
+    def run() -> list[Any]:
+        model = disney.MODEL
+        out = [
+            model.eval(xp, model.prepare(xp, p), a, b)
+            for p, (a, b) in zip(PARAM_SETS.values(), parts, strict=True)
+        ]
+        dr.eval(out)
+        dr.sync_thread()
+        return out
+
+    return run
+
+
+def _mitsuba_runner(wi: np.ndarray, wo: np.ndarray):
+    import drjit as dr
+    import mitsuba as mi
+
+    bsdfs = [mi.load_dict(principled_dict(p)) for p in PARAM_SETS.values()]
+    ctx = mi.BSDFContext()
+    parts = []
+    for s in _split(len(wi)):
+        si = dr.zeros(mi.SurfaceInteraction3f, s.stop - s.start)
+        si.wi = _vectors(mi, wo[s])
+        parts.append((si, _vectors(mi, wi[s])))
+    dr.eval(parts)
+
+    def run() -> list[Any]:
+        out = [b.eval(ctx, si, w) for b, (si, w) in zip(bsdfs, parts, strict=True)]
+        dr.eval(out)
+        dr.sync_thread()
+        return out
+
+    return run
+
+
+def _first_and_best(fn: Any, repeat: int) -> tuple[float, float]:
+    from lookdev.pipeline.cli.bench import best_time
+
+    t0 = time.perf_counter()
+    fn()
+    first = time.perf_counter() - t0
+    return first, best_time(fn, repeat=repeat)
+
+
+def run(n: int = 1_000_000, *, repeat: int = 3, progress: Any = None) -> dict[str, Any]:
+    """Every figure of the benchmark (see the module docstring)."""
+    from lookdev.pipeline.variant import use_mitsuba
+
+    variant = use_mitsuba()
+    wi, wo = direction_pairs(n)
+    runners = {
+        "numpy_float32": _numpy_runner(wi, wo, np.float32),
+        "numpy_float64": _numpy_runner(wi, wo, np.float64),
+        "drjit": _drjit_runner(wi, wo),
+        "mitsuba": _mitsuba_runner(wi, wo),
+    }
+    first, best = {}, {}
+    for name, fn in runners.items():
+        if progress is not None:
+            progress(name)
+        first[name], best[name] = _first_and_best(fn, repeat)
+    rate = {k: n / v for k, v in best.items()}
+    numpy_dtype = max(("float32", "float64"), key=lambda d: rate[f"numpy_{d}"])
+    return {
+        "n": n,
+        "materials": list(PARAM_SETS),
+        "variant": variant,
+        "evals_per_s_numpy_float32": rate["numpy_float32"],
+        "evals_per_s_numpy_float64": rate["numpy_float64"],
+        "evals_per_s_drjit": rate["drjit"],
+        "evals_per_s_mitsuba": rate["mitsuba"],
+        "drjit_first_call_s": first["drjit"],
+        "mitsuba_first_call_s": first["mitsuba"],
+        "numpy_dtype": numpy_dtype,
+        "ratio_drjit_to_mitsuba": rate["drjit"] / rate["mitsuba"],
+        "ratio_numpy_to_mitsuba": rate[f"numpy_{numpy_dtype}"] / rate["mitsuba"],
+        "target_drjit": 0.5,
+        "target_numpy": 0.1,
+    }
+
+
+def command(
+    n: Annotated[
+        int, typer.Option("--n", "-n", min=1000, max=50_000_000, help="Direction pairs.")
+    ] = 1_000_000,
+    repeat: Annotated[int, typer.Option(min=1, max=20, help="Timed runs; the best counts.")] = 3,
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+) -> None:
+    """Evaluate the Disney BSDF on N direction pairs: numpy, Dr.Jit and Mitsuba's principled.
+
+    Eight materials share the pairs so that every lobe runs. Throughputs are measured in
+    one process; the ratios to Mitsuba's C++ plugin are the figures (targets: Dr.Jit
+    ≥ 0.5, numpy ≥ 0.1). First-call (compile) times are shown apart.
+    """
+    from rich.progress import Progress
+
+    from lookdev.pipeline.cli.common import console, err_console, print_json, table
+
+    with Progress(console=err_console, transient=True, disable=as_json) as bar:
+        task = bar.add_task("timing", total=4)
+
+        def step(name: str) -> None:
+            bar.update(
+                task, description=f"timing {name}", advance=0 if name == "numpy_float32" else 1
+            )
+
+        result = run(n, repeat=repeat, progress=step)
+    if as_json:
+        print_json(result)
+        return
+    rows = [
+        ["numpy float32", result["evals_per_s_numpy_float32"], "", ""],
+        ["numpy float64", result["evals_per_s_numpy_float64"], "", ""],
+        ["Dr.Jit (ours)", result["evals_per_s_drjit"], result["drjit_first_call_s"], ""],
+        ["Mitsuba principled", result["evals_per_s_mitsuba"], result["mitsuba_first_call_s"], ""],
+        ["ratio Dr.Jit / Mitsuba", result["ratio_drjit_to_mitsuba"], "", "≥ 0.5"],
+        [
+            f"ratio numpy ({result['numpy_dtype']}) / Mitsuba",
+            result["ratio_numpy_to_mitsuba"],
+            "",
+            "≥ 0.1",
+        ],
+    ]
+    console.print(
+        table(
+            f"bench eval: {n:,} pairs, {len(PARAM_SETS)} materials, {result['variant']}",
+            ["backend", "evals/s", "first call s", "target"],
+            rows,
+        )
+    )
