@@ -116,24 +116,32 @@ class Turntable:
         self._cup_positions = self._array("cup.vertex_positions")
         self._cup_normals = self._array("cup.vertex_normals")
         self._pivot = np.asarray(shaderball.CUP_CENTER)
+        self._pose = (0.0, 0.0)  # (element, light) angles the scene is posed at
 
     def _array(self, key: str) -> np.ndarray:
         return np.array(self.params[key], dtype=np.float64).reshape(-1, 3)
 
     def set_frame(self, frame: Frame) -> None:
-        """Pose the element and the lighting for ``frame`` and push the changes."""
+        """Pose the element and the lighting for ``frame``, pushing only what changed.
+
+        Moving a shape rebuilds the acceleration structure (tens of milliseconds), so a
+        lighting frame after the first touches the envmap's ``to_world`` alone.
+        """
         import mitsuba as mi
 
         element = frame.angle if frame.kind == "element" else 0.0
         light = frame.angle if frame.kind == "light" else 0.0
-        self.params["ball.to_world"] = shaderball.ball_to_world(element)
-        rot = shaderball.rotation_y(element)
-        positions = (self._cup_positions - self._pivot) @ rot.T + self._pivot
-        self.params["cup.vertex_positions"] = mi.Float(positions.ravel().astype(np.float32))
-        self.params["cup.vertex_normals"] = mi.Float(
-            (self._cup_normals @ rot.T).ravel().astype(np.float32)
-        )
-        self.params["environment.to_world"] = mi.ScalarTransform4f().rotate([0, 1, 0], light)
+        if element != self._pose[0]:
+            self.params["ball.to_world"] = shaderball.ball_to_world(element)
+            rot = shaderball.rotation_y(element)
+            positions = (self._cup_positions - self._pivot) @ rot.T + self._pivot
+            self.params["cup.vertex_positions"] = mi.Float(positions.ravel().astype(np.float32))
+            self.params["cup.vertex_normals"] = mi.Float(
+                (self._cup_normals @ rot.T).ravel().astype(np.float32)
+            )
+        if light != self._pose[1]:
+            self.params["environment.to_world"] = mi.ScalarTransform4f().rotate([0, 1, 0], light)
+        self._pose = (element, light)
         self.params.update()
 
     def render(self, spp: int, seed: int) -> np.ndarray:
