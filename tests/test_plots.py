@@ -178,8 +178,19 @@ def test_cli_ibl_only_with_sphere(cli, tmp_path):
 def test_cli_plots_presets_side_by_side(cli, tmp_path, view):
     _needs_disney()
     out = tmp_path / f"{view}.png"
+    ibl = ["--ibl", "studio"] if view == "sphere" else []
     res = cli(
-        "plot", "gold", "plaster", "--view", view, "-o", str(out), "--resolution", "24", "--json"
+        "plot",
+        "gold",
+        "plaster",
+        "--view",
+        view,
+        "-o",
+        str(out),
+        "--resolution",
+        "24",
+        "--json",
+        *ibl,
     )
     assert res.code == 0, res.err
     assert json.loads(res.out) == {
