@@ -207,15 +207,17 @@ def _lobe_value(xp: Any, prep: dict[str, Any], w: dict, lobe: str, wi: Any, wo: 
         if lobe == "diffuse_t":
             f = lobes.frn_blend(xp, n, g, -wi[2]) * lobes.INV_PI
         else:
+            # Blended by the view's incidence on the front, where the light crosses: the
+            # transmitted weights are the share the front Fresnel did not reflect.
             back_i, back_o = lobes.to_back(xp, wi), lobes.back_view(xp, wo, prep["eta"])
-            f = lobes.p_specular(xp, back_i, back_o, _power(prep, lobe), n, g)
+            f = lobes.p_specular(xp, back_i, back_o, _power(prep, lobe), n, g, wo[2])
     else:
         side = wi[2] > 0.0
         if lobe == "diffuse":
             f = lobes.frn_blend(xp, n, g, wi[2]) * lobes.INV_PI
         else:
             f = lobes.p_specular(xp, wi, wo, _power(prep, lobe), n, g)
-    return f * xp.select(side & (wo[2] > 0.0), 1.0, 0.0)
+    return xp.select(side & (wo[2] > 0.0), f, 0.0)
 
 
 def _eval(xp: Any, prep: dict[str, Any], wi: Any, wo: Any) -> Any:

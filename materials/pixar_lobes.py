@@ -82,18 +82,20 @@ def sin2_of(xp: Any, h: Any) -> Any:
     return (h[0] * h[0] + h[1] * h[1]) / xp.maximum(xp.dot(h, h), xp.tiny)
 
 
-def p_specular(xp: Any, wi: Any, wo: Any, p: Any, fn: Any, fg: Any) -> Any:
+def p_specular(xp: Any, wi: Any, wo: Any, p: Any, fn: Any, fg: Any, fresnel_cos: Any = None) -> Any:
     """``PSpecular`` / π: D(h) FrnBlend[N, G, u·h] / (4 ((n·u)² + (n·v)² − (n·u)(n·v))).
 
     Both directions above the surface; the caller masks. Colour weights broadcast.
-    ``(n·u)² + (n·v)² − (n·u)(n·v)`` ≥ ((n·u)² + (n·v)²)/2 vanishes only when both
-    directions graze, and is floored at the dtype's tiny there.
+    ``fresnel_cos`` replaces u·h in the Fresnel blend (the transmitted lobes blend by
+    the front-side incidence). ``(n·u)² + (n·v)² − (n·u)(n·v)`` ≥ ((n·u)² + (n·v)²)/2
+    vanishes only when both directions graze, and is floored at the dtype's tiny there.
     """
     h = xp.normalize(wi + wo)
     ci, co = wi[2], wo[2]
     denom = 4.0 * xp.maximum(ci * ci + co * co - ci * co, xp.tiny)
     d = distribution(xp, sin2_of(xp, h), p)
-    return frn_blend(xp, fn, fg, xp.dot(wi, h)) * (d / denom)
+    cos_f = xp.dot(wi, h) if fresnel_cos is None else fresnel_cos
+    return frn_blend(xp, fn, fg, cos_f) * (d / denom)
 
 
 # -- sampling the Gaussian-of-sin distribution --------------------------------------------

@@ -358,3 +358,23 @@ def test_drjit_backend_agrees_with_numpy():
     n_wi, _, n_pdf = pixar.sample(p, wo, u)
     np.testing.assert_allclose(np.array(d_wi).T, n_wi, atol=1e-4)
     np.testing.assert_allclose(np.array(d_pdf), n_pdf, rtol=1e-3, atol=1e-5)
+
+
+@pytest.mark.parametrize(
+    "params",
+    [
+        P(surface_color=1.0, roughness=0.1, clear=1.0),
+        P(surface_color=1.0, roughness=0.5, clear=0.5, back=0.5),
+        P(surface_color=1.0, roughness=0.0, clear=0.3, back=1.0, metallic=0.5),
+        P(surface_color=1.0, roughness=0.3, grazing_fresnel=0.4, clear=0.7),
+    ],
+    ids=range(4),
+)
+def test_white_furnace_never_gains_energy(params):
+    # The weights partition energy only if the lobes blend them at the same incidence:
+    # the transmitted highlights take the front view's, like the reflected ones.
+    u = np.random.default_rng(6).random((10_000, 3))
+    for cos_o in (1.0, 0.5, 0.02, 1e-4):
+        _, weight, _ = pixar.sample(params, _dir(cos_o, 0.3), u)
+        mean, err = weight.mean(axis=0), weight.std(axis=0) / math.sqrt(len(u))
+        assert np.all(mean <= 1.0 + 4 * err + 1e-12), (cos_o, mean)
