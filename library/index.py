@@ -15,12 +15,13 @@ deleting it is always safe.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import time
-from dataclasses import dataclass
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 from lookdev.materials.errors import LookdevError
 
@@ -28,33 +29,29 @@ from .errors import PresetError
 from .preset import MODELS, NAME_RE, parse_toml
 
 INDEX_NAME = ".lookdev-index.json"
-INDEX_VERSION = 1
+INDEX_VERSION = 3
 RACY_S = 2.0
 SUFFIX = ".toml"
 
 
-@dataclass(frozen=True)
-class Header:
-    """What ``presets list`` shows of one preset file (model may be inherited: None)."""
+class Header(NamedTuple):
+    """What ``presets list`` shows of one preset file (``model`` None: inherited).
+
+    A tuple of plain strings, not of ``Path`` objects: a listing builds tens of thousands.
+    """
 
     name: str
-    path: Path
+    file: str  # the preset file
+    library: str  # the library folder it was found in
     model: str | None = None
     description: str = ""
     tags: tuple[str, ...] = ()
     extends: str | None = None
     error: str | None = None  # set when the file cannot be read as a preset
 
-    def row(self) -> list[Any]:
-        return [self.model, self.description, list(self.tags), self.extends, self.error]
-
-
-@dataclass(frozen=True)
-class _Stat:
-    key: list[int]  # (mtime_ns, size, inode): a changed file changes it
-    path: Path
-    rel: str
-    mtime_ns: int
+    @property
+    def path(self) -> Path:
+        return Path(self.file)
 
 
 def scan_folder(folder: Path, *, cache: bool = True, skip: tuple[str, ...] = ()) -> list[Header]:
@@ -65,50 +62,53 @@ def scan_folder(folder: Path, *, cache: bool = True, skip: tuple[str, ...] = ())
     small and must not grow files inside a checkout or an installed package). ``skip``
     names top-level sub-folders that hold other data (the built-in ``ibl/``).
     """
-    stats = _walk(folder, skip)
+    root = os.fspath(folder)
+    found = _walk(root, skip)
     cached = _read_index(folder) if cache else {}
-    headers, fresh, misses = [], {}, 0
-    for s in stats:
-        header = _from_row(s, cached.get(s.rel))
-        if header is None:
-            header, misses = read_header(s.path), misses + 1
+    headers, misses, sep = [], 0, os.sep
+    for rel, mtime, size, ino in found:
+        e = cached.get(rel)
+        try:
+            if e[1] != mtime or e[2] != size or e[3] != ino:
+                raise LookupError("changed")
+            header = Header(e[4], f"{root}{sep}{rel}", root, e[5], e[6], tuple(e[7]), e[8], e[9])
+        except (LookupError, TypeError):  # not indexed, changed, or a malformed entry
+            header, misses = read_header(Path(root, rel), library=root), misses + 1
         headers.append(header)
-        fresh[s.rel] = [s.key, header.row()]
-    if cache and (misses or len(cached) != len(fresh)):
-        _write_index(folder, stats, fresh)
+    if cache and (misses or len(cached) != len(found)):
+        _write_index(folder, found, headers)
     return headers
 
 
-def read_header(path: Path) -> Header:
+def read_header(path: Path, *, library: str | None = None) -> Header:
     """The header of one preset file; a file that is not a preset gets ``error`` set."""
-    name = path.name[: -len(SUFFIX)]
+    name, file = path.name[: -len(SUFFIX)], os.fspath(path)
+    library = os.fspath(path.parent) if library is None else library
     try:
-        doc = parse_toml(_header_bytes(path), where=str(path))
-        return _header_from_doc(doc, name, path)
+        doc = _header_doc(path)
+        return Header(name, file, library, *_header_fields(doc, name, file))
     except (LookdevError, OSError) as exc:
-        return Header(name=name, path=path, error=str(exc))
+        return Header(name, file, library, error=str(exc))
 
 
-def _header_bytes(path: Path) -> bytes:
-    """The top-level key/values of a preset: everything before the first table header.
+def _header_doc(path: Path) -> dict[str, Any]:
+    """The top-level key/values of a preset, parsed from what precedes its first table.
 
     If the cut lands inside a multi-line string or array the prefix is not valid TOML,
-    and the whole file is used instead.
+    and the whole file is parsed instead (so its errors are the file's own).
     """
-    data = path.read_bytes()
+    data, where = path.read_bytes(), str(path)
     cut = data.find(b"\n[")
-    if cut < 0:
-        return data
-    head = data[: cut + 1]
-    try:
-        parse_toml(head, where=str(path))
-    except PresetError:
-        return data
-    return head
+    if cut >= 0:
+        try:
+            return parse_toml(data[: cut + 1], where=where)
+        except PresetError:
+            pass
+    return parse_toml(data, where=where)
 
 
-def _header_from_doc(doc: dict[str, Any], name: str, path: Path) -> Header:
-    where = str(path)
+def _header_fields(doc: dict[str, Any], name: str, where: str) -> tuple:
+    """(model, description, tags, extends) of a parsed preset, checked just enough to list."""
     got = {k: doc.get(k) for k in ("name", "model", "description", "tags", "extends")}
     if got["name"] != name:
         raise PresetError(f"name {got['name']!r} differs from the file name", where=where)
@@ -126,54 +126,66 @@ def _header_from_doc(doc: dict[str, Any], name: str, path: Path) -> Header:
     description = got["description"] or ""
     if not isinstance(description, str):
         raise PresetError("'description' must be a string", where=where, field="description")
-    return Header(name, path, got["model"], description, tuple(tags), got["extends"])
+    return got["model"], description, tuple(tags), got["extends"]
 
 
-def _walk(folder: Path, skip: tuple[str, ...] = ()) -> list[_Stat]:
-    out: list[_Stat] = []
-    stack = [(folder, "")]
+def _walk(root: str, skip: tuple[str, ...] = ()) -> list[tuple[str, int, int, int]]:
+    """``(relative path, mtime_ns, size, inode)`` of every visible preset file, sorted.
+
+    Each folder is scanned through a descriptor, so a stat is an ``fstatat`` relative
+    to it rather than a walk of the whole path (a third cheaper on Linux).
+    """
+    out: list[tuple[str, int, int, int]] = []
+    stack = [(root, "")]
     while stack:
         here, prefix = stack.pop()
-        with os.scandir(here) as it:
+        with _scandir(here) as it:
             for e in it:
-                if e.name.startswith(".") or (not prefix and e.name in skip):
+                name = e.name
+                if name.startswith(".") or (not prefix and name in skip):
                     continue
-                if e.is_dir():
-                    stack.append((Path(e.path), f"{prefix}{e.name}/"))
-                elif e.name.endswith(SUFFIX):
+                if name.endswith(SUFFIX) and e.is_file():
                     st = e.stat()
-                    key = [st.st_mtime_ns, st.st_size, st.st_ino]
-                    out.append(_Stat(key, Path(e.path), prefix + e.name, st.st_mtime_ns))
-    out.sort(key=lambda s: s.rel)
+                    out.append((prefix + name, st.st_mtime_ns, st.st_size, st.st_ino))
+                elif e.is_dir():
+                    stack.append((os.path.join(here, name), f"{prefix}{name}/"))
+    out.sort()
     return out
 
 
-def _from_row(s: _Stat, entry: Any) -> Header | None:
-    """The cached header if the index has one for this exact stat, else None."""
+@contextlib.contextmanager
+def _scandir(folder: str) -> Iterator[Iterator[os.DirEntry]]:
+    if os.scandir not in os.supports_fd:  # Windows
+        with os.scandir(folder) as it:
+            yield it
+        return
+    fd = os.open(folder, os.O_RDONLY)
     try:
-        key, (model, description, tags, extends, error) = entry
-    except (TypeError, ValueError):
-        return None
-    if key != s.key or not isinstance(tags, list):
-        return None
-    name = s.path.name[: -len(SUFFIX)]
-    return Header(name, s.path, model, description, tuple(tags), extends, error)
+        with os.scandir(fd) as it:
+            yield it
+    finally:
+        os.close(fd)
 
 
-def _read_index(folder: Path) -> dict[str, Any]:
+def _read_index(folder: Path) -> dict[str, list[Any]]:
+    """``{relative path: [path, mtime_ns, size, inode, *header]}`` from the index, or ``{}``."""
     try:
         doc = json.loads((folder / INDEX_NAME).read_bytes())
-    except (OSError, ValueError):
+        if doc.get("version") != INDEX_VERSION:
+            return {}
+        return {e[0]: e for e in doc["entries"]}
+    except (OSError, ValueError, TypeError, LookupError, AttributeError):
         return {}
-    if not isinstance(doc, dict) or doc.get("version") != INDEX_VERSION:
-        return {}
-    entries = doc.get("entries")
-    return entries if isinstance(entries, dict) else {}
 
 
-def _write_index(folder: Path, stats: list[_Stat], fresh: dict[str, Any]) -> None:
+def _write_index(folder: Path, found: list[tuple], headers: list[Header]) -> None:
+    """Store the stats and headers of settled files, one flat list per file."""
     settled = time.time_ns() - int(RACY_S * 1e9)
-    entries = {s.rel: fresh[s.rel] for s in stats if s.mtime_ns < settled}
+    entries = [
+        [*stat, h.name, h.model, h.description, list(h.tags), h.extends, h.error]
+        for stat, h in zip(found, headers, strict=True)
+        if stat[1] < settled
+    ]
     data = json.dumps({"version": INDEX_VERSION, "entries": entries}, separators=(",", ":"))
     tmp = folder / f"{INDEX_NAME}.{os.getpid()}.tmp"
     try:

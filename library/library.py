@@ -64,6 +64,7 @@ class Library:
             ]
         self.user_folders: list[Path] = list(dict.fromkeys(user))
         self.builtin = builtin_folder() if builtin else None
+        self.builtin_str = str(self.builtin) if builtin else None
         self.folders = [*self.user_folders, *([self.builtin] if self.builtin else [])]
         self._builtin_headers: list[Header] | None = None
 
@@ -279,7 +280,7 @@ def _with_model(h: Header, winners: dict[str, Header]) -> Header:
         parent = winners[parent.extends]
     if parent is h:
         return h
-    return Header(h.name, h.path, parent.model, h.description, h.tags, h.extends, h.error)
+    return h._replace(model=parent.model)
 
 
 def _library_root(path: Path, folders: Sequence[Path]) -> Path:

@@ -284,15 +284,16 @@ def test_listing_index_is_used_and_notices_changes(tmp_path):
     assert scan_folder(tmp_path)[0].description == "one"
     index = json.loads((tmp_path / INDEX_NAME).read_text())
     # Fresh files are 'racy' (changed within the timestamp granularity), not cached yet.
-    assert "a.toml" not in index["entries"]
+    assert index["entries"] == []
     old = 1_000_000_000
     os.utime(tmp_path / "a.toml", ns=(old, old))
     scan_folder(tmp_path)
-    assert "a.toml" in json.loads((tmp_path / INDEX_NAME).read_text())["entries"]
+    assert json.loads((tmp_path / INDEX_NAME).read_text())["entries"][0][0] == "a.toml"
     write(tmp_path, "a", 'name="a"\nmodel="disney"\ndescription="two"\n')
     assert scan_folder(tmp_path)[0].description == "two"
-    (tmp_path / INDEX_NAME).write_text("{not json")
-    assert scan_folder(tmp_path)[0].description == "two"
+    for junk in ("{not json", '{"version": 3, "entries": [["a.toml", "x"], 5]}', "[]"):
+        (tmp_path / INDEX_NAME).write_text(junk)
+        assert scan_folder(tmp_path)[0].description == "two"
 
 
 def test_broken_files_are_listed_with_their_error_not_raised(tmp_path):
