@@ -95,15 +95,16 @@ def sidecar_dict(blended: BlendedMaterial, files: dict[str, str]) -> dict[str, A
 
 
 def _encode(name: str, array: np.ndarray) -> np.ndarray:
-    """Rows flipped to file order (top row v = 1); normals to the (n + 1)/2 encoding."""
+    """(H, W, C) in file order (top row v = 1); normals in the (n + 1)/2 encoding."""
     if name.endswith("normal_map"):
         array = 0.5 * array + 0.5
+    if array.ndim == 2:
+        array = array[..., None]  # OpenImageIO reads a 2-D array as the wrong shape
     return np.ascontiguousarray(array[::-1], dtype=np.float32)
 
 
 def _write_exr(path: Path, pixels: np.ndarray, where: str) -> None:
-    height, width = pixels.shape[:2]
-    channels = 1 if pixels.ndim == 2 else pixels.shape[2]
+    height, width, channels = pixels.shape
     spec = oiio.ImageSpec(width, height, channels, oiio.FLOAT)
     spec.channelnames = ("Y",) if channels == 1 else ("R", "G", "B")
     spec.attribute("compression", "zip")
