@@ -105,6 +105,58 @@ def principled_eval(bsdf: Any, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
     return np.where(cos[:, None] > 0, f / np.maximum(cos[:, None], 1e-30), 0.0)
 
 
+# Where the two models coincide (DESIGN.md, Traps): model restricted to some lobes (None:
+# all of ours), our parameters; Mitsuba gets principled_dict(params). With specular = 0
+# Mitsuba's exact Fresnel is 0 everywhere, so its total is its diffuse (+ sheen) alone.
+AGREEMENT_CASES: dict[str, tuple[tuple[str, ...] | None, DisneyParams]] = {
+    "metal_r0.3_aniso0.5": (
+        None,
+        DisneyParams(base_color=(0.9, 0.6, 0.3), metallic=1.0, roughness=0.3, anisotropic=0.5),
+    ),
+    "metal_r0": (None, DisneyParams(base_color=(0.9, 0.6, 0.3), metallic=1.0, roughness=0.0)),
+    "metal_r1_aniso1": (
+        None,
+        DisneyParams(base_color=(0.9, 0.6, 0.3), metallic=1.0, roughness=1.0, anisotropic=1.0),
+    ),
+    "diffuse_retro_r0.8": (("diffuse",), DisneyParams(specular=0.0, roughness=0.8)),
+    "subsurface_is_flatness": (
+        ("diffuse",),
+        DisneyParams(specular=0.0, roughness=0.5, subsurface=0.6),
+    ),
+    "sheen_untinted": (
+        ("diffuse", "sheen"),
+        DisneyParams(specular=0.0, roughness=0.3, sheen=1.0, sheen_tint=0.0),
+    ),
+    "dielectric_ior1.5": (None, DisneyParams(ior=1.5, roughness=0.4)),
+}
+
+
+def relative_difference(ours: np.ndarray, theirs: np.ndarray) -> float:
+    """max |ours − theirs| / max(|theirs|, 10⁻³ · max |theirs|): relative where it means
+    something, absolute (scaled) where Mitsuba's value is near 0."""
+    floor = 1e-3 * float(np.max(np.abs(theirs)))
+    return float(np.max(np.abs(ours - theirs) / np.maximum(np.abs(theirs), floor)))
+
+
+def agreement(n: int = 4096, seed: int = 1) -> dict[str, float]:
+    """Max relative difference to ``principled`` per case of :data:`AGREEMENT_CASES`."""
+    import mitsuba as mi
+
+    from lookdev.materials.bsdf import evaluate
+    from lookdev.pipeline.variant import use_mitsuba
+
+    use_mitsuba()
+    wi, wo = direction_pairs(n, seed)
+    wi[:, 2] = np.abs(wi[:, 2])  # reflection only: where the cases coincide
+    out = {}
+    for name, (lobes, params) in AGREEMENT_CASES.items():
+        model = disney.MODEL if lobes is None else disney.lobe_model(*lobes)
+        ours = evaluate(model, params, wi, wo)
+        theirs = principled_eval(mi.load_dict(principled_dict(params)), wi, wo)
+        out[name] = relative_difference(ours, theirs)
+    return out
+
+
 # -- the benchmark ---------------------------------------------------------------------------
 def direction_pairs(n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """(wi, wo), each (n, 3): wo uniform on the upper hemisphere, wi on the whole sphere."""
