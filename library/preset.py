@@ -29,16 +29,11 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 from lookdev.materials.errors import ParameterError
 from lookdev.materials.layers import ConstantMask, LayerSpec
 from lookdev.materials.params import DisneyParams, Params
+from lookdev.materials.pixar import PixarParams
 
 from .errors import PresetError
 
-# TEMPORARY until the Pixar module lands (issue interfaces); then a plain import.
-try:
-    from lookdev.materials.pixar import PixarParams
-
-    MODELS: dict[str, type[Params]] = {"disney": DisneyParams, "pixar": PixarParams}
-except ImportError:
-    MODELS = {"disney": DisneyParams}
+MODELS: dict[str, type[Params]] = {"disney": DisneyParams, "pixar": PixarParams}
 """Parameter schema of each reflectance model a preset may name."""
 
 MAX_BYTES = 1 << 20  # presets are hand-written text; anything larger is not one
@@ -98,9 +93,6 @@ class PresetFile(BaseModel):
 
     @model_validator(mode="after")
     def _fields_fit_the_model(self) -> PresetFile:
-        if self.model is not None and self.model != "layered" and self.model not in MODELS:
-            allowed = ", ".join([*MODELS, "layered"])
-            raise ValueError(f"model {self.model!r} is not installed; allowed: {allowed}")
         if self.model is None and self.extends is None:
             raise ValueError(
                 "'model' is required (disney, pixar or layered) unless 'extends' is given"

@@ -53,6 +53,7 @@ def test_builtin_library_is_big_enough_and_covers_the_issue():
     needed |= {"plastic_glossy", "plastic_matte", "rubber", "ceramic_glazed", "marble"}
     needed |= {"glass_clear", "water", "car_paint_red", "velvet", "cotton", "satin", "leaf"}
     needed |= {"rusty_iron", "worn_paint_over_metal", "dust_over_plastic"}
+    needed |= {"pixar_painted_metal", "pixar_rusty_metal", "pixar_translucent_plastic"}
     assert needed <= set(BUILTIN_NAMES)
 
 
@@ -87,6 +88,10 @@ def test_issue_looks_use_the_features_they_name():
     assert leaf.thin and leaf.diff_trans > 0
     assert BUILTIN.load("car_paint_red").params.clearcoat > 0
     assert BUILTIN.load("marble").params.subsurface > 0
+    plastic = BUILTIN.load("pixar_translucent_plastic").params
+    assert plastic.clear > 0 and plastic.back > 0
+    for name in ("pixar_painted_metal", "pixar_rusty_metal"):
+        assert {layer.material.model for layer in BUILTIN.load(name).layers} == {"pixar"}
     for name in ("rusty_iron", "worn_paint_over_metal", "dust_over_plastic"):
         for layer in BUILTIN.load(name).layers:
             assert not list(textures(layer.mask)), "built-in masks need no files"

@@ -307,7 +307,7 @@ def _text_table(title: str, columns: list[str], rows: list[list[str]]) -> Table:
     """A Rich table of text columns: left-aligned, names never wrapped."""
     t = Table(title=title, title_justify="left")
     for c in columns:
-        t.add_column(c, no_wrap=c in ("name", "model"), overflow="fold")
+        t.add_column(c, no_wrap=c in ("name", "model"), ratio={"tags": 1, "description": 2}.get(c))
     for r in rows:
         t.add_row(*r, style="dim" if r[1] == "?" else None)
     return t
