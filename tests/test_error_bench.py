@@ -12,7 +12,18 @@ from _lambert import LAMBERT, PHONG
 from lookdev.pipeline.analysis import error_bench as E
 from lookdev.pipeline.analysis import measure as M
 
-TINY = E.Settings((1, 4, 16), 128, 12, (8, 32), (64, 1024), 128, (4, 16), 512, 500)
+TINY = E.Settings(
+    render_ladder=(1, 4, 16),
+    render_reference_spp=128,
+    render_resolution=12,
+    quadrature=(8, 32),
+    samples=(64, 1024),
+    albedo_reference_nodes=128,
+    albedo_reference_samples=4096,
+    lambda_nodes=(4, 16),
+    lambda_reference_nodes=512,
+    precision_pairs=500,
+)
 
 
 def test_the_lambda_reference_matches_an_independent_double_integral():
@@ -55,6 +66,16 @@ def test_albedo_rows_compare_each_estimator_with_the_converged_quadrature():
     assert by[("quadrature", "64×64")].error < by[("quadrature", "8×8")].error
     assert by[("monte carlo", "4096 spp")].error < by[("monte carlo", "64 spp")].error
     assert all(r.seconds > 0 and r.evaluations > 0 for r in rows)
+    assert rows[0].reference == "quadrature 256×256"  # a smooth lobe: the grid converges
+
+
+def test_a_near_delta_lobe_is_measured_against_monte_carlo_not_an_unresolved_grid():
+    # exponent 1e5: a lobe ~0.3° wide that a 64×64 grid cannot see
+    ref, how = M.albedo_reference(
+        PHONG, PHONG.params_type(exponent=1e5), np.radians([0.0, 40.0]), 64, 4096
+    )
+    assert how == "monte carlo 4096 spp"
+    np.testing.assert_allclose(ref[:, 0], [1.0, math.cos(math.radians(40))], rtol=1e-3)
 
 
 def test_float32_against_float64_of_lambert_is_within_float32_precision():

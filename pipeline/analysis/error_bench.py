@@ -59,13 +59,25 @@ class Settings:
     quadrature: tuple[int, ...] = (8, 16, 32, 64, 128)
     samples: tuple[int, ...] = (64, 256, 1024, 4096)
     albedo_reference_nodes: int = 512
+    albedo_reference_samples: int = 65536
     lambda_nodes: tuple[int, ...] = (8, 16, 32, 64, 128)
     lambda_reference_nodes: int = 2048
     precision_pairs: int = 20000
 
     @classmethod
     def quick(cls) -> Settings:
-        return cls((1, 4, 16), 128, 16, (8, 16, 32), (64, 256), 128, (4, 16), 512, 2000)
+        return cls(
+            render_ladder=(1, 4, 16),
+            render_reference_spp=128,
+            render_resolution=16,
+            quadrature=(8, 16, 32),
+            samples=(64, 256),
+            albedo_reference_nodes=128,
+            albedo_reference_samples=8192,
+            lambda_nodes=(4, 16),
+            lambda_reference_nodes=512,
+            precision_pairs=2000,
+        )
 
 
 @dataclass
@@ -209,6 +221,7 @@ def run(
                         quadrature=settings.quadrature,
                         samples=settings.samples,
                         reference_nodes=settings.albedo_reference_nodes,
+                        reference_samples=settings.albedo_reference_samples,
                     ),
                 )
             )
@@ -291,7 +304,7 @@ ERROR_NAMES = {
     "lambda": "relative RMS error",
     "precision": "max relative error of float32",
 }
-TABLE_COLUMNS = ["case", "method", "setting", "error", "ms/call", "ns/eval"]
+TABLE_COLUMNS = ["case", "method", "setting", "error", "ms/call", "ns/eval", "against"]
 
 
 def _table_row(r: Row) -> list[str]:
@@ -302,6 +315,7 @@ def _table_row(r: Row) -> list[str]:
         f"{r.error:.3g}",
         f"{r.seconds * 1e3:.3g}",
         f"{r.seconds_per_evaluation * 1e9:.3g}",
+        r.reference,
     ]
 
 
