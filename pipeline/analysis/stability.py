@@ -103,9 +103,12 @@ def available_models(names: list[str] | None = None) -> tuple[dict[str, Model], 
 
 
 def allowance(name: str) -> float:
-    """Energy a model may add by design (see the module docstring)."""
+    """Energy a model may add by design (see the module docstring); 0 if unknown."""
+    default = ALLOWANCE.get(name, 0.0)
+    if name not in MODEL_MODULES:
+        return default
     module = importlib.import_module(MODEL_MODULES[name])
-    return float(getattr(module, "ENERGY_ALLOWANCE", ALLOWANCE.get(name, 0.0)))
+    return float(getattr(module, "ENERGY_ALLOWANCE", default))
 
 
 def _extremes(info: Any) -> list[Any]:
@@ -210,6 +213,7 @@ class ModelReport:
     cases: int = 0
     counts: dict[str, int] = field(default_factory=lambda: dict.fromkeys(KINDS, 0))
     by_dtype: dict[str, dict[str, int]] = field(default_factory=dict)
+    cases_by_dtype: dict[str, int] = field(default_factory=dict)
     failures: dict[str, Finding] = field(default_factory=dict)  # first or largest per kind
     max_albedo: Finding | None = None
 
@@ -232,7 +236,9 @@ class ModelReport:
             **self.counts,
             "worst": worst.to_json() if worst else None,
             "allowance": self.allowance,
-            "by_dtype": self.by_dtype,
+            "by_dtype": {
+                k: {"cases": self.cases_by_dtype[k], **v} for k, v in self.by_dtype.items()
+            },
         }
 
     def _count(self, dtype: str, kind: str, n: int, finding: Finding) -> None:
@@ -283,6 +289,7 @@ def _sweep_queries(report: ModelReport, model: Model, label: str, params: Any, d
         inf &= ~nan
         negative = (negative.any(axis=-1) if negative.ndim == 3 else negative) & ~nan & ~inf
         report.cases += nan.size
+        report.cases_by_dtype[name] += nan.size
         for kind, mask in (("nan", nan), ("inf", inf), ("negative", negative)):
             if mask.any():
                 i, j = np.argwhere(mask)[0]
@@ -308,6 +315,7 @@ def _sweep_energy(report: ModelReport, model: Model, label: str, params: Any, dt
     )
     mean, err = curve.albedo, curve.stderr
     report.cases += len(theta)
+    report.cases_by_dtype[name] += len(theta)
     excess = mean - SIGMAS * err - (1.0 + report.allowance + ROUNDING[name])
     k, c = np.unravel_index(np.argmax(mean), mean.shape)
     top = float(mean[k, c])
@@ -329,6 +337,7 @@ def check_model(
     report = ModelReport(name, allowance(name))
     for dtype in DTYPES:
         report.by_dtype[np.dtype(dtype).name] = dict.fromkeys(KINDS, 0)
+        report.cases_by_dtype[np.dtype(dtype).name] = 0
     for label, params in parameter_cases(model.params_type):
         progress(label)
         for dtype in DTYPES:

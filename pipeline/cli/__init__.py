@@ -43,10 +43,11 @@ def _root(
 
 
 def _register() -> None:
-    from . import bench, export, export_usd, plot, presets, proof
+    from . import bench, check, export, export_usd, plot, presets, proof
     from . import blend as blend_cli
 
     app.add_typer(bench.app, name="bench")
+    app.command("check")(check.check)
     app.command("blend")(blend_cli.blend)
     app.add_typer(export.app, name="export")
     export.app.command("usd")(export_usd.export_usd)

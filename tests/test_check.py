@@ -1,0 +1,138 @@
+"""``lookdev check``: the stability sweep finds what it should and reports it."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from _lambert import LambertParams
+
+from lookdev.materials.bsdf import Model
+from lookdev.pipeline.analysis import stability
+
+
+# -- a model broken on purpose, three ways ---------------------------------------------------
+def _prepare(xp, params, **maps):
+    return {"rho": xp.color(maps.get("base_color", params.base_color)), "lobes": ("diffuse",)}
+
+
+def _eval(xp, prepared, wi, wo):
+    # 1.2/π: a 20% energy gain; NaN exactly at grazing light (0/0); exp(100(1 − 3 cos θi))
+    # overflows float32 (not float64) for lights within about 2° of the horizon.
+    upper = (wi[2] >= 0) & (wo[2] > 0)
+    grazing_nan = wi[2] / wi[2]
+    overflow = xp.exp(100.0 * (1.0 - 3.0 * wi[2])) * 1e-40
+    f = 1.2 / math.pi * grazing_nan * (1.0 + overflow)
+    return prepared["rho"] * xp.select(upper, f, 0.0)
+
+
+def _pdf(xp, prepared, wi, wo):
+    return xp.select((wi[2] > 0) & (wo[2] > 0), wi[2] / math.pi, 0.0)
+
+
+def _sample(xp, prepared, wo, u):
+    r, phi = xp.sqrt(u[1]), 2.0 * math.pi * u[2]
+    wi = xp.vec3(r * xp.cos(phi), r * xp.sin(phi), xp.safe_sqrt(1.0 - u[1]))
+    pdf = _pdf(xp, prepared, wi, wo)
+    f = _eval(xp, prepared, wi, wo)
+    return wi, f * xp.select(pdf > 0, wi[2] / xp.maximum(pdf, 1e-30), 0.0), pdf
+
+
+MODEL = Model("broken", LambertParams, _prepare, _eval, _pdf, _sample)
+
+
+@pytest.fixture
+def broken_registered(monkeypatch):
+    monkeypatch.setitem(stability.MODEL_MODULES, "broken", "test_check")
+
+
+# -- the sweep ------------------------------------------------------------------------------
+def test_sweep_finds_nan_inf_and_energy_gain_where_they_are():
+    report = stability.check_model("broken", MODEL)
+    assert report.failed
+    assert report.by_dtype["float32"]["nan"] > 0 and report.by_dtype["float64"]["nan"] > 0
+    assert report.by_dtype["float32"]["inf"] > 0
+    assert report.by_dtype["float64"]["inf"] == 0  # only float32 overflows
+    assert report.counts["energy_gain"] > 0
+    assert report.worst.kind == "nan"
+    assert "wi=(" in report.worst.case and "float" in report.worst.case
+    gain = report.failures["energy_gain"]
+    assert gain.value == pytest.approx(1.2, abs=0.05)
+
+
+def test_parameter_cases_cover_every_extreme_and_the_named_combinations():
+    from lookdev.materials.pixar import PixarParams
+
+    labels = [label for label, _ in stability.parameter_cases(PixarParams)]
+    for expected in ("roughness=0", "roughness=1", "surface_color=black", "clear=1", "ior=10"):
+        assert expected in labels
+    assert "roughness=0, clear=1, back=1" in labels  # a named combination
+    assert not any("metallic=1, roughness" in label for label in labels)  # Disney-only combo
+
+
+def test_directions_hold_the_stiff_pairs():
+    d = stability.directions()
+    np.testing.assert_allclose(np.linalg.norm(d, axis=1), 1.0, rtol=1e-12)
+    z = set(np.round(d[:, 2], 12))
+    assert {1.0, 0.5, 1e-4, 1e-7, 0.0, -0.5} <= z
+    as_set = {tuple(v) for v in np.round(d, 12)}
+    assert all(tuple(np.round(-v, 12) + 0.0) in as_set for v in d)  # wi = −wo is a pair
+
+
+def test_plausible_excludes_pushed_parameters():
+    from lookdev.materials.params import DisneyParams
+
+    assert stability._plausible(DisneyParams(sheen=1.0, specular=1.0))
+    assert not stability._plausible(DisneyParams(sheen=10.0))
+    assert stability._plausible(DisneyParams(ior=10.0))  # a range that does not start at 0
+
+
+# -- the command ----------------------------------------------------------------------------
+def test_check_json_reports_every_built_model(cli):
+    result = cli("check", "--json")
+    data = json.loads(result.out)
+    assert result.code == 0, data
+    assert {"sheen", "pixar"} <= set(data["models"])
+    for name, m in data["models"].items():
+        assert m["cases"] > 10_000, name
+        assert (m["nan"], m["inf"], m["negative"], m["energy_gain"]) == (0, 0, 0, 0), m["worst"]
+        assert m["worst"]["kind"] == "max_albedo"
+        assert m["worst"]["value"] <= 1.0 + m["allowance"] + 0.05
+    print(f"\nlookdev check --json: {data['seconds']} s")
+
+
+def test_check_prints_a_table_per_model(cli):
+    result = cli("check", "--model", "sheen")
+    assert result.code == 0
+    assert "sheen: ok" in result.out
+    for column in ("cases", "NaN", "inf", "negative", "energy gain", "float32", "float64"):
+        assert column in result.out
+    assert "highest albedo" in result.out
+
+
+def test_check_exits_1_when_a_model_fails(cli, broken_registered):
+    result = cli("check", "--model", "broken", "--json")
+    assert result.code == 1
+    data = json.loads(result.out)["models"]["broken"]
+    assert data["nan"] > 0 and data["energy_gain"] > 0
+    assert data["worst"]["kind"] == "nan"
+    human = cli("check", "--model", "broken")
+    assert human.code == 1 and "FAILED" in human.out and "worst: nan" in human.out
+
+
+def test_unknown_model_is_one_line_and_exit_2(cli):
+    result = cli("check", "--model", "velvet")
+    assert result.code == 2
+    assert result.err.count("\n") == 1
+    assert "velvet" in result.err and "disney, sheen, pixar" in result.err
+    assert "Traceback" not in result.err
+
+
+def test_missing_model_is_skipped_not_fatal(cli, monkeypatch):
+    monkeypatch.setitem(stability.MODEL_MODULES, "ghost", "lookdev.materials.no_such_model")
+    result = cli("check", "--model", "ghost", "--model", "sheen", "--json")
+    data = json.loads(result.out)
+    assert result.code == 0
+    assert "ghost" in data["missing"] and "sheen" in data["models"]
