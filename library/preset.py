@@ -146,7 +146,10 @@ def parse_toml(data: bytes, *, where: str) -> dict[str, Any]:
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise PresetError(f"malformed TOML: {exc}", where=where) from None
+        # tomllib says "at end of document" without a line; editors want one.
+        at_end = f"at end of document, line {text.count(chr(10)) + 1}"
+        msg = str(exc).replace("at end of document", at_end)
+        raise PresetError(f"malformed TOML: {msg}", where=where) from None
     except RecursionError:
         raise PresetError("malformed TOML: values nested too deeply", where=where) from None
 
