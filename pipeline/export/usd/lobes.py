@@ -8,6 +8,7 @@ A parameter of a dead lobe has no effect, so it is neither written nor compared.
 are judged as USD stores them (float32).
 
 >>> from lookdev.materials.params import DisneyParams
+from lookdev.materials.pixar import PixarParams
 >>> on = active_lobes(canonical(DisneyParams(metallic=1.0, sheen=0.5)))
 >>> on["sheen"], on["dielectric"]
 (False, False)
@@ -20,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from lookdev.materials.params import DisneyParams
+from lookdev.materials.pixar import PixarParams
 
 PARAM_LOBE: dict[str, dict[str, str]] = {
     "disney": {
@@ -38,13 +40,28 @@ PARAM_LOBE: dict[str, dict[str, str]] = {
         "flatness": "flatness",
         "scatter_distance": "scatter",
     },
+    "pixar": {
+        "back": "diffuse_t",
+        "diffuse_t_scale": "diffuse_t",
+        "diffuse_scale": "diffuse",
+        "specular_scale": "specular",
+        "specular_cone_scale": "specular",
+        "reflection_scale": "reflection",
+        "reflection_cone_scale": "reflection",
+        "specular_t_scale": "specular_t",
+        "reflection_t_scale": "reflection_t",
+        "specular_tint": "highlights",
+        "transmission_tint": "transmission",
+        "ior": "transmission",
+    },
 }
 """model → parameter → the lobe it belongs to (parameters not listed are always live)."""
 
 DEFAULTS: dict[str, dict[str, Any]] = {
     "disney": {**DisneyParams().model_dump(), "ior": 1.5, "specular": 0.5},
+    "pixar": {**PixarParams().model_dump(), "eta": PixarParams().eta},
 }
-"""model → our defaults, with both spellings of the specular filled in."""
+"""model → our defaults (Disney: both spellings of the F0; Pixar: the IOR in use, ``eta``)."""
 
 
 def canonical(params: Any) -> dict[str, Any]:
@@ -58,14 +75,22 @@ def canonical(params: Any) -> dict[str, Any]:
     if isinstance(params, DisneyParams):
         data["specular"] = params.effective_specular
         data["ior"] = params.effective_ior
+    if isinstance(params, PixarParams):
+        from .pixar import derived
+
+        data["eta"] = params.eta  # the IOR in use: given, or from normal_fresnel
+        data.update(derived(params))
     return data
 
 
 def active_lobes(values: dict[str, Any], model: str = "disney") -> dict[str, bool]:
     """lobe → whether it carries any weight, for canonical ``values`` of ``model``."""
-    if model != "disney":
-        raise KeyError(model)
+    if model == "pixar" and "amp_diffuse" not in values:  # bare parameters: derive weights
+        fields = {k: values[k] for k in PixarParams.model_fields if k in values}
+        values = {**values, **canonical(PixarParams.parse(fields))}
     v = {k: _stored(x) for k, x in values.items()}
+    if model == "pixar":
+        return _pixar_lobes(v)
     dielectric = v["metallic"] < 1.0
     diffuse = dielectric and v["spec_trans"] < 1.0
     spec_trans = dielectric and v["spec_trans"] > 0.0
@@ -85,6 +110,18 @@ def active_lobes(values: dict[str, Any], model: str = "disney") -> dict[str, boo
         "scatter": (spec_trans or subsurface) and not v["thin"] and v["scatter_distance"] > 0,
         "thin": bool(v["thin"]),
     }
+
+
+def _pixar_lobes(v: dict[str, Any]) -> dict[str, bool]:
+    """Smits' six lobes live where their weight amplitude (:mod:`.pixar`) is not zero."""
+    on = {lobe: v[f"amp_{lobe}"] > 0.0 for lobe in LOBES_PIXAR}
+    on["highlights"] = on["specular"] or on["reflection"]
+    on["transmission"] = on["specular_t"] or on["reflection_t"]
+    on["dielectric"] = v["metallic"] < 1.0
+    return on
+
+
+LOBES_PIXAR = ("diffuse", "diffuse_t", "specular", "reflection", "specular_t", "reflection_t")
 
 
 def _stored(x: Any) -> Any:

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from .live import mixed_input
-from .names import SURFACE_IDS, Slot, table_for
+from .names import SURFACE_IDS, Slot, mapped_params, table_for
 from .network import (
     Connection,
     ExportError,
@@ -79,12 +79,40 @@ def build(source: Source) -> Network:
     node_id = SURFACE_IDS[("mtlx", source.model)]
     table = table_for("mtlx", source.model)
     inputs = surface_inputs(source, table, node_defaults(node_id), nodes, _live_or_baked(source))
-    extra = ""
-    if source.normal_map is not None:
-        extra = f"{node_id} has no normal input: the normal map is not applied"
-    note = loss_note(source, node_id, {s.param for s in table}, extra)
+    extra = [EXTRA_LOSS[source.model]] if source.model in EXTRA_LOSS else []
+    if source.normal_map is not None and source.model == "disney":
+        extra.append(f"{node_id} has no normal input: the normal map is not applied")
+    elif source.normal_map is not None:
+        inputs["geometry_normal"] = _normal(nodes, source.normal_map)
+    mapped = mapped_params("mtlx", source.model)
+    note = loss_note(source, node_id, mapped, "; ".join(extra))
     surface = Node(SURFACE, node_id, inputs, {"out": "token"}, {"loss": note})
     return Network("mtlx", Connection(SURFACE, "out"), [surface, *nodes])
+
+
+EXTRA_LOSS = {
+    "pixar": "OpenPBR has one specular lobe: Smits' specular and reflection share the "
+    "broad lobe's roughness; no transmitted diffuse; lobe scales fold into colours only "
+    "where a colour exists",
+}
+
+
+def _normal(nodes: list[Node], image: Image) -> tuple[str, Any]:
+    """A tangent-space normal map through ``ND_normalmap_float`` (0..1 encoded)."""
+    nodes.append(
+        Node(
+            "mtlx_normal_image", "ND_image_vector3", {"file": ("asset", image)}, {"out": "vector3f"}
+        )
+    )
+    nodes.append(
+        Node(
+            "mtlx_normal_map",
+            "ND_normalmap_float",
+            {"in": ("vector3f", Connection("mtlx_normal_image", "out"))},
+            {"out": "vector3f"},
+        )
+    )
+    return "vector3f", Connection("mtlx_normal_map", "out")
 
 
 def _live_or_baked(source: Source):

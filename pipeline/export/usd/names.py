@@ -206,10 +206,65 @@ RI_DISNEY: tuple[Slot, ...] = (
     Slot("thin", "thin", "int", lobe="thin", to_target=_flag, from_target=bool),
 )
 
+# UsdPreviewSurface for Smits' model: his surface colour, metallic blend and roughness
+# play the roles of the surface's own (metallic workflow: diffuse goes to 0 and the
+# highlight takes the surface colour as metallic → 1, as Smits' nRefl does).
+# `roughness` passes as it is: it is the one control of highlight width and fade in
+# both. `clear` (light passing straight through) is the surface's translucency.
+PREVIEW_PIXAR: tuple[Slot, ...] = (
+    Slot("surface_color", "diffuseColor", "color3f"),
+    Slot("metallic", "metallic", "float"),
+    Slot("roughness", "roughness", "float"),
+    # Smits' nRefl scales metals too, and `clear` also darkens the diffuse: both are
+    # live whatever the lobes, so neither is gated.
+    Slot("eta", "ior", "float"),
+    Slot(
+        "clear",
+        "opacity",
+        "float",
+        to_target=_one_minus,
+        from_target=_one_minus,
+        texture_linear=(-1.0, 1.0),
+    ),
+)
+
+# MaterialX OpenPBR for Smits' model (see the module note for the choice).
+MTLX_PIXAR: tuple[Slot, ...] = (
+    Slot("surface_color", "base_color", "color3f"),
+    Slot("metallic", "base_metalness", "float"),
+    Slot("spec_roughness", "specular_roughness", "float", lobe="highlights"),
+    Slot("specular_tint", "specular_color", "color3f", lobe="highlights"),
+    Slot("eta", "specular_ior", "float", lobe="dielectric"),
+    Slot("clear", "transmission_weight", "float", lobe="transmission"),
+    Slot("transmission_tint", "transmission_color", "color3f", lobe="transmission"),
+)
+
+# RenderMan PxrSurface: its face/edge colours are Smits' normal/grazing weights. His
+# broad "specular" is PxrSurface's rough specular, his sharp "reflection" its primary
+# specular; his transmitted diffuse is PxrSurface's diffuse transmission and his
+# refraction its glass lobe. Weights are written in full (PxrSurface is artistic mode:
+# face/edge blended by (1 - cos)^5, Smits' FrnBlend).
+RI_PIXAR: tuple[Slot, ...] = (
+    Slot("front", "diffuseColor", "color3f", lobe="diffuse"),
+    Slot("reflN", "specularFaceColor", "color3f", lobe="reflection"),
+    Slot("reflG", "specularEdgeColor", "color3f", lobe="reflection"),
+    Slot("refl_roughness", "specularRoughness", "float", lobe="reflection"),
+    Slot("specN", "roughSpecularFaceColor", "color3f", lobe="specular"),
+    Slot("specG", "roughSpecularEdgeColor", "color3f", lobe="specular"),
+    Slot("spec_roughness", "roughSpecularRoughness", "float", lobe="specular"),
+    Slot("behind", "diffuseTransmitColor", "color3f", lobe="diffuse_t"),
+    Slot("reflTN", "refractionColor", "color3f", lobe="reflection_t"),
+    Slot("refl_roughness", "glassRoughness", "float", lobe="reflection_t"),
+    Slot("eta", "glassIor", "float", lobe="reflection_t"),
+)
+
 TABLES: dict[tuple[str, str], tuple[Slot, ...]] = {
     ("universal", "disney"): PREVIEW_DISNEY,
     ("mtlx", "disney"): MTLX_DISNEY,
     ("ri", "disney"): RI_DISNEY,
+    ("universal", "pixar"): PREVIEW_PIXAR,
+    ("mtlx", "pixar"): MTLX_PIXAR,
+    ("ri", "pixar"): RI_PIXAR,
 }
 """(context, model) → the table of that target."""
 
@@ -217,6 +272,9 @@ SURFACE_IDS: dict[tuple[str, str], str] = {
     ("universal", "disney"): "UsdPreviewSurface",
     ("mtlx", "disney"): "ND_disney_principled",
     ("ri", "disney"): "PxrDisneyBsdf",
+    ("universal", "pixar"): "UsdPreviewSurface",
+    ("mtlx", "pixar"): "ND_open_pbr_surface_surfaceshader",
+    ("ri", "pixar"): "PxrSurface",
 }
 """(context, model) → the surface shader's ``info:id``."""
 
@@ -226,11 +284,26 @@ def table_for(context: str, model: str) -> tuple[Slot, ...]:
     return TABLES[(context, model)]
 
 
-def lost_params(context: str, model: str, params: dict) -> list[str]:
-    """Our parameters with a non-default effect that ``context`` has no input for."""
-    mapped = {s.param for s in table_for(context, model)}
-    if "ior" in mapped:
-        mapped.add("specular")  # one parameter, two spellings
-    if "specular" in mapped:
-        mapped.add("ior")
-    return sorted(k for k in params if k not in mapped)
+_SMITS_WEIGHT = frozenset(
+    (
+        "surface_color metallic roughness clear back normal_fresnel grazing_fresnel "
+        "specular_tint transmission_tint diffuse_scale specular_scale reflection_scale "
+        "diffuse_t_scale reflection_t_scale"
+    ).split()
+)
+DERIVED_FROM: dict[str, frozenset[str]] = {
+    "spec_roughness": frozenset(("roughness", "specular_cone_scale")),
+    "refl_roughness": frozenset(("roughness", "reflection_cone_scale")),
+    **{w: _SMITS_WEIGHT for w in ("front", "behind", "specN", "specG", "reflN", "reflG")},
+    "reflTN": _SMITS_WEIGHT,
+    "eta": frozenset(("ior", "normal_fresnel")),
+}
+"""Derived target quantity (:mod:`.pixar`) → the parameters it carries."""
+
+
+def mapped_params(context: str, model: str) -> set[str]:
+    """Our parameters that ``context`` expresses, directly or through derived weights."""
+    out: set[str] = set()
+    for slot in table_for(context, model):
+        out |= DERIVED_FROM.get(slot.param, {slot.param})
+    return out

@@ -27,6 +27,12 @@ CONTEXT_OUTPUT = {"universal": "surface", "mtlx": "mtlx:surface", "ri": "ri:surf
 
 CONTEXTS = tuple(CONTEXT_OUTPUT)
 
+F0_KEYS = frozenset(("specular", "ior", "eta"))
+"""One quantity in several spellings (Burley's specular, an IOR): mapped when any is."""
+
+DEFAULT_SPELLING = {"disney": "specular", "pixar": "normal_fresnel"}
+"""How a preset gives its normal-incidence reflectance unless it gives ``ior``."""
+
 WEIGHTS = frozenset(
     ("sheen", "clearcoat", "spec_trans", "diff_trans", "subsurface", "flatness", "scatter_distance")
 )
@@ -124,7 +130,7 @@ class Source:
 
 def source_from_params(name: str, model: str, params: Any, description: str = "") -> Source:
     """A constant material's :class:`Source` (no maps)."""
-    spelling = "ior" if getattr(params, "uses_ior", False) else "specular"
+    spelling = "ior" if getattr(params, "ior", None) is not None else DEFAULT_SPELLING[model]
     return Source(name, model, canonical(params), spelling=spelling, description=description)
 
 
@@ -173,8 +179,8 @@ def loss_note(source: Source, context: str, mapped: set[str], extra: str = "") -
     defaults = DEFAULTS[source.model]
     lost = sorted(
         k
-        for k, v in values.items()
-        if k not in mapped and k not in ("specular", "ior") and not same_or_eq(v, defaults[k])
+        for k in defaults
+        if k not in mapped and k not in F0_KEYS and not same_or_eq(values[k], defaults[k])
     )
     parts = []
     if lost:

@@ -12,17 +12,24 @@ from __future__ import annotations
 from functools import cache
 from typing import Any
 
-from .names import Slot, table_for
+from .names import Slot, mapped_params, table_for
 from .network import Connection, Image, Network, Node, Source, loss_note, surface_inputs
 from .textures import converted
 
 SURFACE = "preview_surface"
 ST_READER = "preview_st"
 SHAPE_NOTES = {
-    "clearcoat": "the clearcoat is GGX here, Burley's GTR1 (App. B.2) there",
-    "diffuse": "the diffuse has no retro-reflection (Burley §5.3)",
+    "disney": {
+        "clearcoat": "the clearcoat is GGX here, Burley's GTR1 (App. B.2) there",
+        "diffuse": "the diffuse has no retro-reflection (Burley §5.3)",
+    },
+    "pixar": {
+        "highlights": "Smits' specular and reflection lobes become one GGX lobe",
+        "diffuse": "the diffuse loses Smits' Fresnel-shaped darkening (PDiffuse)",
+        "diffuse_t": "no transmitted diffuse lobe",
+    },
 }
-"""Lobes whose shape the surface changes, though their weight is kept."""
+"""model → lobe → what the surface changes about it when that lobe is live."""
 
 
 @cache
@@ -47,10 +54,10 @@ def build(source: Source) -> Network:
     inputs = surface_inputs(source, table, preview_defaults(), nodes, _texture)
     if source.normal_map is not None:
         inputs["normal"] = _normal(nodes, source.normal_map)
-    mapped = {s.param for s in table}
     lobes = source.lobes
-    shapes = "; ".join(text for lobe, text in SHAPE_NOTES.items() if lobes[lobe])
-    note = loss_note(source, "UsdPreviewSurface", mapped, shapes)
+    notes = SHAPE_NOTES[source.model]
+    shapes = "; ".join(text for lobe, text in notes.items() if lobes[lobe])
+    note = loss_note(source, "UsdPreviewSurface", mapped_params("universal", source.model), shapes)
     surface = Node(SURFACE, "UsdPreviewSurface", inputs, {"surface": "token"})
     surface.custom["loss"] = note
     return Network("universal", Connection(SURFACE, "surface"), [surface, *nodes])

@@ -21,6 +21,7 @@ from .lobes import DEFAULTS, active_lobes, effective
 from .names import SURFACE_IDS, ior_to_specular, specular_to_ior, table_for
 from .network import (
     CONTEXT_OUTPUT,
+    F0_KEYS,
     Connection,
     ExportError,
     Image,
@@ -29,10 +30,17 @@ from .network import (
     Node,
     same_or_eq,
 )
+from .pixar import ior_to_normal_fresnel
 from .preview import preview_defaults
 
 TEXTURE_FILE_INPUT = {"UsdUVTexture": "file", "PxrTexture": "filename"}
 READ_ORDER = ("universal", "ri", "mtlx")
+READABLE = {
+    "disney": READ_ORDER,
+    # PxrSurface and OpenPBR get Smits' derived weights, which do not invert to his
+    # parameters: a Pixar material is read from its UsdPreviewSurface.
+    "pixar": ("universal",),
+}
 
 
 @dataclass
@@ -149,7 +157,7 @@ def _imported(spec: MaterialSpec) -> Imported | None:
     values = dict(DEFAULTS[model])
     result = Imported(spec.name, model, {})
     by_context = {net.context: net for net in spec.networks}
-    for context in READ_ORDER:
+    for context in READABLE[model]:
         net = by_context.get(context)
         surface = _surface(net, context, model)
         if surface is None:
@@ -160,7 +168,7 @@ def _imported(spec: MaterialSpec) -> Imported | None:
             result.loss.append(f"{context}: {surface.custom['loss']}")
     if not result.contexts:
         return None
-    spelling = spec.custom.get("spelling") or ("ior" if "ior" in result.maps else "specular")
+    spelling = spec.custom.get("spelling") or "ior"
     result.params = _preset_params(values, model, spelling)
     return result
 
@@ -202,8 +210,6 @@ def _read_surface(net, surface, context, model, values, result) -> None:
             values[slot.param] = slot.from_target(defaults[slot.input])
     if has_specular:
         values["ior"] = specular_to_ior(values["specular"])
-    else:
-        values["specular"] = ior_to_specular(values["ior"])
 
 
 def _defaults(context: str, node_id: str) -> dict[str, Any] | None:
@@ -226,20 +232,28 @@ def _texture_file(nodes: dict[str, Node], conn: Connection) -> Path | None:
     return value.path if isinstance(value, Image) else None
 
 
+F0_SPELLING = {
+    "disney": ("ior", "specular", ior_to_specular),
+    "pixar": ("eta", "normal_fresnel", ior_to_normal_fresnel),
+}
+"""model → (the IOR value read, the other spelling, the conversion to it)."""
+
+
 def _preset_params(values: dict[str, Any], model: str, spelling: str) -> dict:
-    """Non-default live parameters, ``specular``/``ior`` in the preset's own spelling."""
+    """Non-default live parameters, the F0 in the preset's own spelling (ior or the other)."""
     live = effective(values, model)
     defaults = DEFAULTS[model]
-    params = {}
-    for k, v in live.items():
-        if k in ("specular", "ior"):
-            continue
-        if not same_or_eq(v, defaults[k]):
-            params[k] = _round(v)
-    key = "ior" if spelling == "ior" else "specular"
-    params[key] = _round(live[key])
-    if same_or_eq(params[key], defaults[key]):
-        del params[key]
+    read, other, convert = F0_SPELLING[model]
+    params = {
+        k: _round(v)
+        for k, v in live.items()
+        if k in defaults and k not in F0_KEYS | {other} and not same_or_eq(v, defaults[k])
+    }
+    ior = live[read]
+    key, value = ("ior", ior) if spelling == "ior" else (other, convert(ior))
+    reference = defaults[read] if key == "ior" else defaults[other]
+    if not same_or_eq(value, reference):
+        params[key] = _round(value)
     return params
 
 

@@ -1,4 +1,4 @@
-"""The ``ri`` context: RenderMan's ``PxrDisneyBsdf`` for Disney materials.
+"""The ``ri`` context: RenderMan's ``PxrDisneyBsdf`` (Disney) and ``PxrSurface`` (Pixar).
 
 usd-core has no Sdr description of RenderMan's nodes, so only the defaults that are
 certain are relied on (a lobe weight of 0 and RenderMan's zero metallic, anisotropy and
@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from .names import SURFACE_IDS, Slot, table_for
+from .names import SURFACE_IDS, Slot, mapped_params, table_for
 from .network import Connection, Image, Network, Node, Source, loss_note, surface_inputs
 from .textures import converted
 
@@ -34,9 +34,34 @@ def build(source: Source) -> Network:
         )
         inputs["bumpNormal"] = ("normal3f", Connection("ri_normal_map", "resultN"))
     node_id = SURFACE_IDS[("ri", source.model)]
-    note = loss_note(source, node_id, {s.param for s in table})
+    if source.model == "pixar":
+        inputs.update(_pixar_gains(source.lobes))
+    extra = EXTRA_LOSS.get(source.model, "")
+    note = loss_note(source, node_id, mapped_params("ri", source.model), extra)
     surface = Node(SURFACE, node_id, inputs, {"bxdf_out": "token"}, {"loss": note})
     return Network("ri", Connection(SURFACE, "bxdf_out"), [surface, *nodes])
+
+
+PXR_SURFACE_GAINS = {
+    # lobe: (gain input, PxrSurface's default gain): a gain on by default must be
+    # written 0 for a dead lobe, one off by default written 1 for a live one.
+    "diffuse": ("diffuseGain", 1.0),
+    "diffuse_t": ("diffuseTransmitGain", 0.0),
+    "reflection_t": ("refractionGain", 0.0),
+}
+EXTRA_LOSS = {
+    "pixar": "PxrSurface has no transmitted specular lobe (Smits' specT); the diffuse "
+    "weight is its normal-incidence colour, without Smits' view-dependent Fresnel shape",
+}
+
+
+def _pixar_gains(lobes: dict[str, bool]) -> dict[str, tuple[str, Any]]:
+    out = {}
+    for lobe, (name, default) in PXR_SURFACE_GAINS.items():
+        wanted = 1.0 if lobes[lobe] else 0.0
+        if wanted != default:
+            out[name] = ("float", wanted)
+    return out
 
 
 def _texture(nodes: list[Node], slot: Slot, image: Image) -> tuple[str, Any]:

@@ -20,7 +20,7 @@ from .lobes import canonical
 from .names import specular_to_ior
 from .network import ExportError, Image, Source, source_from_params
 
-SUPPORTED = ("disney",)
+SUPPORTED = ("disney", "pixar")
 
 
 def source_for(
@@ -62,6 +62,12 @@ def baked_source(material: Any, texture_dir: Path, resolution: int, scratch: Pat
 
     blended = blend(material, resolution)
     _check_model(blended.model, material.name)
+    if getattr(blended, "representation", "params") == "lobe_weights":
+        raise ExportError(
+            "layered Pixar presets blend to Smits' lobe weights, which the USD exporter "
+            "cannot write yet; export the layers' own presets",
+            where=material.name,
+        )
     files = bake(blended, scratch)
 
     def image(name: str, array: np.ndarray) -> Image:
