@@ -27,6 +27,8 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from lookdev.materials.layers import CombineMask, ConstantMask, Mask, TextureMask, map_textures
+from lookdev.materials.params import DisneyParams
+from lookdev.materials.pixar import PixarParams
 
 from .errors import PresetError, PresetNotFoundError
 from .preset import MODELS, PresetFile, check_params
@@ -38,13 +40,13 @@ Lookup = Callable[[str], tuple[PresetFile, Path]]
 class Material(BaseModel):
     """A resolved preset, ready for blending, export and proofing."""
 
-    model_config = ConfigDict(frozen=True, arbitrary_types_allowed=True)
+    model_config = ConfigDict(frozen=True)
 
     name: str
     model: Literal["disney", "pixar", "layered"]
     description: str = ""
     tags: list[str] = Field(default_factory=list)
-    params: Any = None  # the model's Params instance; None for layered materials
+    params: DisneyParams | PixarParams | None = Field(None, description="None when layered.")
     layers: list[Layer] = Field(default_factory=list)
     source: Path | None = None
     citation: str | None = Field(None, description="The preset's `source` note (measurements).")
@@ -54,7 +56,7 @@ class Material(BaseModel):
 class Layer(BaseModel):
     """One layer of a layered material: a resolved material under a mask."""
 
-    model_config = ConfigDict(frozen=True, arbitrary_types_allowed=True)
+    model_config = ConfigDict(frozen=True)
 
     material: Material
     mask: Mask = Field(default_factory=ConstantMask)

@@ -25,7 +25,11 @@ app = typer.Typer(
     help="Browse and edit material presets. Presets are TOML files found, in order, in each "
     "--library folder, then in LOOKDEV_LIBRARY_PATH (os.pathsep-separated), then in the "
     "built-in library; the first definition of a name wins. Writes go to the first user "
-    "library; the built-in one is read-only.",
+    "library; the built-in one is read-only.\n\n"
+    'A preset with `extends = "parent"` takes the parent\'s parameters and overrides some '
+    "(giving `ior` drops an inherited `specular` and vice versa); description, tags, source "
+    "and layers are inherited unless given. A layer naming a layered preset brings its layers, "
+    'masks multiplied. Colours are linear \\[r, g, b] or sRGB "#rrggbb".',
     no_args_is_help=True,
 )
 
