@@ -55,7 +55,7 @@ class Header(NamedTuple):
 
 
 def scan_folder(folder: Path, *, cache: bool = True, skip: tuple[str, ...] = ()) -> list[Header]:
-    """Headers of every preset file under ``folder``, sorted by relative path.
+    """Headers of every preset file under ``folder``: shallowest first, then by path.
 
     Hidden files and folders (``.name``) are skipped: they are temporaries and caches.
     ``cache=False`` neither reads nor writes the index (the built-in library, which is
@@ -110,7 +110,7 @@ def _header_doc(path: Path) -> dict[str, Any]:
 def _header_fields(doc: dict[str, Any], name: str, where: str) -> tuple:
     """(model, description, tags, extends) of a parsed preset, checked just enough to list."""
     got = {k: doc.get(k) for k in ("name", "model", "description", "tags", "extends")}
-    if got["name"] != name:
+    if got["name"] != name or not NAME_RE.match(name):
         raise PresetError(f"name {got['name']!r} differs from the file name", where=where)
     if got["model"] is not None and got["model"] not in (*MODELS, "layered"):
         raise PresetError(f"unknown model {got['model']!r}", where=where, field="model")
@@ -149,7 +149,7 @@ def _walk(root: str, skip: tuple[str, ...] = ()) -> list[tuple[str, int, int, in
                     out.append((prefix + name, st.st_mtime_ns, st.st_size, st.st_ino))
                 elif e.is_dir():
                     stack.append((os.path.join(here, name), f"{prefix}{name}/"))
-    out.sort()
+    out.sort(key=lambda f: (f[0].count("/"), f[0]))  # shallowest first: it wins a name
     return out
 
 

@@ -178,6 +178,15 @@ def test_validate_everything_and_explicit_paths(cli, tmp_path):
     one_line_error(cli("presets", "validate", str(tmp_path / "nope.toml")), "no such file")
 
 
+def test_validate_flags_a_name_defined_twice_in_one_library(cli, tmp_path):
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "x.toml").write_text('name = "x"\nextends = "gold"\n')
+    (tmp_path / "sub" / "x.toml").write_text('name = "x"\nextends = "silver"\n')
+    assert Library([tmp_path], use_env=False).load("x").chain[0] == tmp_path / "x.toml"
+    r = cli("presets", "validate", "-L", str(tmp_path))
+    assert r.code == 2 and "sub/x.toml: 'x' is also defined by" in r.err
+
+
 def test_malformed_toml_names_file_and_line(cli, tmp_path):
     (tmp_path / "bad.toml").write_text(
         'name = "bad"\nmodel = "disney"\n[params]\nroughness = 0.3.\n'

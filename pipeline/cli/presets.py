@@ -243,7 +243,8 @@ def validate(
     # Folders named here join the search path, so their presets' parents are found.
     lib = Library([*[p if p.is_dir() else p.parent for p in paths or []], *(library or [])])
     files = _files(paths) if paths else [h.path for h in lib.headers()]
-    results = [(f, _problem(lib, f)) for f in files]
+    hidden = _hidden_in_own_library(lib)
+    results = [(f, hidden.get(f) or _problem(lib, f)) for f in files]
     bad = [(f, e) for f, e in results if e]
     if as_json:
         print_json([{"file": str(f), "ok": e is None, "error": e} for f, e in results])
@@ -422,6 +423,17 @@ def _files(paths: list[Path]) -> list[Path]:
             out.append(p)
         else:
             raise PresetError("no such file or folder", where=str(p))
+    return out
+
+
+def _hidden_in_own_library(lib: Library) -> dict[Path, str]:
+    """Files that lose their name to another file of the same library: never used."""
+    first: dict[tuple[str, str], Header] = {}
+    out = {}
+    for h in lib.headers():
+        winner = first.setdefault((h.library, h.name), h)
+        if winner is not h:
+            out[h.path] = f"{h.file}: {h.name!r} is also defined by {winner.file}, which wins"
     return out
 
 
