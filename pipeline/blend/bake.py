@@ -77,6 +77,7 @@ def sidecar_dict(blended: BlendedMaterial, files: dict[str, str]) -> dict[str, A
         "schema": SCHEMA,
         "name": blended.name,
         "model": blended.model,
+        "representation": blended.representation,
         "resolution": [width, height],
         "orientation": "top row of each file is v = 1; UV (0, 0) is the bottom-left texel",
         "constants": {k: _plain(v) for k, v in blended.constants.items()},

@@ -54,6 +54,9 @@ class BlendedMaterial:
     normal_map: np.ndarray | None = None
     specular_normal_map: np.ndarray | None = None
     decisions: list[Decision] = field(default_factory=list)
+    representation: str = "params"
+    """``"params"``: constants and maps are the model's parameters. ``"lobe_weights"``:
+    a layered Pixar material, composited into Smits' lobe weights (see :mod:`.pixar`)."""
 
     @property
     def arrays(self) -> dict[str, np.ndarray]:
@@ -70,15 +73,25 @@ class BlendedMaterial:
         return sum(a.nbytes for a in self.arrays.values())
 
     def params_at(self, row: int, col: int):
-        """The model's parameters at texel ``(row, col)`` (UV order; see module doc)."""
+        """The model's parameters at texel ``(row, col)`` (UV order; see module doc).
+
+        For ``representation = "lobe_weights"`` the values by name, as a dict.
+        """
         values = dict(self.constants)
         for name, a in self.maps.items():
             v = a[row, col]
             values[name] = tuple(float(x) for x in v) if np.ndim(v) else float(v)
+        if self.representation != "params":
+            return values
         return _params_type(self.model).parse(values, where=f"{self.name} texel {row},{col}")
 
     def to_params(self):
         """The parameters of a uniform result; a :class:`BlendError` if anything varies."""
+        if self.representation != "params":
+            raise BlendError(
+                "a layered Pixar material is composited lobe weights, not parameters",
+                where=self.name,
+            )
         if self.maps:
             raise BlendError(
                 f"parameters vary across the surface ({', '.join(sorted(self.maps))}); "
@@ -103,6 +116,7 @@ def blend(
     progress: Progress | None = None,
     prune: bool = True,
     images: dict | None = None,
+    layering: str = "full",
 ) -> BlendedMaterial:
     """Blend a library :class:`~lookdev.library.Material` at ``resolution``.
 
@@ -110,7 +124,9 @@ def blend(
     to constants and no maps. Disney stacks blend parameters (:mod:`.disney`); Pixar
     stacks composite lobe weights (:mod:`.pixar`). ``prune=False`` turns off every
     saving (all layers, all parameters as maps) and exists to measure them. ``images``
-    caches decoded textures across calls (see :class:`.MaskSampler`).
+    caches decoded textures across calls (see :class:`.MaskSampler`). ``layering`` is
+    Smits' ``"full"`` (transmitted light meets the layers below) or ``"simple"`` layering
+    of Pixar stacks.
     """
     width, height = (resolution, resolution) if isinstance(resolution, int) else resolution
     if width < 1 or height < 1:
@@ -120,7 +136,15 @@ def blend(
     if entries[0].model == "pixar":
         from . import pixar
 
-        return pixar.blend_stack(material.name, entries, sampler, progress, prune=prune)
+        return pixar.blend_stack(
+            material.name,
+            entries,
+            sampler,
+            progress,
+            prune=prune,
+            layered=material.model == "layered",
+            mode=layering,
+        )
     kept, decisions = prune_stack(entries, sampler, enabled=prune)
     result = _blend_disney(material.name, kept, sampler, progress, naive=not prune)
     result.decisions = decisions + result.decisions

@@ -1,0 +1,381 @@
+"""Pixar layers: lobe-weight compositing (Smits, "Reflection Model Design for Wall-E and Up",
+section "Layering").
+
+Each layer is Smits' six lobes with normal and grazing weights (:func:`layer_lobes`), the
+cone angles of its highlight lobes, a diffuse and a highlight normal, and a layer weight
+α = mask × presence. Two ways to combine a stack, top first:
+
+**Simple layering** (``"simple"``): "the weights can be computed with standard A over B
+compositing and then applied directly to the lobe weights": layer k gets
+``cₖ = αₖ Πⱼ₍above₎ (1 − αⱼ)``, every lobe weight is ``Σ cₖ Wₖ``.
+
+**Full layering** (``"full"``, the default): light that layer A transmits (refraction,
+transmitted specular, transmitted diffuse) meets the six lobes of the layer B below.
+Blur orders the lobe types, reflection/refraction < specular < diffuse; a B lobe that
+blurs less keeps the incoming type and cone, one that blurs the same keeps the type and
+takes the max cone, one that blurs more replaces the type (and brings its own cone).
+That gives Smits' table for the light reflected back out of B::
+
+    A \\ B              reflection B   specular B   diffuse B
+    refraction A       reflection     specular     diffuse
+    transmitted spec   specular       specular     diffuse
+    transmitted diff   diffuse        diffuse      diffuse
+
+and the same nine interactions with B's transmitted lobes accumulate the transmission
+that the next layer down receives. Incident light enters as a unit refraction packet of
+cone 0, so a lone layer reproduces its own lobes exactly. Where α < 1 the uncovered share
+passes to the next layer unchanged; under the bottom layer there is nothing, so light
+that gets through every layer leaves as the composite's transmitted lobes. Weights
+multiply per channel and separately at normal and grazing incidence; every interaction
+moves at most the energy it receives, so no stack returns more than 1 per channel.
+Smits' one-pass scheme does not attenuate light reflected by B on its way back up
+through A ("account for all interactions in some plausible manner").
+
+Cones and normals are blended by energy, "the product of the lobe and layer weights":
+an interaction's energy is the channel mean of its (N + G)/2 weight. Two normals are kept,
+one for the diffuse lobes and one for the highlights (Smits: "two, one for all diffuse,
+one for all highlights").
+
+The diffuse weights depend on the view through FrnBlend(…, V·n), which is affine in
+s = (1 − V·n)⁵. A stack is therefore composited twice, for the view at normal incidence
+(s = 0) and at grazing (s = 1); simple layering is linear, so its result is exact at
+every view by interpolating in s, full layering is exact at both ends.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from lookdev.materials.pixar import LOBES, WEIGHT_NAMES, PixarParams, lobe_weights
+from lookdev.materials.pixar_lobes import CONE_MIN_DEG
+
+from .errors import BlendError
+from .masks import MaskSampler
+from .stack import Entry, prune_stack
+
+PREFIX = dict(zip(LOBES, ("diff", "spec", "refl", "diffT", "specT", "reflT"), strict=True))
+BLUR = {"reflection": 0, "specular": 1, "diffuse": 2}
+"""Smits' order of blurring: reflection/refraction < specular < diffuse."""
+REFLECTED = {"reflection": "reflection", "specular": "specular", "diffuse": "diffuse"}
+TRANSMITTED = {"reflection": "reflection_t", "specular": "specular_t", "diffuse": "diffuse_t"}
+TYPE_OF = {
+    "diffuse": "diffuse",
+    "specular": "specular",
+    "reflection": "reflection",
+    "diffuse_t": "diffuse",
+    "specular_t": "specular",
+    "reflection_t": "reflection",
+}
+GROUP = {lobe: "diffuse" if TYPE_OF[lobe] == "diffuse" else "highlight" for lobe in LOBES}
+VIEWS = {"": 1.0, "_grazing": 0.0}
+"""Map-name suffix → cos θ of the view the weights are composited for."""
+CONES = ("specular", "reflection", "specular_t", "reflection_t")
+
+
+@dataclass
+class Part:
+    """Light of one lobe type: normal/grazing weights (…, 3), cone (…), normal (…, 3)."""
+
+    n: Any
+    g: Any
+    cone: Any = 0.0
+    normal: Any = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+
+    @property
+    def energy(self) -> Any:
+        """Channel mean of (N + G)/2: the weight for energy-weighted blending."""
+        return (np.mean(self.n, axis=-1) + np.mean(self.g, axis=-1)) * 0.5
+
+
+Lobes = dict[str, Part]
+"""Lobe name (:data:`LOBES`) → its light."""
+
+
+def layer_lobes(params: PixarParams, cos_view: float, normals: dict | None = None) -> Lobes:
+    """One layer's six lobes (Smits' weights, cones in degrees) for a view at ``cos_view``.
+
+    Cones: specular (30 r + 5)°, reflection 10 r° (at least the model's floor), each times
+    its cone scale; transmitted lobes share their front twin's cone.
+    """
+    w = lobe_weights(params, cos_view)
+    r = params.roughness
+    spec = (30.0 * r + 5.0) * params.specular_cone_scale
+    refl = max(10.0 * r * params.reflection_cone_scale, CONE_MIN_DEG)
+    cone = {"diffuse": 0.0, "specular": spec, "reflection": refl}
+    normals = normals or {}
+    flat = np.array([0.0, 0.0, 1.0])
+    return {
+        lobe: Part(
+            np.asarray(w[PREFIX[lobe] + "N"], dtype=np.float64),
+            np.asarray(w[PREFIX[lobe] + "G"], dtype=np.float64),
+            cone[TYPE_OF[lobe]],
+            normals.get(GROUP[lobe], flat),
+        )
+        for lobe in LOBES
+    }
+
+
+class _Sum:
+    """Accumulates parts per lobe: weights add, cones and normals average by energy."""
+
+    def __init__(self) -> None:
+        self.parts: dict[str, list[Part]] = {lobe: [] for lobe in LOBES}
+
+    def add(self, lobe: str, part: Part) -> None:
+        self.parts[lobe].append(part)
+
+    def total(self, lobe: str, zero: Part) -> Part:
+        """The lobe's summed weights, mean cone and energy-weighted normal *sum*.
+
+        The mean is taken about the first part's cone, so parts that share a cone (or a
+        lone part) give that cone exactly.
+        """
+        parts = self.parts[lobe] or [zero]
+        energies = [p.energy for p in parts]
+        n = sum(p.n for p in parts[1:]) + parts[0].n
+        g = sum(p.g for p in parts[1:]) + parts[0].g
+        ref = parts[0].cone
+        e_sum = sum(energies)
+        spread = sum(e * (p.cone - ref) for e, p in zip(energies, parts, strict=True))
+        cone = ref + spread / np.where(e_sum > 0, e_sum, 1.0)
+        normal = sum(
+            np.asarray(e)[..., None] * p.normal for e, p in zip(energies, parts, strict=True)
+        )
+        return Part(n, g, cone, normal)
+
+
+def composite(
+    layers: Sequence[tuple[Lobes, Any]], mode: str = "full"
+) -> tuple[Lobes, dict[str, np.ndarray]]:
+    """Combine ``(lobes, α)`` pairs, **top first**, into one set of lobes and two normals.
+
+    Returns the composite's lobes (cones energy-weighted) and ``{"diffuse", "highlight"}``
+    unit normals (energy-weighted, the geometric normal where there is no energy).
+    """
+    if mode not in ("full", "simple"):
+        raise BlendError(f"unknown Pixar layering {mode!r}; allowed: full, simple")
+    acc = _Sum()
+    if mode == "simple":
+        _simple(layers, acc)
+    else:
+        _full(layers, acc)
+    zero = _zero_like(layers[0][0])
+    lobes = {lobe: acc.total(lobe, zero) for lobe in LOBES}
+    normals = {}
+    for group in ("diffuse", "highlight"):
+        total = sum(lobes[lobe].normal for lobe in LOBES if GROUP[lobe] == group)
+        normals[group] = _unit(total)
+    for part in lobes.values():
+        part.normal = None
+    return lobes, normals
+
+
+def _simple(layers: Sequence[tuple[Lobes, Any]], acc: _Sum) -> None:
+    """A over B: layer k contributes cₖ = αₖ Π(1 − αⱼ above) of each of its lobes."""
+    remaining: Any = 1.0
+    for lobes, alpha in layers:
+        c = alpha * remaining
+        if not _known(c, 0.0):
+            for lobe, part in lobes.items():
+                acc.add(lobe, _scaled(part, c))
+        remaining = remaining * (1.0 - alpha)
+
+
+def _full(layers: Sequence[tuple[Lobes, Any]], acc: _Sum) -> None:
+    """Packets of transmitted light meet each layer's lobes by Smits' table (module doc)."""
+    one = np.ones(3)
+    packets = {"reflection": Part(one, one, 0.0)}  # the incident light, unblurred
+    for lobes, alpha in layers:
+        onward = _Sum()
+        for kind, packet in packets.items():
+            for lobe, part in lobes.items():
+                if _known(alpha, 0.0):
+                    break
+                out_type, cone = _interact(kind, packet.cone, TYPE_OF[lobe], part.cone)
+                hit = Part(packet.n * part.n, packet.g * part.g, cone, part.normal)
+                hit = _scaled(hit, alpha)
+                if lobe.endswith("_t"):
+                    onward.add(TRANSMITTED[out_type], hit)
+                else:
+                    acc.add(REFLECTED[out_type], hit)
+            if not _known(alpha, 1.0):
+                onward.add(TRANSMITTED[kind], _scaled(packet, 1.0 - alpha))  # through holes
+        zero = _zero_like(lobes)
+        packets = {
+            TYPE_OF[lobe]: _normalised(onward.total(lobe, zero))
+            for lobe in LOBES
+            if lobe.endswith("_t")
+        }
+    for kind, packet in packets.items():
+        acc.add(TRANSMITTED[kind], packet)
+
+
+def _known(alpha: Any, value: float) -> bool:
+    """True when every α equals ``value`` (its parts would be exactly zero: skip them)."""
+    return bool(np.all(np.asarray(alpha) == value))
+
+
+def _interact(incoming: str, cone_in: Any, lobe: str, cone_lobe: Any) -> tuple[str, Any]:
+    """Smits' rule: less blur keeps type and cone, same blur takes the max cone, more
+    blur replaces the type and brings the lobe's cone."""
+    if BLUR[lobe] < BLUR[incoming]:
+        return incoming, cone_in
+    if BLUR[lobe] == BLUR[incoming]:
+        return incoming, np.maximum(cone_in, cone_lobe)
+    return lobe, cone_lobe
+
+
+def _scaled(part: Part, c: Any) -> Part:
+    c = np.asarray(c)
+    return Part(part.n * c[..., None], part.g * c[..., None], part.cone, part.normal)
+
+
+def _normalised(part: Part) -> Part:
+    """A part whose normal sum (energy-weighted, from :class:`_Sum`) is made unit."""
+    return Part(part.n, part.g, part.cone, _unit(part.normal))
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    v = np.asarray(v, dtype=np.float64)
+    length = np.linalg.norm(v, axis=-1, keepdims=True)
+    flat = np.broadcast_to(np.array([0.0, 0.0, 1.0]), v.shape)
+    return np.where(length > 1e-12, v / np.where(length > 1e-12, length, 1.0), flat)
+
+
+def _zero_like(lobes: Lobes) -> Part:
+    z = np.zeros(3)
+    return Part(z, z, 0.0, np.zeros(3))
+
+
+def energy_sum(lobes: Lobes) -> tuple[np.ndarray, np.ndarray]:
+    """Σ over the six lobes of the normal and of the grazing weights, per channel."""
+    return sum(p.n for p in lobes.values()), sum(p.g for p in lobes.values())
+
+
+# -- the engine's Pixar path ---------------------------------------------------------------
+def opaque(entry: Entry) -> bool:
+    """True when the layer transmits nothing at any view (it hides what is below)."""
+    for cos_view in VIEWS.values():
+        lobes = layer_lobes(entry.params, cos_view)
+        if any(np.any(lobes[lobe].n > 0) or np.any(lobes[lobe].g > 0) for lobe in LOBES[3:]):
+            return False
+    return True
+
+
+def blend_stack(
+    name: str,
+    entries: list[Entry],
+    sampler: MaskSampler,
+    progress,
+    *,
+    prune: bool = True,
+    layered: bool = True,
+    mode: str = "full",
+):
+    """The engine's Pixar path: prune, composite per tile, fold uniform outputs.
+
+    A plain (not layered) Pixar material stays its parameters. A layered one becomes
+    lobe weights (``representation = "lobe_weights"``): Smits' twelve weight names for
+    the view at normal incidence and the same with ``_grazing`` for the view at grazing
+    incidence (RGB), ``<lobe>_cone`` in degrees for the four highlight lobes, and the
+    diffuse and highlight normals as ``normal_map`` and ``specular_normal_map``.
+    """
+    from .engine import BlendedMaterial
+
+    resolution = (sampler.width, sampler.height)
+    if not layered:
+        params = entries[0].params
+        constants = {k: v for k, v in params.model_dump().items() if v is not None}
+        return BlendedMaterial(name, "pixar", resolution, constants, decisions=[])
+    kept, decisions = prune_stack(
+        entries,
+        sampler,
+        base_opaque=False,
+        hides=lambda e: mode == "simple" or opaque(e),
+        enabled=prune,
+    )
+    outputs = _outputs(kept[::-1], sampler, progress, mode)
+    out = BlendedMaterial(name, "pixar", resolution, {}, decisions=decisions)
+    out.representation = "lobe_weights"
+    for key, value in outputs.items():
+        if key in ("normal_map", "specular_normal_map"):
+            if not _is_flat(value):
+                setattr(out, key, value.astype(np.float32))
+        elif prune and _uniform(value):
+            out.constants[key] = _constant(value)
+        else:
+            out.maps[key] = value.astype(np.float32)
+    out.constants["layering"] = mode
+    return out
+
+
+def _outputs(top_first: list[Entry], sampler: MaskSampler, progress, mode: str):
+    """Every output array, (H, W[, 3]), composited tile by tile."""
+    from .engine import TILE_TEXELS
+
+    height, width = sampler.height, sampler.width
+    rows_per_tile = max(1, TILE_TEXELS // width)
+    out: dict[str, np.ndarray] = {}
+    for r0 in range(0, height, rows_per_tile):
+        rows = slice(r0, min(height, r0 + rows_per_tile))
+        n = rows.stop - rows.start
+        alphas = [np.broadcast_to(e.coverage(sampler, rows), (n, width)) for e in top_first]
+        normals = [_entry_normals(e, sampler, rows) for e in top_first]
+        for suffix, cos_view in VIEWS.items():
+            stack = [
+                (layer_lobes(e.params, cos_view, nm), a)
+                for e, nm, a in zip(top_first, normals, alphas, strict=True)
+            ]
+            lobes, group_normals = composite(stack, mode)
+            for lobe, part in lobes.items():
+                _store(out, f"{PREFIX[lobe]}N{suffix}", part.n, rows, n, width, height)
+                _store(out, f"{PREFIX[lobe]}G{suffix}", part.g, rows, n, width, height)
+                if suffix == "" and lobe in CONES:
+                    _store(out, f"{lobe}_cone", part.cone, rows, n, width, height)
+            if suffix == "":
+                _store(out, "normal_map", group_normals["diffuse"], rows, n, width, height)
+                _store(
+                    out, "specular_normal_map", group_normals["highlight"], rows, n, width, height
+                )
+        if progress is not None:
+            progress(rows.stop, height)
+    return out
+
+
+def _entry_normals(entry: Entry, sampler: MaskSampler, rows: slice) -> dict[str, Any]:
+    """The layer's diffuse and highlight normals on ``rows`` (unit), flat where absent."""
+    out = {}
+    if entry.normal_map is not None:
+        out["diffuse"] = out["highlight"] = _unit(entry.normals(sampler, entry.normal_map, rows))
+    if entry.specular_normal_map is not None:
+        out["highlight"] = _unit(entry.normals(sampler, entry.specular_normal_map, rows))
+    return out
+
+
+def _store(out, key, value, rows, n, width, height) -> None:
+    """Write one tile of output ``key`` (cones are scalars, the rest RGB or xyz)."""
+    channels = () if key.endswith("_cone") else (3,)
+    if key not in out:
+        out[key] = np.empty((height, width, *channels), dtype=np.float32)
+    out[key][rows] = np.broadcast_to(value, (n, width, *channels))
+
+
+def _uniform(a: np.ndarray) -> bool:
+    flat = a.reshape(-1, *a.shape[2:])
+    return bool((flat == flat[0]).all())
+
+
+def _constant(a: np.ndarray) -> Any:
+    v = a[0, 0]
+    return tuple(float(x) for x in v) if np.ndim(v) else float(v)
+
+
+def _is_flat(normals: np.ndarray) -> bool:
+    return bool(np.all(normals == np.array([0.0, 0.0, 1.0], dtype=normals.dtype)))
+
+
+__all__ = ["WEIGHT_NAMES", "Lobes", "Part", "composite", "energy_sum", "layer_lobes"]
