@@ -148,6 +148,7 @@ def test_a_batch_runs_on_a_dask_cluster(mitsuba, gold, tmp_path):
     doc = batch.summary(tmp_path, jobs, results, 1.0)
     assert [p["frames"] for p in doc["proofs"]] == [3, 3]
     assert json.loads((tmp_path / "manifest.json").read_text()) == doc
+    assert doc["overview"] == "overview.png" and (tmp_path / "overview.png").is_file()
 
 
 def test_a_crashing_job_is_one_line_with_its_traceback_kept(gold, tmp_path, monkeypatch):

@@ -92,7 +92,6 @@ def naive_scene(bsdf: dict, depth: int, env: Any, s: Settings, frame: Any) -> di
 
     element = frame.angle if frame.kind == "element" else 0.0
     light = frame.angle if frame.kind == "light" else 0.0
-    pivot = list(shaderball.CUP_CENTER)
     scene = shaderball.scene_dict(bsdf, env.pixels, s.resolution, depth)
     scene["environment"] = {
         "type": "envmap",
@@ -100,12 +99,7 @@ def naive_scene(bsdf: dict, depth: int, env: Any, s: Settings, frame: Any) -> di
         "to_world": mi.ScalarTransform4f().rotate([0, 1, 0], light),
     }
     scene["ball"]["to_world"] = shaderball.ball_to_world(element)
-    scene["cup"]["to_world"] = (
-        mi.ScalarTransform4f()
-        .translate(pivot)
-        .rotate([0, 1, 0], element)
-        .translate([-c for c in pivot])
-    )
+    scene["cup"]["to_world"] = shaderball.cup_to_world(element)
     return scene
 
 

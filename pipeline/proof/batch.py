@@ -3,6 +3,7 @@
 Layout of an output folder::
 
     OUT/manifest.json                    the batch: one entry per material × IBL
+    OUT/overview.png                     the first frame of each, materials × IBLs
     OUT/<material>/<ibl>/frame_NNN.exr   scene-linear frames
     OUT/<material>/<ibl>/frame_NNN.png   the same through the proof view transform
     OUT/<material>/<ibl>/contact.png     all frames of the turntable, labelled
@@ -314,6 +315,21 @@ def summary(out: Path, jobs: list[Job], results: list[dict[str, Any]], seconds: 
         "wall_seconds": round(seconds, 3),
         "settings": jobs[0].settings.as_json() if jobs else {},
         "proofs": entries,
+        "overview": overview(out, jobs, results).name if jobs else None,
     }
     write_json(doc, out / MANIFEST)
     return doc
+
+
+def overview(out: Path, jobs: list[Job], results: list[dict[str, Any]]) -> Path:
+    """``OUT/overview.png``: the first frame of every proof, a row per material."""
+    import OpenImageIO as oiio
+
+    images, labels = [], []
+    for job, doc in zip(jobs, results, strict=True):
+        first = job.folder / doc["frames"][0]["png"]["file"]
+        images.append(oiio.ImageBuf(str(first)).get_pixels(oiio.FLOAT)[..., :3])
+        labels.append(f"{doc['material']} × {doc['ibl']}")
+    columns = len({job.ibl for job in jobs})
+    sheet = contact.contact_sheet(images, labels, f"{len(jobs)} proofs", columns)
+    return contact.write_png(sheet, out / "overview.png")

@@ -180,6 +180,26 @@ def ball_to_world(degrees: float) -> Any:
     return mi.ScalarTransform4f().translate(list(BALL_CENTER)).rotate([0, 1, 0], degrees)
 
 
+def cup_to_world(degrees: float) -> Any:
+    """The cup's transform at turntable angle ``degrees``: a turn about its own centre."""
+    import mitsuba as mi
+
+    pivot = list(CUP_CENTER)
+    return (
+        mi.ScalarTransform4f()
+        .translate(pivot)
+        .rotate([0, 1, 0], degrees)
+        .translate([-c for c in pivot])
+    )
+
+
+_material = {"type": "ref", "id": "material"}
+
+
+def _instance(group: str, to_world: Any) -> dict[str, Any]:
+    return {"type": "instance", "shapegroup": {"type": "ref", "id": group}, "to_world": to_world}
+
+
 def scene_dict(
     bsdf: dict[str, Any],
     environment: np.ndarray,
@@ -203,17 +223,21 @@ def scene_dict(
             "bitmap": mi.Bitmap(np.ascontiguousarray(environment, dtype=np.float32)),
         },
         "material": bsdf | {"id": "material"},
-        "ball": {
-            "type": "sphere",
-            "to_world": ball_to_world(0.0),
-            "bsdf": {"type": "ref", "id": "material"},
+        # Each shape sits in a shapegroup placed by an instance: turning an instance
+        # re-commits only the top-level acceleration structure (≈ 10 ms, not ≈ 80 ms
+        # for moving the shapes themselves; measured in lookdev bench proof).
+        "ball_shape": {"type": "shapegroup", "shape": {"type": "sphere", "bsdf": _material}},
+        "cup_shape": {
+            "type": "shapegroup",
+            "shape": {
+                "type": "ply",
+                "filename": str(cup_ply()),
+                "face_normals": False,
+                "bsdf": _material,
+            },
         },
-        "cup": {
-            "type": "ply",
-            "filename": str(cup_ply()),
-            "face_normals": False,
-            "bsdf": {"type": "ref", "id": "material"},
-        },
+        "ball": _instance("ball_shape", ball_to_world(0.0)),
+        "cup": _instance("cup_shape", cup_to_world(0.0)),
         "ground": {
             "type": "rectangle",
             "to_world": mi.ScalarTransform4f().rotate([1, 0, 0], -90).scale([30, 30, 1]),

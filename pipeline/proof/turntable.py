@@ -2,7 +2,7 @@
 
 Burley 2012 §6.1: "all turntables include both element and lighting rotations". The scene
 is loaded once; every frame only updates scene parameters through ``mi.traverse`` (the
-ball's ``to_world``, the cup's vertex positions and normals, the envmap's ``to_world``),
+``to_world`` of the ball's and the cup's instances and of the envmap),
 so Mitsuba reuses the kernels it compiled for the first frame (DESIGN.md, Proofing).
 
 Each frame is rendered as two independent half-sample images: their mean is the frame
@@ -113,18 +113,12 @@ class Turntable:
 
         self.scene = mi.load_dict(shaderball.scene_dict(bsdf, environment, resolution, max_depth))
         self.params = mi.traverse(self.scene)
-        self._cup_positions = self._array("cup.vertex_positions")
-        self._cup_normals = self._array("cup.vertex_normals")
-        self._pivot = np.asarray(shaderball.CUP_CENTER)
         self._pose = (0.0, 0.0)  # (element, light) angles the scene is posed at
-
-    def _array(self, key: str) -> np.ndarray:
-        return np.array(self.params[key], dtype=np.float64).reshape(-1, 3)
 
     def set_frame(self, frame: Frame) -> None:
         """Pose the element and the lighting for ``frame``, pushing only what changed.
 
-        Moving a shape rebuilds the acceleration structure (tens of milliseconds), so a
+        Turning the element re-commits the scene's top-level acceleration structure, so a
         lighting frame after the first touches the envmap's ``to_world`` alone.
         """
         import mitsuba as mi
@@ -133,12 +127,7 @@ class Turntable:
         light = frame.angle if frame.kind == "light" else 0.0
         if element != self._pose[0]:
             self.params["ball.to_world"] = shaderball.ball_to_world(element)
-            rot = shaderball.rotation_y(element)
-            positions = (self._cup_positions - self._pivot) @ rot.T + self._pivot
-            self.params["cup.vertex_positions"] = mi.Float(positions.ravel().astype(np.float32))
-            self.params["cup.vertex_normals"] = mi.Float(
-                (self._cup_normals @ rot.T).ravel().astype(np.float32)
-            )
+            self.params["cup.to_world"] = shaderball.cup_to_world(element)
         if light != self._pose[1]:
             self.params["environment.to_world"] = mi.ScalarTransform4f().rotate([0, 1, 0], light)
         self._pose = (element, light)
