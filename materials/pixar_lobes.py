@@ -88,11 +88,12 @@ def p_specular(xp: Any, wi: Any, wo: Any, p: Any, fn: Any, fg: Any, fresnel_cos:
     Both directions above the surface; the caller masks. Colour weights broadcast.
     ``fresnel_cos`` replaces u·h in the Fresnel blend (the transmitted lobes blend by
     the front-side incidence). ``(n·u)² + (n·v)² − (n·u)(n·v)`` ≥ ((n·u)² + (n·v)²)/2
-    vanishes only when both directions graze, and is floored at the dtype's tiny there.
+    vanishes only when both directions graze; it is floored at ε² (both within ε of the
+    tangent plane), which keeps f finite in float32 and changes nothing elsewhere.
     """
     h = xp.normalize(wi + wo)
     ci, co = wi[2], wo[2]
-    denom = 4.0 * xp.maximum(ci * ci + co * co - ci * co, xp.tiny)
+    denom = 4.0 * xp.maximum(ci * ci + co * co - ci * co, xp.epsilon * xp.epsilon)
     d = distribution(xp, sin2_of(xp, h), p)
     cos_f = xp.dot(wi, h) if fresnel_cos is None else fresnel_cos
     return frn_blend(xp, fn, fg, cos_f) * (d / denom)
@@ -115,10 +116,17 @@ def sample_half_vector(xp: Any, p: Any, u1: Any, u2: Any) -> Any:
 
 
 def half_vector_pdf(xp: Any, wi: Any, wo: Any, p: Any) -> Any:
-    """Solid-angle density of wi = reflect(wo, h) with h ~ D cos θh: D cos θh / 4|wo·h|."""
+    """Solid-angle density of wi = reflect(wo, h) with h ~ D cos θh: D cos θh / 4|wo·h|.
+
+    The Jacobian 1/4|wo·h| is singular at wi = −wo, reachable only with both directions
+    in the tangent plane; the density is taken as 0 where |wo·h| ≤ ε (as pbrt-v4 does at
+    exactly grazing), so it cannot overflow float32 or meet a zero odds as 0 · ∞.
+    """
     h = xp.normalize(wi + wo)
     d = distribution(xp, sin2_of(xp, h), p)
-    return d * xp.abs(h[2]) / xp.maximum(4.0 * xp.abs(xp.dot(wo, h)), xp.tiny)
+    cos_oh = xp.abs(xp.dot(wo, h))
+    ok = cos_oh > xp.epsilon
+    return xp.select(ok, d * xp.abs(h[2]) / (4.0 * xp.select(ok, cos_oh, 1.0)), 0.0)
 
 
 def reflect(xp: Any, w: Any, h: Any) -> Any:

@@ -12,7 +12,9 @@ float32 and float64:
   exactly 0 (grazing and tangent), below the surface, random ones; the set is closed
   under negation and mirroring, so every pair includes wi = −wo (zero half vector),
   wi = wo and the mirror direction (the peak of a delta-like lobe);
-* **uniforms** — the corners 0, ½ and 1 − 2⁻²⁴ of every sampling dimension, and random.
+* **uniforms** — the corners 0, ½ and 1 − 2⁻²⁴ of every sampling dimension, and random;
+* **maps** — once more with every float and colour field given per element (mixing its
+  extremes), the array code path that textures take.
 
 It counts queries whose output (f, pdf, sampled direction, weight) holds a NaN, an
 infinity or a negative value, and directional albedos (the model's own importance
@@ -57,6 +59,7 @@ FURNACE_THETA_DEG = (0.0, 45.0, 60.0, 75.0, 89.0, 89.99)
 FURNACE_SAMPLES = 2048
 SIGMAS = 4.0
 ROUNDING = {"float32": 1e-5, "float64": 1e-12}  # a white Lambertian sums to 1 ± this
+MAPS_LABEL = "per-element maps of every field"
 UNBOUNDED_HIGH = 10.0  # the "pushed" value of a field with no upper bound
 
 # Named stiff combinations (DESIGN.md), applied where every named field exists.
@@ -266,23 +269,61 @@ def _vec(v: np.ndarray) -> str:
     return "(" + ", ".join(f"{x:.3g}" for x in v) + ")"
 
 
-def _sweep_queries(report: ModelReport, model: Model, label: str, params: Any, dtype: Any) -> None:
+def per_element_maps(params_type: type, lead: tuple[int, ...], seed: int = 13) -> dict:
+    """Every float and colour field as a per-element map mixing its extremes and midpoint.
+
+    Constants fold into Python floats and may take other branches than arrays do (the
+    Dr.Jit plugin sees textures as arrays), so the sweep runs once with maps as well.
+    """
+    rng = np.random.default_rng(seed)
+    maps = {}
+    for name, info in params_type.model_fields.items():
+        ext = _extremes(info)
+        if ext == [(0.0, 0.0, 0.0), (1.0, 1.0, 1.0)]:
+            maps[name] = rng.choice([0.0, 0.5, 1.0], size=(*lead, 3))
+        elif len(ext) == 2 and all(isinstance(v, float) for v in ext):
+            lo, hi = ext
+            hi = min(hi, 1.0) if lo == 0.0 else hi
+            maps[name] = rng.choice([lo, 0.5 * (lo + hi), hi], size=lead)
+    return maps
+
+
+def _element(maps: dict[str, np.ndarray], index: tuple[int, ...]) -> str:
+    return ", ".join(f"{k}={_short(float(v[index]))}" for k, v in maps.items() if v.ndim == 2)
+
+
+def _sweep_queries(
+    report: ModelReport,
+    model: Model,
+    label: str,
+    params: Any,
+    dtype: Any,
+    with_maps: bool = False,
+) -> None:
     """eval and pdf on every direction pair, sample at every (wo, u)."""
     name = np.dtype(dtype).name
     d, u = directions(), uniforms()
+    pair_maps = per_element_maps(model.params_type, (len(d), len(d))) if with_maps else {}
+    sample_maps = per_element_maps(model.params_type, (len(d), len(u))) if with_maps else {}
     wi, wo = d[:, None, :], d[None, :, :]
-    f = evaluate(model, params, wi, wo, dtype=dtype)
-    pdf = density(model, params, wi, wo, dtype=dtype)
-    s_wi, s_w, s_pdf = draw(model, params, d[:, None, :], u[None, :, :], dtype=dtype)
+    f = evaluate(model, params, wi, wo, dtype=dtype, **pair_maps)
+    pdf = density(model, params, wi, wo, dtype=dtype, **pair_maps)
+    s_wi, s_w, s_pdf = draw(model, params, d[:, None, :], u[None, :, :], dtype=dtype, **sample_maps)
+
+    def pair(i: int, j: int) -> str:
+        return f"wi={_vec(d[i])}, wo={_vec(d[j])}" + (
+            f" [{_element(pair_maps, (i, j))}]" if pair_maps else ""
+        )
+
+    def draw_at(i: int, j: int) -> str:
+        return f"wo={_vec(d[i])}, u={_vec(u[j])}" + (
+            f" [{_element(sample_maps, (i, j))}]" if sample_maps else ""
+        )
+
     queries = [
-        ("eval", (f,), lambda i, j: f"wi={_vec(d[i])}, wo={_vec(d[j])}", (f < 0)),
-        ("pdf", (pdf[..., None],), lambda i, j: f"wi={_vec(d[i])}, wo={_vec(d[j])}", (pdf < 0)),
-        (
-            "sample",
-            (s_wi, s_w, s_pdf[..., None]),
-            lambda i, j: f"wo={_vec(d[i])}, u={_vec(u[j])}",
-            (s_w < 0).any(axis=-1) | (s_pdf < 0),
-        ),
+        ("eval", (f,), pair, (f < 0)),
+        ("pdf", (pdf[..., None],), pair, (pdf < 0)),
+        ("sample", (s_wi, s_w, s_pdf[..., None]), draw_at, (s_w < 0).any(axis=-1) | (s_pdf < 0)),
     ]
     for what, arrays, where, negative in queries:
         nan, inf = _flags(*arrays, lead=2)
@@ -345,6 +386,10 @@ def check_model(
                 _sweep_queries(report, model, label, params, dtype)
                 if _plausible(params):
                     _sweep_energy(report, model, label, params, dtype)
+    progress(MAPS_LABEL)
+    for dtype in DTYPES:
+        with np.errstate(all="ignore"):
+            _sweep_queries(report, model, MAPS_LABEL, model.params_type(), dtype, with_maps=True)
     return report
 
 
@@ -362,4 +407,4 @@ def run(
 def case_count(names: list[str] | None = None) -> int:
     """How many parameter sets :func:`run` will sweep (for a progress bar)."""
     models, _ = available_models(names)
-    return sum(len(parameter_cases(m.params_type)) for m in models.values())
+    return sum(len(parameter_cases(m.params_type)) + 1 for m in models.values())
