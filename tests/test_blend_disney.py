@@ -12,6 +12,7 @@ from lookdev.library import Library, Material
 from lookdev.materials.layers import ConstantMask, NoiseMask, RampMask, TextureMask
 from lookdev.materials.params import DisneyParams
 from lookdev.pipeline.blend import BlendError, TextureError, blend, engine
+from lookdev.pipeline.blend.sheen import base_scale as sheen_base_scale
 
 GOLD = disney("gold", base_color=(1.0, 0.78, 0.34), metallic=1.0, roughness=0.2)
 RUBBER = disney("rubber", base_color=(0.05, 0.1, 0.6), roughness=0.9, specular=0.3)
@@ -277,3 +278,25 @@ def test_builtin_layered_presets_blend(name):
 def test_base_mask_is_documented_as_unused():
     out = blend(layered(layer(GOLD, ConstantMask(value=0.3)), layer(RUBBER, 0.5)), 2)
     assert "not used" in out.decisions[0].reason
+
+
+# -- Conty-Kulla sheen over the blended base ------------------------------------------------
+def test_sheen_scales_the_blended_base_per_texel():
+    lib = Library(use_env=False)
+    velvet, plastic = lib.load("velvet"), lib.load("plastic_glossy")
+    ramp = RampMask(axis="u", start=0.2, end=0.8)  # exactly 0 in column 0, 1 in column 3
+    out = blend(layered(layer(plastic), layer(velvet, ramp)), 4)
+    assert "sheen" in out.maps and out.constants["sheen_model"] == "conty_kulla"
+    scale = sheen_base_scale(out, 0.7)
+    assert scale.shape == (4, 4, 3) and scale.dtype == np.float32
+    assert np.all(scale[:, 0] == 1.0)  # no sheen there: the base is untouched
+    alone = sheen_base_scale(blend(velvet, 1), 0.7)
+    assert np.allclose(scale[:, 3], alone, atol=1e-6)
+    # In between, the factor is that of the texel's blended parameters.
+    mid = Material(name="mid", model="disney", params=out.params_at(2, 1))
+    assert np.allclose(scale[2, 1], sheen_base_scale(blend(mid, 1), 0.7), atol=1e-6)
+    assert np.all(scale <= 1.0) and np.all(scale > 0.5)
+
+
+def test_no_conty_kulla_sheen_means_no_scaling():
+    assert sheen_base_scale(blend(GOLD, 4)) == (1.0, 1.0, 1.0)
