@@ -170,3 +170,17 @@ def test_model_cases_cover_the_roughness_edges_and_every_optional_lobe():
         "disney sheen 1",
         "disney spec_trans 1",
     ]
+
+
+def test_a_failing_case_is_reported_and_the_others_still_measured():
+    from lookdev.materials.bsdf import Model
+
+    def broken_eval(xp, prepared, wi, wo):
+        raise ZeroDivisionError("model bug")
+
+    broken = Model(
+        "broken", LAMBERT.params_type, LAMBERT.prepare, broken_eval, LAMBERT.pdf, LAMBERT.sample
+    )
+    report = E.run(TINY, ("precision",), models={"broken": broken, "lambert": LAMBERT})
+    assert report.skipped == {"precision broken default": "failed: ZeroDivisionError: model bug"}
+    assert {r.case for r in report.rows} == {"lambert default"}

@@ -251,7 +251,11 @@ def run(
             )
     for name, task in tasks:
         progress(name)
-        report.rows.extend(task())
+        try:
+            report.rows.extend(task())
+        except Exception as exc:  # noqa: BLE001 - one broken case must not hide the rest
+            first = (str(exc).splitlines() or [""])[0]
+            report.skipped[name] = f"failed: {type(exc).__name__}: {first}"
     return report
 
 
