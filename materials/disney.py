@@ -147,6 +147,7 @@ def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
         "subsurface": p["subsurface"],
         "flatness": p["flatness"] if thin else 0.0,
     }
+    pr["ax2"], pr["ay2"] = ax * ax, ay * ay
     if thin:
         # Burley 2015 Fig. 15 via Schutte: a thin sheet's transmission looks rougher.
         r_t = (0.65 * eta - 0.35) * p["roughness"]
@@ -154,6 +155,7 @@ def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
         pr["tax"], pr["tay"] = mf.anisotropic_alphas(xp, r_t, p["anisotropic"])
     else:
         pr["tax"], pr["tay"] = ax, ay
+    pr["tax2"], pr["tay2"] = pr["tax"] * pr["tax"], pr["tay"] * pr["tay"]
     weights = {
         "diffuse": pr["diffuse"],
         "diff_trans": pr["diff_trans"],
@@ -246,14 +248,6 @@ def _diffuse_shape(xp: Any, pr: dict[str, Any], ci: Any, co: Any, cos2_d: Any) -
     return _mix(shape, hk, sss)  # 2012 subsurface (BRDF Explorer)
 
 
-def _sheen(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, cos2_d: Any) -> Any:
-    color = pr["sheen"] * pr["sheen_color"]
-    if pr["sheen_model"] == "conty_kulla":
-        ck = _conty_kulla()
-        return color * ck.lobe(xp, wi, wo, xp.asarray(pr["sheen_r"]), True)
-    return color * fr.schlick_weight(xp, xp.sqrt(cos2_d))  # 2014 addendum
-
-
 def _conty_kulla() -> Any:
     return importlib.import_module(".sheen", __package__)
 
@@ -267,122 +261,129 @@ def _base_scale(xp: Any, pr: dict[str, Any], ci: Any, co: Any) -> Any:
     return xp.maximum(_conty_kulla().base_scale(xp, ci, co, r, color), 0.0)
 
 
-def _specular(xp, pr, wi, wo, h, front) -> Any:
-    """F·D·G/(4 cos θl cos θv) with G1/cos kept together (finite at grazing)."""
-    cos_d = xp.dot(wi, h)
+def _q(pr: dict[str, Any], w: Any, z2: Any, prefix: str = "") -> Any:
+    """αx² x² + αy² y², the projected roughness of Smith's Λ (Heitz 2014 eq. 86).
+
+    Isotropic constants use x² + y² = 1 − z² (only its absolute error matters: q is
+    added to z²), which saves two products per direction.
+    """
+    ax2, ay2 = pr[prefix + "ax2"], pr[prefix + "ay2"]
+    if isinstance(ax2, float) and ax2 == ay2:
+        return ax2 * (1.0 - z2)
+    return ax2 * (w[0] * w[0]) + ay2 * (w[1] * w[1])
+
+
+def _times(x: Any, front: Any) -> Any:
+    return x if front is None else x * front
+
+
+def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> list:
+    """(colour or None, scalar) pairs summing to the reflection lobes, masked to wi, wo up.
+
+    Scalars carry every per-direction factor and colours are constants (or per-element
+    maps), so each lobe costs one colour product. The half vector is h = wi + wo,
+    unnormalised: |h|² = 4 cos²θd and D is homogeneous in h.
+    """
+    lobes, ci, co = pr["lobes"], wi[2], wo[2]
+    up = (ci > 0.0) & (co > 0.0)
+    cos2_d = xp.maximum(0.5 + 0.5 * xp.dot(wi, wo), 0.0)  # cos²θd = (1 + wi·wo)/2
+    cos_d = xp.sqrt(cos2_d)
     w = fr.schlick_weight(xp, cos_d)
-    a, b, c = pr["spec_a"], pr["spec_b"], pr["spec_c"]
-    eta_side = _pick(xp, front, pr["eta"], 1.0 / pr["eta"])
-    f_exact = 0.0 if xp.known_zero(c) else fr.dielectric(xp, cos_d, eta_side)
-    color = _pick(xp, front, a + (b - a) * w + c * f_exact, pr["glass"] * f_exact)
-    ax, ay = pr["ax"], pr["ay"]
-    dg = mf.ggx_d(xp, h, ax, ay) * _g1_over_cos(xp, wi, ax, ay) * _g1_over_cos(xp, wo, ax, ay)
-    return color * (0.25 * dg)
+    h = wi + wo
+    h2 = 4.0 * cos2_d
+    zi2, zo2 = ci * ci, co * co
+    scale = _base_scale(xp, pr, ci, co)
+    terms = []
+    if "specular" in lobes:
+        d = mf.ggx_d(xp, h, pr["ax"], pr["ay"], n2=h2)
+        g = mf.g1_over_cos(xp, ci, _q(pr, wi, zi2), zi2) * mf.g1_over_cos(
+            xp, co, _q(pr, wo, zo2), zo2
+        )
+        dg = xp.select(up, 0.25 * d * g, 0.0)
+        a, b, c = pr["spec_a"], pr["spec_b"], pr["spec_c"]
+        dg_out = _times(dg, front)
+        terms += [(a * scale, dg_out), ((b - a) * scale, dg_out * w)]
+        if not xp.known_zero(c):
+            # The glass reflects the exact Fresnel on either side; inside, nothing else does.
+            f_exact = fr.dielectric(xp, cos_d, _pick(xp, front, pr["eta"], 1.0 / pr["eta"]))
+            terms.append((None, f_exact * dg * _pick(xp, front, c, pr["glass"])))
+    if "diffuse" in lobes:
+        shape = _diffuse_shape(xp, pr, ci, co, cos2_d)
+        k = _times(pr["diffuse"] * INV_PI * shape, front)
+        terms.append((pr["base"] * scale, xp.select(up, k, 0.0)))
+    if "sheen" in lobes:
+        if pr["sheen_model"] == "conty_kulla":
+            lobe = _conty_kulla().lobe(xp, wi, wo, xp.asarray(pr["sheen_r"]), True)
+        else:
+            lobe = w  # 2014 addendum: sheen · (1 − cos θd)⁵, no 1/π (BRDF Explorer)
+        k = _times(lobe * pr["sheen"], front)
+        terms.append((pr["sheen_color"], xp.select(up, k, 0.0)))
+    if "clearcoat" in lobes:
+        inv_h2 = 1.0 / xp.maximum(h2, xp.tiny)
+        sin2_h = (h[0] * h[0] + h[1] * h[1]) * inv_h2  # not 1 − cos²: the α = 10⁻³ peak
+        d = mf.gtr_d(xp, 1.0, pr["clearcoat_a2"], h[2] * h[2] * inv_h2, sin2_h)
+        a2 = mf.CLEARCOAT_G_ALPHA * mf.CLEARCOAT_G_ALPHA
+        g = mf.g1_over_cos(xp, ci, a2 * (1.0 - zi2), zi2) * mf.g1_over_cos(
+            xp, co, a2 * (1.0 - zo2), zo2
+        )
+        f = fr.schlick(xp, CLEARCOAT_F0, cos_d)
+        # Burley's clearcoat keeps the 1/(4 cos cos) that Schutte and Mitsuba leave out.
+        k = _times((0.25 * pr["clearcoat"]) * f * d * g, front)
+        terms.append((None, xp.select(up, k, 0.0)))
+    return terms
 
 
-def _g1_over_cos(xp: Any, w: Any, ax: Any, ay: Any) -> Any:
-    """G1(w)/|cos θ| = 2/(|z| + √(z² + αx²x² + αy²y²)) (Heitz 2014 eq. 86, divided)."""
-    z = xp.abs(w[2])
-    q = (ax * w[0]) * (ax * w[0]) + (ay * w[1]) * (ay * w[1])
-    return 2.0 / xp.maximum(z + xp.sqrt(z * z + q), xp.tiny)
-
-
-def _clearcoat_d(xp: Any, pr: dict[str, Any], h: Any) -> Any:
-    return mf.gtr_d(xp, 1.0, pr["clearcoat_a2"], h[2] * h[2], h[0] * h[0] + h[1] * h[1])
-
-
-def _clearcoat(xp, pr, wi, wo, h) -> Any:
-    """Burley's clearcoat, with the 1/(4 cos cos) that Schutte and Mitsuba leave out."""
-    f = fr.schlick(xp, CLEARCOAT_F0, xp.dot(wi, h))
-    g = _g1_over_cos(xp, wi, mf.CLEARCOAT_G_ALPHA, mf.CLEARCOAT_G_ALPHA) * _g1_over_cos(
-        xp, wo, mf.CLEARCOAT_G_ALPHA, mf.CLEARCOAT_G_ALPHA
-    )
-    return pr["clearcoat"] * f * _clearcoat_d(xp, pr, h) * g * 0.25
-
-
-def _transmission_half(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, etap: Any) -> Any:
-    """Walter 2007's generalised half vector wi·η' + wo, turned to the upper side."""
-    h = xp.normalize(wi * etap + wo)
-    one = xp.full(h[2], 1.0)
-    return h * xp.select(h[2] < 0.0, -one, one)
-
-
-def _solid_transmission(xp, pr, wi, wo, etap) -> tuple[Any, Any]:
-    """(f, pdf) of the rough dielectric BTDF (pbrt-v4 DielectricBxDF, radiance mode)."""
-    h = _transmission_half(xp, pr, wi, wo, etap)
+def _transmission(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> tuple[Any, Any]:
+    """(f, pdf) of the specular transmission, without weight and colour, wi below."""
+    ax, ay = pr["tax"], pr["tay"]
+    if pr["thin"]:
+        # Schutte: reflection about the rougher thin α, mirrored through the sheet.
+        wm = xp.vec3(wi[0], wi[1], -wi[2])
+        h = xp.normalize(wm + wo)
+        oh = xp.dot(wo, h)
+        g = mf.g1_over_cos(xp, wm[2], _qt(pr, wm)) * mf.g1_over_cos(xp, wo[2], _qt(pr, wo))
+        d = mf.ggx_d(xp, h, ax, ay)
+        f = (1.0 - fr.dielectric(xp, oh, pr["eta"])) * d * g * 0.25
+        return f, mf.visible_ggx_pdf(xp, wo, h, ax, ay) / xp.maximum(4.0 * oh, xp.tiny)
+    # Walter et al. 2007 / pbrt-v4 DielectricBxDF in radiance mode (the 1/η'² included).
+    etap = _pick(xp, front, pr["eta"], 1.0 / pr["eta"])
+    h = mf.transmission_half(xp, wi, wo, etap)
     ih, oh = xp.dot(wi, h), xp.dot(wo, h)
     ok = (ih < 0.0) & (oh > 0.0)
     denom = ih + oh / etap
     denom2 = xp.maximum(denom * denom, xp.tiny)
-    ax, ay = pr["tax"], pr["tay"]
+    g = mf.g1_over_cos(xp, -wi[2], _qt(pr, wi)) * mf.g1_over_cos(xp, wo[2], _qt(pr, wo))
     d = mf.ggx_d(xp, h, ax, ay)
-    jac = xp.abs(ih) / denom2
-    f = (
-        (1.0 - fr.dielectric(xp, oh, etap))
-        * d
-        * _g1_over_cos(xp, wi, ax, ay)
-        * _g1_over_cos(xp, wo, ax, ay)
-        * xp.abs(ih * oh)
-        / (denom2 * etap * etap)
-    )
-    pdf = mf.visible_ggx_pdf(xp, wo, h, ax, ay) * jac
+    f = (1.0 - fr.dielectric(xp, oh, etap)) * d * g * xp.abs(ih * oh) / (denom2 * etap * etap)
+    pdf = mf.visible_ggx_pdf(xp, wo, h, ax, ay) * xp.abs(ih) / denom2
     return xp.select(ok, f, 0.0), xp.select(ok, pdf, 0.0)
 
 
-def _thin_transmission(xp, pr, wi, wo) -> tuple[Any, Any]:
-    """(f, pdf): reflection about the rougher thin α, mirrored through the sheet (Schutte)."""
-    wm = xp.vec3(wi[0], wi[1], -wi[2])
-    h = xp.normalize(wm + wo)
-    ax, ay = pr["tax"], pr["tay"]
-    d = mf.ggx_d(xp, h, ax, ay)
-    f = (
-        (1.0 - fr.dielectric(xp, xp.dot(wo, h), pr["eta"]))
-        * d
-        * _g1_over_cos(xp, wm, ax, ay)
-        * _g1_over_cos(xp, wo, ax, ay)
-        * 0.25
-    )
-    pdf = mf.visible_ggx_pdf(xp, wo, h, ax, ay) / xp.maximum(4.0 * xp.dot(wo, h), xp.tiny)
-    return f, pdf
+def _qt(pr: dict[str, Any], w: Any) -> Any:
+    return _q(pr, w, w[2] * w[2], "t")
 
 
 # -- the model's four core functions -------------------------------------------------------
-def _add(total: Any, term: Any) -> Any:
-    return term if total is None else total + term
-
-
 def _eval_oriented(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> Any:
+    terms = _reflection_terms(xp, pr, wi, wo, front)
     lobes = pr["lobes"]
-    ci, co = wi[2], wo[2]
-    up = (ci > 0.0) & (co > 0.0)
-    down = (ci < 0.0) & (co > 0.0)
-    h = xp.normalize(wi + wo)
-    cos2_d = xp.maximum(0.5 * (1.0 + xp.dot(wi, wo)), 0.0)  # cos²θd = (1 + wi·wo)/2
-    scale = _base_scale(xp, pr, ci, co)
-    outside = None
-    if "diffuse" in lobes:
-        shape = _diffuse_shape(xp, pr, ci, co, cos2_d)
-        outside = (pr["diffuse"] * INV_PI) * pr["base"] * (shape * scale)
-    if "sheen" in lobes:
-        outside = _add(outside, _sheen(xp, pr, wi, wo, cos2_d))
-    if "clearcoat" in lobes:
-        outside = _add(outside, _clearcoat(xp, pr, wi, wo, h))
-    f = _specular(xp, pr, wi, wo, h, front) * scale if "specular" in lobes else None
-    if outside is not None:
-        f = _add(f, _pick(xp, front, outside, 0.0))
-    f = xp.select(up, f, 0.0) if f is not None else xp.zeros(ci) * pr["base"]
-    if "diff_trans" in lobes:
-        f = f + xp.select(down, (pr["diff_trans"] * INV_PI) * pr["trans_color"], 0.0)
-    if "spec_trans" in lobes:
-        ft, _ = _transmission(xp, pr, wi, wo, front)
-        f = f + xp.select(down, (pr["glass"] * ft) * pr["trans_color"], 0.0)
-    return f
+    if "diff_trans" in lobes or "spec_trans" in lobes:
+        down = (wi[2] < 0.0) & (wo[2] > 0.0)
+        t = pr["diff_trans"] * INV_PI if "diff_trans" in lobes else 0.0
+        if "spec_trans" in lobes:
+            t = t + pr["glass"] * _transmission(xp, pr, wi, wo, front)[0]
+        terms.append((pr["trans_color"], xp.select(down, t, 0.0)))
+    grey = [s for c, s in terms if c is None]
+    f = xp.zeros(wi[2]) * pr["base"] if not grey else None
+    for color, scalar in terms:
+        f = _add(f, color * scalar if color is not None else None)
+    return _add(f, sum(grey[1:], grey[0]) if grey else None)
 
 
-def _transmission(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> tuple[Any, Any]:
-    if pr["thin"]:
-        return _thin_transmission(xp, pr, wi, wo)
-    return _solid_transmission(xp, pr, wi, wo, _pick(xp, front, pr["eta"], 1.0 / pr["eta"]))
+def _add(total: Any, term: Any) -> Any:
+    if term is None:
+        return total
+    return term if total is None else total + term
 
 
 def _odds(xp: Any, pr: dict[str, Any], front: Any) -> dict[str, Any]:
@@ -393,36 +394,54 @@ def _pdf_oriented(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> 
     odds = _odds(xp, pr, front)
     ci, co = wi[2], wo[2]
     up = (ci > 0.0) & (co > 0.0)
-    down = (ci < 0.0) & (co > 0.0)
-    h = xp.normalize(wi + wo)
-    oh4 = xp.maximum(4.0 * xp.dot(wo, h), xp.tiny)
+    h = wi + wo
+    h2 = xp.maximum(2.0 + 2.0 * xp.dot(wi, wo), xp.tiny)  # |wi + wo|² = 4 cos²θd
     p_up = 0.0
     if "specular" in odds:
-        p_up = odds["specular"] * mf.visible_ggx_pdf(xp, wo, h, pr["ax"], pr["ay"]) / oh4
-    cosine = odds.get("diffuse", 0.0) + odds.get("sheen", 0.0)
+        # Visible normals: D_wo(h)/(4 wo·h) = G1(wo) D(h) / (4 cos θo).
+        zo2 = co * co
+        g1 = mf.g1_over_cos(xp, co, _q(pr, wo, zo2), zo2)
+        p_up = odds["specular"] * 0.25 * mf.ggx_d(xp, h, pr["ax"], pr["ay"], n2=h2) * g1
     if "diffuse" in odds or "sheen" in odds:
-        p_up = p_up + cosine * ci * INV_PI
+        p_up = p_up + (odds.get("diffuse", 0.0) + odds.get("sheen", 0.0)) * INV_PI * ci
     if "clearcoat" in odds:
-        p_up = p_up + odds["clearcoat"] * _clearcoat_d(xp, pr, h) * h[2] / oh4
+        # D(h) cos θh / (4 wo·h) with cos θh = h_z/|h| and wo·h = |h|/2.
+        d = mf.gtr_d(
+            xp, 1.0, pr["clearcoat_a2"], h[2] * h[2] / h2, (h[0] * h[0] + h[1] * h[1]) / h2
+        )
+        p_up = p_up + odds["clearcoat"] * d * h[2] / (2.0 * h2)
     p = xp.select(up, p_up, 0.0)
-    if "diff_trans" in odds:
-        p = p + xp.select(down, odds["diff_trans"] * -ci * INV_PI, 0.0)
-    if "spec_trans" in odds:
-        _, pt = _transmission(xp, pr, wi, wo, front)
-        p = p + xp.select(down, odds["spec_trans"] * pt, 0.0)
+    if "diff_trans" in odds or "spec_trans" in odds:
+        down = (ci < 0.0) & (co > 0.0)
+        p_down = odds["diff_trans"] * -ci * INV_PI if "diff_trans" in odds else 0.0
+        if "spec_trans" in odds:
+            p_down = p_down + odds["spec_trans"] * _transmission(xp, pr, wi, wo, front)[1]
+        p = p + xp.select(down, p_down, 0.0)
     return p
+
+
+def _oriented(xp: Any, pr: dict[str, Any], wi: Any, wo: Any) -> tuple[Any, Any, Any, Any]:
+    """(wi, wo, front, s) in the frame where wo is up; untouched when nothing needs it.
+
+    Only a thin sheet (two-sided) or transmission looks at a viewer below the surface:
+    without them every lobe is masked to wo.z > 0 anyway, and the flip is skipped.
+    """
+    if not (pr["thin"] or "spec_trans" in pr["lobes"] or "diff_trans" in pr["lobes"]):
+        return wi, wo, None, None
+    wi_, wo_, s = _orient(xp, wi, wo)
+    return wi_, wo_, _front(pr, s), s
 
 
 def eval_core(xp: Any, pr: dict[str, Any], wi: Any, wo: Any) -> Any:
     """f(wi, wo) without the cosine (the :class:`~.bsdf.Model` contract)."""
-    wi_, wo_, s = _orient(xp, wi, wo)
-    return _eval_oriented(xp, pr, wi_, wo_, _front(pr, s))
+    wi_, wo_, front, _ = _oriented(xp, pr, wi, wo)
+    return _eval_oriented(xp, pr, wi_, wo_, front)
 
 
 def pdf_core(xp: Any, pr: dict[str, Any], wi: Any, wo: Any) -> Any:
     """Solid-angle density of :func:`sample_core` producing wi: the lobe mixture."""
-    wi_, wo_, s = _orient(xp, wi, wo)
-    return _pdf_oriented(xp, pr, wi_, wo_, _front(pr, s))
+    wi_, wo_, front, _ = _oriented(xp, pr, wi, wo)
+    return _pdf_oriented(xp, pr, wi_, wo_, front)
 
 
 def _candidates(xp: Any, pr: dict[str, Any], wo: Any, u1: Any, u2: Any, front: Any) -> dict:
@@ -454,8 +473,7 @@ def _candidates(xp: Any, pr: dict[str, Any], wo: Any, u1: Any, u2: Any, front: A
 
 def sample_core(xp: Any, pr: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any, Any]:
     """(wi, f·|cos θi|/pdf, pdf): u[0] picks a lobe by its odds, u[1], u[2] its direction."""
-    _, wo_, s = _orient(xp, wo, wo)
-    front = _front(pr, s)
+    _, wo_, front, s = _oriented(xp, pr, wo, wo)
     odds = _odds(xp, pr, front)
     cands = _candidates(xp, pr, wo_, u[1], u[2], front)
     order = [k for k in LOBES if k in odds]
@@ -472,11 +490,16 @@ def sample_core(xp: Any, pr: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any,
         wi = xp.select(cond, cands[k][0], wi)
         valid = xp.select(cond, cands[k][1], valid)
     valid = valid & (wo_[2] > 0.0)
+    # A failed candidate may be NaN; evaluate at a harmless finite direction instead.
+    wi = xp.vec3(*(xp.select(valid, wi[k], wo_[k]) for k in range(3)))
     pdf = xp.select(valid, _pdf_oriented(xp, pr, wi, wo_, front), 0.0)
     f = _eval_oriented(xp, pr, wi, wo_, front)
     ok = pdf > 0.0
-    weight = xp.select(ok, f * (xp.abs(wi[2]) / xp.select(ok, pdf, 1.0)), 0.0)
-    return xp.vec3(wi[0], wi[1], wi[2] * s), weight, pdf
+    weight = f * xp.select(ok, xp.abs(wi[2]) / xp.select(ok, pdf, 1.0), 0.0)
+    z = wi[2] if s is None else wi[2] * s
+    # A failed sample is the zero vector with pdf 0 and weight 0, never NaN.
+    wi = xp.vec3(xp.select(ok, wi[0], 0.0), xp.select(ok, wi[1], 0.0), xp.select(ok, z, 0.0))
+    return wi, weight, pdf
 
 
 MODEL = Model("disney", DisneyParams, prepare, eval_core, pdf_core, sample_core)

@@ -21,14 +21,14 @@ from typing import Any
 
 
 def schlick_weight(xp: Any, cos: Any) -> Any:
-    """(1 − cos θ)⁵ (Schlick 1994), clamped to [0, 1] so |cos| > 1 from rounding is harmless.
+    """(1 − cos θ)⁵ (Schlick 1994), 0 where rounding makes cos θ exceed 1.
 
     >>> import numpy as np
     >>> from .arrays import NumpyOps
     >>> float(schlick_weight(NumpyOps(), np.float64(0.0)))
     1.0
     """
-    m = xp.clip(1.0 - cos, 0.0, 1.0)
+    m = xp.maximum(1.0 - cos, 0.0)  # cos ≤ 1 for unit vectors: one bound is enough
     m2 = m * m
     return m2 * m2 * m
 

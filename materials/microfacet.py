@@ -110,15 +110,17 @@ def anisotropic_alphas(xp: Any, roughness: Any, anisotropic: Any) -> tuple[Any, 
     return xp.maximum(a / aspect, ALPHA_MIN), xp.maximum(a * aspect, ALPHA_MIN)
 
 
-def ggx_d(xp: Any, h: Any, ax: Any, ay: Any) -> Any:
+def ggx_d(xp: Any, h: Any, ax: Any, ay: Any, n2: Any = None) -> Any:
     """D_GTR2aniso(h) = 1/(π αx αy ((h·x)²/αx² + (h·y)²/αy² + (h·n)²)²) (eq. 13).
 
-    ``h`` need not be normalised: D is evaluated at h/|h| (the ratio is homogeneous).
+    ``h`` need not be normalised: D is evaluated at h/|h| (the ratio is homogeneous);
+    ``n2`` = |h|² when the caller knows it (1 for a unit h).
     """
     hx, hy, hz = h[0] / ax, h[1] / ay, h[2]
     s = hx * hx + hy * hy + hz * hz
-    n2 = h[0] * h[0] + h[1] * h[1] + hz * hz
-    return (n2 * n2) / (math.pi * ax * ay * s * s)
+    if n2 is None:
+        n2 = h[0] * h[0] + h[1] * h[1] + hz * hz
+    return (n2 * n2) / ((math.pi * ax * ay) * (s * s))
 
 
 def sample_ggx(xp: Any, ax: Any, ay: Any, u1: Any, u2: Any) -> Any:
@@ -138,6 +140,16 @@ def smith_g1(xp: Any, w: Any, ax: Any, ay: Any) -> Any:
     z = xp.abs(w[2])
     q = (ax * w[0]) * (ax * w[0]) + (ay * w[1]) * (ay * w[1])
     return 2.0 * z / xp.maximum(z + xp.sqrt(z * z + q), xp.tiny)
+
+
+def g1_over_cos(xp: Any, z: Any, q: Any, z2: Any = None) -> Any:
+    """G1(w)/cos θ = 2/(z + √(z² + q)), q = αx²wx² + αy²wy², for z = cos θ ≥ 0.
+
+    The form a microfacet BRDF needs (G1(wi) G1(wo) / (4 cos θi cos θo)): finite as
+    z → 0, where G1 and cos θ both vanish.
+    """
+    z2 = z * z if z2 is None else z2
+    return 2.0 / xp.maximum(z + xp.sqrt(z2 + q), xp.tiny)
 
 
 def clearcoat_g1(xp: Any, w: Any) -> Any:
@@ -172,6 +184,16 @@ def visible_ggx_pdf(xp: Any, wo: Any, h: Any, ax: Any, ay: Any) -> Any:
     """D_wo(h) of :func:`sample_visible_ggx` (``wo`` upper, ``h`` unit)."""
     cos_o = xp.maximum(wo[2], xp.tiny)
     return smith_g1(xp, wo, ax, ay) * xp.maximum(xp.dot(wo, h), 0.0) * ggx_d(xp, h, ax, ay) / cos_o
+
+
+def transmission_half(xp: Any, wi: Any, wo: Any, eta: Any) -> Any:
+    """Walter et al. 2007's generalised half vector ∝ wi·η + wo, turned to the upper side.
+
+    ``wo`` is on the side of relative IOR 1, ``wi`` across the interface (η = η_wi/η_wo).
+    """
+    h = xp.normalize(wi * eta + wo)
+    one = xp.full(h[2], 1.0)  # keeps the dtype of h
+    return h * xp.select(h[2] < 0.0, -one, one)
 
 
 def reflect(xp: Any, w: Any, h: Any) -> Any:

@@ -492,4 +492,5 @@ def test_drjit_backend_equals_numpy_float32(mitsuba, params):
     # condition number: compare where both backends picked the same valid sample.
     same = np.all(np.abs(np.array(s_wi).T - n_wi) < 1e-4, axis=1) & (n_p > 0)
     assert same.mean() > 0.95
-    assert relative_difference(np.array(s_p)[same], n_p[same]) < 1e-3
+    # At α = 10⁻³ a pdf of 10⁵ moves by 10⁻³ of itself when wi moves by a float32 ulp.
+    assert relative_difference(np.array(s_p)[same], n_p[same]) < 1e-2
