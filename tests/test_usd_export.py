@@ -13,11 +13,7 @@ from pxr import Sdf, Usd, UsdShade  # noqa: E402
 from lookdev.library import Library, load_material  # noqa: E402
 from lookdev.materials.params import DisneyParams  # noqa: E402
 from lookdev.pipeline.export.usd import mtlx  # noqa: E402
-from lookdev.pipeline.export.usd.network import (  # noqa: E402
-    CONTEXTS,
-    ExportError,
-    source_from_params,
-)
+from lookdev.pipeline.export.usd.network import CONTEXTS, source_from_params  # noqa: E402
 from lookdev.pipeline.export.usd.sources import source_for  # noqa: E402
 from lookdev.pipeline.export.usd.validate import validate_usd  # noqa: E402
 from lookdev.pipeline.export.usd.writer import export_usd  # noqa: E402
@@ -41,17 +37,12 @@ def _authored(stage: Usd.Stage, prefix: str = "/Materials") -> dict[str, list[st
     return out
 
 
-def _exportable(material) -> bool:
-    """Layered Pixar presets blend to lobe weights, which the exporter does not write yet."""
-    return material.model != "layered" or material.layers[0].material.model != "pixar"
-
-
 @pytest.fixture(scope="module")
 def library_stage(tmp_path_factory):
     """Every built-in preset in one stage, all contexts, plus the standalone .mtlx."""
     tmp = tmp_path_factory.mktemp("lib")
     lib = Library(use_env=False)
-    names = [n for n in lib.names() if _exportable(load_material(n, lib))]
+    names = lib.names()
     scratch = tmp / "scratch"
     scratch.mkdir()
     sources = [
@@ -249,12 +240,27 @@ def test_package_holds_stage_and_textures(tmp_path):
     assert validate_usd(tmp_path / "r.usdz").ok
 
 
-def test_layered_pixar_is_refused_with_one_line(tmp_path):
-    lib = Library(use_env=False)
-    layered = [n for n in lib.names() if not _exportable(load_material(n, lib))]
-    if not layered:
-        pytest.skip("no layered Pixar preset in the library")
+def test_layered_pixar_exports_its_lobe_weights(tmp_path):
+    """A Pixar stack blends to Smits' weights: PxrSurface takes them, the preview surface
+    takes them in its specular workflow (its diffuse written black rather than left grey)."""
+    from lookdev.library import Layer, Material
+    from lookdev.materials.pixar import PixarParams
+
+    def layer(name, **kw):
+        return Layer(material=Material(name=name, model="pixar", params=PixarParams(**kw)))
+
+    metal = layer("metal", surface_color=0.9, metallic=1.0, roughness=0.0)
+    material = Material(name="stack", model="layered", layers=[metal])
     scratch = tmp_path / "scratch"
     scratch.mkdir()
-    with pytest.raises(ExportError, match="lobe weights"):
-        source_for(load_material(layered[0], lib), tmp_path / "tex", MAP_RES, scratch=scratch)
+    source = source_for(material, tmp_path / "tex", MAP_RES, scratch=scratch)
+    assert source.model == "pixar_weights" and not source.maps
+    export_usd([source], tmp_path / "s.usda")
+    assert validate_usd(tmp_path / "s.usda").ok
+    stage = Usd.Stage.Open(str(tmp_path / "s.usda"))
+    preview = stage.GetPrimAtPath("/Materials/stack/preview_surface")
+    assert preview.GetAttribute("inputs:useSpecularWorkflow").Get() == 1
+    assert tuple(preview.GetAttribute("inputs:diffuseColor").Get()) == (0.0, 0.0, 0.0)
+    assert preview.GetAttribute("inputs:specularColor").Get()[0] == pytest.approx(0.9)
+    ri = stage.GetPrimAtPath("/Materials/stack/ri_surface")
+    assert ri.GetAttribute("inputs:diffuseGain").Get() == 0.0

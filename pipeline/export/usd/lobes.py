@@ -54,12 +54,19 @@ PARAM_LOBE: dict[str, dict[str, str]] = {
         "transmission_tint": "transmission",
         "ior": "transmission",
     },
+    "pixar_weights": {},  # blended lobe weights: each is its own lobe's weight
 }
 """model → parameter → the lobe it belongs to (parameters not listed are always live)."""
 
 DEFAULTS: dict[str, dict[str, Any]] = {
     "disney": {**DisneyParams().model_dump(), "ior": 1.5, "specular": 0.5},
     "pixar": {**PixarParams().model_dump(), "eta": PixarParams().eta},
+    "pixar_weights": {
+        **dict.fromkeys(("front", "behind", "specN", "specG", "reflN", "reflG"), (0.0,) * 3),
+        **dict.fromkeys(("reflTN", "f0"), (0.0,) * 3),
+        **dict.fromkeys(("spec_roughness", "refl_roughness", "highlight_roughness"), 0.0),
+        "eta": PixarParams().eta,
+    },
 }
 """model → our defaults (Disney: both spellings of the F0; Pixar: the IOR in use, ``eta``)."""
 
@@ -89,7 +96,7 @@ def active_lobes(values: dict[str, Any], model: str = "disney") -> dict[str, boo
         fields = {k: values[k] for k in PixarParams.model_fields if k in values}
         values = {**values, **canonical(PixarParams.parse(fields))}
     v = {k: _stored(x) for k, x in values.items()}
-    if model == "pixar":
+    if model in ("pixar", "pixar_weights"):
         return _pixar_lobes(v)
     dielectric = v["metallic"] < 1.0
     diffuse = dielectric and v["spec_trans"] < 1.0
@@ -117,7 +124,7 @@ def _pixar_lobes(v: dict[str, Any]) -> dict[str, bool]:
     on = {lobe: v[f"amp_{lobe}"] > 0.0 for lobe in LOBES_PIXAR}
     on["highlights"] = on["specular"] or on["reflection"]
     on["transmission"] = on["specular_t"] or on["reflection_t"]
-    on["dielectric"] = v["metallic"] < 1.0
+    on["dielectric"] = v.get("metallic", 0.0) < 1.0
     return on
 
 

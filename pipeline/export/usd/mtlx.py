@@ -32,6 +32,7 @@ from .network import (
     prim_name,
     surface_inputs,
 )
+from .preview import SPECULAR_WORKFLOW
 from .textures import converted
 
 SURFACE = "mtlx_surface"
@@ -79,18 +80,23 @@ def build(source: Source) -> Network:
     node_id = SURFACE_IDS[("mtlx", source.model)]
     table = table_for("mtlx", source.model)
     inputs = surface_inputs(source, table, node_defaults(node_id), nodes, _live_or_baked(source))
+    if source.model in SPECULAR_WORKFLOW:
+        inputs["useSpecularWorkflow"] = ("int", 1)
     extra = [EXTRA_LOSS[source.model]] if source.model in EXTRA_LOSS else []
     if source.normal_map is not None and source.model == "disney":
         extra.append(f"{node_id} has no normal input: the normal map is not applied")
     elif source.normal_map is not None:
-        inputs["geometry_normal"] = _normal(nodes, source.normal_map)
+        inputs[NORMAL_INPUT[source.model]] = _normal(nodes, source.normal_map)
     mapped = mapped_params("mtlx", source.model)
     note = loss_note(source, node_id, mapped, "; ".join(extra))
     surface = Node(SURFACE, node_id, inputs, {"out": "token"}, {"loss": note})
     return Network("mtlx", Connection(SURFACE, "out"), [surface, *nodes])
 
 
+NORMAL_INPUT = {"pixar": "geometry_normal", "pixar_weights": "normal"}
 EXTRA_LOSS = {
+    "pixar_weights": "UsdPreviewSurface node in its specular workflow: one highlight lobe, "
+    "no transmitted lobes",
     "pixar": "OpenPBR has one specular lobe: Smits' specular and reflection share the "
     "broad lobe's roughness; no transmitted diffuse; lobe scales fold into colours only "
     "where a colour exists",

@@ -258,6 +258,17 @@ RI_PIXAR: tuple[Slot, ...] = (
     Slot("eta", "glassIor", "float", lobe="reflection_t"),
 )
 
+# A layered Pixar material blends to Smits' lobe weights, not to parameters (blend.pixar).
+# UsdPreviewSurface takes them in its specular workflow: the diffuse weight as the
+# diffuse colour, the highlight colour at normal incidence (specN + reflN) as the
+# specular colour, one roughness for both highlight lobes. The diffuse colour is written
+# even when black: the surface's default is grey.
+PREVIEW_WEIGHTS: tuple[Slot, ...] = (
+    Slot("front", "diffuseColor", "color3f"),
+    Slot("f0", "specularColor", "color3f", lobe="highlights"),
+    Slot("highlight_roughness", "roughness", "float", lobe="highlights"),
+)
+
 TABLES: dict[tuple[str, str], tuple[Slot, ...]] = {
     ("universal", "disney"): PREVIEW_DISNEY,
     ("mtlx", "disney"): MTLX_DISNEY,
@@ -265,6 +276,10 @@ TABLES: dict[tuple[str, str], tuple[Slot, ...]] = {
     ("universal", "pixar"): PREVIEW_PIXAR,
     ("mtlx", "pixar"): MTLX_PIXAR,
     ("ri", "pixar"): RI_PIXAR,
+    ("universal", "pixar_weights"): PREVIEW_WEIGHTS,
+    # MaterialX has the same surface as a node: no re-mapping of blended weights needed.
+    ("mtlx", "pixar_weights"): PREVIEW_WEIGHTS,
+    ("ri", "pixar_weights"): RI_PIXAR,
 }
 """(context, model) → the table of that target."""
 
@@ -275,6 +290,9 @@ SURFACE_IDS: dict[tuple[str, str], str] = {
     ("universal", "pixar"): "UsdPreviewSurface",
     ("mtlx", "pixar"): "ND_open_pbr_surface_surfaceshader",
     ("ri", "pixar"): "PxrSurface",
+    ("universal", "pixar_weights"): "UsdPreviewSurface",
+    ("mtlx", "pixar_weights"): "ND_UsdPreviewSurface_surfaceshader",
+    ("ri", "pixar_weights"): "PxrSurface",
 }
 """(context, model) → the surface shader's ``info:id``."""
 

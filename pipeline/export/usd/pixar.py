@@ -22,11 +22,17 @@ import math
 from typing import Any
 
 from lookdev.materials.arrays import NumpyOps
-from lookdev.materials.pixar import DIELECTRIC_REFL, PixarParams, _values, view_independent
+from lookdev.materials.pixar import (
+    DIELECTRIC_REFL,
+    PixarParams,
+    _values,
+    view_independent,
+    weights,
+)
 from lookdev.materials.pixar_lobes import power_reflection, power_specular
 
-WEIGHTS = ("front", "behind", "specN", "specG", "reflN", "reflG", "specTN", "reflTN")
-"""Derived colours a target reads (``front``/``behind``: diffuse colour either side)."""
+WEIGHTS = ("specN", "specG", "reflN", "reflG", "reflTN")
+"""Smits' view-independent weights a target reads (RGB)."""
 
 
 def ggx_roughness(power: float) -> float:
@@ -37,15 +43,21 @@ def ggx_roughness(power: float) -> float:
 
 
 def derived(params: PixarParams) -> dict[str, Any]:
-    """Smits' weights (RGB tuples) and the GGX roughness of each highlight lobe."""
+    """Smits' weights (RGB tuples) and the GGX roughness of each highlight lobe.
+
+    ``front``/``behind`` are the diffuse and transmitted-diffuse weights for a view at
+    normal incidence (diffN, diffTN): what a Lambert lobe can carry of his diffuse.
+    """
     xp = NumpyOps()
     w = view_independent(xp, _values(xp, params, {}))
     out: dict[str, Any] = {k: _rgb(w[k]) for k in WEIGHTS}
+    head_on = weights(xp, w, 1.0)  # the diffuse weights seen at normal incidence
+    out["front"], out["behind"] = _rgb(head_on["diffN"]), _rgb(head_on["diffTN"])
     r = params.roughness
     diffuse = max(w["diff_n"], w["diff_g"]) * (1.0 - r) + r  # Mix[max(dN, dG), 1, rough]
     amplitude = {
-        "diffuse": max(out["front"]) * diffuse,
-        "diffuse_t": max(out["behind"]) * diffuse,
+        "diffuse": max(_rgb(w["front"])) * diffuse,
+        "diffuse_t": max(_rgb(w["behind"])) * diffuse,
         "specular": max(out["specN"] + out["specG"]),
         "reflection": max(out["reflN"] + out["reflG"]),
         "specular_t": max(_rgb(w["specTN"]) + _rgb(w["specTG"])),
@@ -64,6 +76,61 @@ def _rgb(value: Any) -> tuple[float, float, float]:
 
     v = np.broadcast_to(np.asarray(value, dtype=np.float64).reshape(-1), (3,))
     return (float(v[0]), float(v[1]), float(v[2]))
+
+
+def cone_roughness(cone_deg: Any) -> Any:
+    """GGX roughness of a blended highlight given only its cone (degrees, ``(…)`` arrays).
+
+    A blend of layers keeps Smits' cone angles but not the roughness behind each lobe's
+    falloff, so the lobe is taken to fall to 10 % at its cone (powerR's definition):
+    p = ln 10 / sin²(cone), α = √(2/p) = sin(cone)·√(2 / ln 10), r = √α (≤ 1).
+
+    >>> round(float(cone_roughness(0.0)), 6)
+    0.0
+    """
+    import numpy as np
+
+    alpha = np.sin(np.radians(np.asarray(cone_deg, dtype=np.float64))) * math.sqrt(2 / math.log(10))
+    return np.sqrt(np.minimum(alpha, 1.0))
+
+
+def from_weights(w: dict[str, Any]) -> dict[str, Any]:
+    """Target quantities of a lobe-weight blend (:mod:`lookdev.pipeline.blend.pixar`).
+
+    ``w`` holds the blend's arrays by name (constants as arrays too). Returns the same
+    keys :func:`derived` gives for one material, plus ``f0`` (the highlight colour at
+    normal incidence, both lobes) and ``highlight_roughness`` (their energy-weighted
+    roughness) for surfaces with a single highlight lobe.
+    """
+    import numpy as np
+
+    def rgb(name: str) -> np.ndarray:
+        return np.asarray(w[name], dtype=np.float64)
+
+    out = {
+        "front": rgb("diffN"),
+        "behind": rgb("diffTN"),
+        **{k: rgb(k) for k in ("specN", "specG", "reflN", "reflG", "reflTN")},
+        "spec_roughness": cone_roughness(w["specular_cone"]),
+        "refl_roughness": cone_roughness(w["reflection_cone"]),
+    }
+    out["f0"] = out["specN"] + out["reflN"]
+    e_spec = (out["specN"] + out["specG"]).mean(axis=-1)
+    e_refl = (out["reflN"] + out["reflG"]).mean(axis=-1)
+    total = np.where(e_spec + e_refl > 0.0, e_spec + e_refl, 1.0)
+    out["highlight_roughness"] = (
+        e_spec * out["spec_roughness"] + e_refl * out["refl_roughness"]
+    ) / total
+    amplitude = {
+        "diffuse": [rgb("diffN"), rgb("diffG")],
+        "diffuse_t": [rgb("diffTN"), rgb("diffTG")],
+        "specular": [rgb("specN"), rgb("specG")],
+        "reflection": [rgb("reflN"), rgb("reflG")],
+        "specular_t": [rgb("specTN"), rgb("specTG")],
+        "reflection_t": [rgb("reflTN"), rgb("reflTG")],
+    }
+    out.update({f"amp_{k}": float(max(a.max() for a in v)) for k, v in amplitude.items()})
+    return out
 
 
 def ior_to_normal_fresnel(ior: float) -> float:

@@ -17,6 +17,7 @@ from .network import Connection, Image, Network, Node, Source, loss_note, surfac
 from .textures import converted
 
 SURFACE = "preview_surface"
+SPECULAR_WORKFLOW = ("pixar_weights",)  # models whose highlight is a colour, not metallic
 ST_READER = "preview_st"
 SHAPE_NOTES = {
     "disney": {
@@ -27,6 +28,13 @@ SHAPE_NOTES = {
         "highlights": "Smits' specular and reflection lobes become one GGX lobe",
         "diffuse": "the diffuse loses Smits' Fresnel-shaped darkening (PDiffuse)",
         "diffuse_t": "no transmitted diffuse lobe",
+    },
+    "pixar_weights": {
+        "highlights": "the blend's specular and reflection lobes become one GGX lobe with "
+        "their energy-weighted roughness and Schlick's edge, not their grazing weights",
+        "diffuse": "the diffuse is its weight at normal incidence",
+        "diffuse_t": "no transmitted diffuse lobe",
+        "transmission": "no refraction: a blend's transmitted lobes are not expressed",
     },
 }
 """model → lobe → what the surface changes about it when that lobe is live."""
@@ -52,6 +60,8 @@ def build(source: Source) -> Network:
     nodes: list[Node] = []
     table = table_for("universal", source.model)
     inputs = surface_inputs(source, table, preview_defaults(), nodes, _texture)
+    if source.model in SPECULAR_WORKFLOW:
+        inputs["useSpecularWorkflow"] = ("int", 1)
     if source.normal_map is not None:
         inputs["normal"] = _normal(nodes, source.normal_map)
     lobes = source.lobes

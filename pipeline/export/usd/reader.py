@@ -40,6 +40,8 @@ READABLE = {
     # PxrSurface and OpenPBR get Smits' derived weights, which do not invert to his
     # parameters: a Pixar material is read from its UsdPreviewSurface.
     "pixar": ("universal",),
+    # A blend of Pixar layers is lobe weights, not parameters: nothing to read back.
+    "pixar_weights": (),
 }
 
 

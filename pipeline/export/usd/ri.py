@@ -34,7 +34,7 @@ def build(source: Source) -> Network:
         )
         inputs["bumpNormal"] = ("normal3f", Connection("ri_normal_map", "resultN"))
     node_id = SURFACE_IDS[("ri", source.model)]
-    if source.model == "pixar":
+    if source.model in PXR_SURFACE_MODELS:
         inputs.update(_pixar_gains(source.lobes))
     extra = EXTRA_LOSS.get(source.model, "")
     note = loss_note(source, node_id, mapped_params("ri", source.model), extra)
@@ -49,10 +49,15 @@ PXR_SURFACE_GAINS = {
     "diffuse_t": ("diffuseTransmitGain", 0.0),
     "reflection_t": ("refractionGain", 0.0),
 }
+PIXAR_LOSS = (
+    "PxrSurface has no transmitted specular lobe (Smits' specT); the diffuse weight is "
+    "its normal-incidence colour, without Smits' view-dependent Fresnel shape"
+)
 EXTRA_LOSS = {
-    "pixar": "PxrSurface has no transmitted specular lobe (Smits' specT); the diffuse "
-    "weight is its normal-incidence colour, without Smits' view-dependent Fresnel shape",
+    "pixar": PIXAR_LOSS,
+    "pixar_weights": PIXAR_LOSS + "; a blend carries no IOR: refraction uses the default",
 }
+PXR_SURFACE_MODELS = tuple(EXTRA_LOSS)
 
 
 def _pixar_gains(lobes: dict[str, bool]) -> dict[str, tuple[str, Any]]:

@@ -16,11 +16,11 @@ import numpy as np
 
 from lookdev.materials.params import DisneyParams
 
-from .lobes import canonical
+from .lobes import DEFAULTS, canonical
 from .names import specular_to_ior
 from .network import ExportError, Image, Source, source_from_params
 
-SUPPORTED = ("disney", "pixar")
+SUPPORTED = ("disney", "pixar")  # layered Pixar: see weights_source
 
 
 def source_for(
@@ -39,7 +39,7 @@ def source_for(
             material.name, material.model, material.params, material.description
         )
     source = baked_source(material, texture_dir, resolution, scratch)
-    if not bake:
+    if not bake and source.model == "disney":  # Smits' layering is not a parameter mix
         from .live import live_stack
 
         source.layers = live_stack(material, texture_dir, resolution)
@@ -63,11 +63,7 @@ def baked_source(material: Any, texture_dir: Path, resolution: int, scratch: Pat
     blended = blend(material, resolution)
     _check_model(blended.model, material.name)
     if getattr(blended, "representation", "params") == "lobe_weights":
-        raise ExportError(
-            "layered Pixar presets blend to Smits' lobe weights, which the USD exporter "
-            "cannot write yet; export the layers' own presets",
-            where=material.name,
-        )
+        return weights_source(material, blended, texture_dir)
     files = bake(blended, scratch)
 
     def image(name: str, array: np.ndarray) -> Image:
@@ -98,3 +94,35 @@ def _constants(blended) -> dict[str, Any]:
     if "ior" in data and "specular" in data:
         del data["specular"]
     return canonical(DisneyParams.parse(data, where=blended.name))
+
+
+def weights_source(material: Any, blended, texture_dir: Path) -> Source:
+    """A Pixar blend (Smits' lobe weights): the target quantities, maps where they vary.
+
+    Derived quantities (:func:`.pixar.from_weights`) are computed on the blend's arrays
+    and written by the exporter beside the file; a quantity varies if any weight behind
+    it does. The refraction IOR is not blended (weights carry none): the default is used.
+    """
+    from .pixar import from_weights
+
+    arrays = {k: np.asarray(v) for k, v in {**blended.constants, **blended.maps}.items()}
+    values: dict[str, Any] = {"eta": DEFAULTS["pixar_weights"]["eta"]}
+    maps: dict[str, Image] = {}
+    for name, value in from_weights(arrays).items():
+        if np.ndim(value) >= 2:
+            path = texture_dir / f"{material.name}_{name}.exr"
+            maps[name] = Image(path, np.flipud(value).astype(np.float32), write=True)
+            value = value.reshape(-1, *value.shape[2:]).mean(axis=0)
+        values[name] = tuple(float(x) for x in value) if np.ndim(value) else float(value)
+    normal = None
+    if blended.normal_map is not None:  # encoded (n + 1)/2 like every normal map
+        pixels = np.flipud(0.5 * blended.normal_map + 0.5).astype(np.float32)
+        normal = Image(texture_dir / f"{material.name}_normal_map.exr", pixels, write=True)
+    return Source(
+        material.name,
+        "pixar_weights",
+        values,
+        maps=maps,
+        normal_map=normal,
+        description=material.description,
+    )

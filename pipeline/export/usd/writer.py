@@ -15,6 +15,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from pxr import Gf, Sdf
+
 from . import mtlx, preview, ri
 from .network import (
     CONTEXT_OUTPUT,
@@ -43,8 +45,6 @@ def material_spec(source: Source, contexts: tuple[str, ...]) -> MaterialSpec:
 
 
 def value_types() -> dict[str, Any]:
-    from pxr import Sdf
-
     t = Sdf.ValueTypeNames
     return {
         "float": t.Float,
@@ -64,8 +64,6 @@ def value_types() -> dict[str, Any]:
 
 def usd_value(kind: str, value: Any, base: Path) -> Any:
     """A Python value as USD stores it; asset paths relative to ``base`` (a folder)."""
-    from pxr import Gf, Sdf
-
     if kind == "asset":
         path = value.path if isinstance(value, Image) else Path(value)
         return Sdf.AssetPath(relative_asset(path, base))
@@ -88,8 +86,6 @@ def relative_asset(path: Path, base: Path) -> str:
 
 def new_layer(default_prim: str = "Materials"):
     """An empty anonymous layer with the stage metadata validators expect."""
-    from pxr import Sdf
-
     layer = Sdf.Layer.CreateAnonymous(".usda")
     layer.defaultPrim = default_prim
     layer.pseudoRoot.SetInfo("upAxis", "Y")
@@ -99,8 +95,6 @@ def new_layer(default_prim: str = "Materials"):
 
 def author(layer, specs: list[MaterialSpec], base: Path) -> list[str]:
     """Author ``specs`` under ``/Materials`` of ``layer``; returns their prim paths."""
-    from pxr import Sdf
-
     types = value_types()
     paths = []
     with Sdf.ChangeBlock():
@@ -113,8 +107,6 @@ def author(layer, specs: list[MaterialSpec], base: Path) -> list[str]:
 
 
 def _author_material(scope, spec: MaterialSpec, base: Path, types: dict[str, Any]):
-    from pxr import Sdf
-
     prim = Sdf.PrimSpec(scope, prim_name(spec.name), Sdf.SpecifierDef, "Material")
     prim.customData = {"lookdev": dict(spec.custom)}
     for net in spec.networks:
@@ -146,8 +138,6 @@ def add_switch(layer, targets: dict[str, tuple[str, str]]) -> None:
 
     ``targets`` maps a variant name to ``(asset path or "" for this layer, prim path)``.
     """
-    from pxr import Sdf
-
     with Sdf.ChangeBlock():
         look = Sdf.PrimSpec(layer.pseudoRoot, SWITCH, Sdf.SpecifierDef, "Material")
         look.customData = {"lookdev": {"switch": True}}
@@ -317,8 +307,6 @@ def _write_all(specs, images, out, mtlx_path, package, split_dir, staging) -> li
 
 
 def _write_split(specs, out: Path, folder: Path, staging: Staging) -> list[Path]:
-    from pxr import Sdf
-
     files, targets = [], {}
     library = new_layer()
     scope = Sdf.CreatePrimInLayer(library, "/Materials")
