@@ -174,7 +174,7 @@ def run(
     render: list[tuple[str, dict, int]] | None = None,
     models: dict[str, Model] | None = None,
     environment: np.ndarray | None = None,
-    progress: Callable[[str], None] = lambda task: None,
+    progress: Callable[[str, int, int], None] = lambda task, done, total: None,
 ) -> Report:
     """Measure every asked item now. ``render``/``models`` override what is discovered."""
     report = Report()
@@ -249,8 +249,8 @@ def run(
                     ),
                 )
             )
-    for name, task in tasks:
-        progress(name)
+    for done, (name, task) in enumerate(tasks):
+        progress(name, done, len(tasks))
         try:
             report.rows.extend(task())
         except Exception as exc:  # noqa: BLE001 - one broken case must not hide the rest
@@ -355,7 +355,13 @@ def command(
     start = time.perf_counter()
     with Progress(console=console, transient=True, disable=as_json) as bar:
         task = bar.add_task("measuring", total=None)
-        report = run(settings, items, progress=lambda name: bar.update(task, description=name))
+        report = run(
+            settings,
+            items,
+            progress=lambda name, done, total: bar.update(
+                task, description=name, completed=done, total=total
+            ),
+        )
     paths = write_outputs(report, settings, out_dir)
     if as_json:
         print_json({**report.to_json(settings), "outputs": {k: str(v) for k, v in paths.items()}})
