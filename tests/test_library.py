@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import doctest
+import importlib
 import json
 import os
 import tomllib
@@ -42,6 +44,13 @@ def write(folder: Path, name: str, text: str) -> Path:
 def lib(tmp_path):
     """A user library in tmp_path, searched before the built-ins."""
     return Library([tmp_path], use_env=False)
+
+
+@pytest.mark.parametrize("module", ["__init__", "errors", "preset", "material"])
+def test_doctests(module):
+    name = "lookdev.library" + ("" if module == "__init__" else f".{module}")
+    result = doctest.testmod(importlib.import_module(name))
+    assert result.attempted and not result.failed
 
 
 # -- the built-in library ---------------------------------------------------------------
