@@ -23,7 +23,15 @@ from . import store
 from .errors import LibraryError, PresetError, PresetNotFoundError, did_you_mean
 from .index import SUFFIX, Header, scan_folder
 from .material import Material, resolve
-from .preset import METADATA, PresetFile, build_preset, check_name, dump_preset, parse_preset
+from .preset import (
+    METADATA,
+    PresetFile,
+    build_preset,
+    check_name,
+    dump_preset,
+    parse_preset,
+    preset_document,
+)
 
 ENV_PATH = "LOOKDEV_LIBRARY_PATH"
 BUILTIN_OTHER_DATA = ("ibl",)
@@ -253,8 +261,7 @@ def apply_changes(preset: PresetFile, changes: dict[str, Any], *, where: str) ->
 
     A value of ``None`` removes the key (a parameter is then inherited again).
     """
-    data = preset.model_dump(mode="json", exclude_defaults=True)
-    data["name"] = preset.name
+    data = preset_document(preset)
     params = dict(preset.params)
     for key, value in changes.items():
         if key in ("name", "model", "layers"):
@@ -293,4 +300,4 @@ def _layer_refs(path: Path, name: str) -> bool:
         preset = read_preset(path)
     except PresetError:
         return False
-    return any(getattr(layer, "preset", None) == name for layer in preset.layers)
+    return any(layer.preset == name for layer in preset.layers)

@@ -206,12 +206,20 @@ def dump_preset(preset: PresetFile) -> str:
     roughness = 0.3
     <BLANKLINE>
     """
+    return _compact_arrays(tomli_w.dumps(preset_document(preset)))
+
+
+def preset_document(preset: PresetFile) -> dict[str, Any]:
+    """The preset as the TOML table it is written as (ordered, no empty fields).
+
+    >>> preset_document(PresetFile(name="a", extends="gold"))
+    {'name': 'a', 'extends': 'gold'}
+    """
     data = preset.model_dump(mode="json", exclude_none=True, exclude_defaults=True)
     data["name"] = preset.name
     if preset.layers:
         data["layers"] = [_layer_doc(layer) for layer in preset.layers]
-    ordered = {k: data[k] for k in PresetFile.model_fields if k in data}
-    return _compact_arrays(tomli_w.dumps(ordered))
+    return {k: data[k] for k in PresetFile.model_fields if k in data}
 
 
 def _layer_doc(layer: LayerSpec) -> dict[str, Any]:

@@ -355,6 +355,14 @@ def test_builtin_is_read_only_and_unwritable_folders_fail_cleanly(tmp_path):
         lib.save(PresetFile(name="x", extends="gold"), folder=blocker / "lib")
 
 
+def test_update_keeps_layers_and_their_masks(lib, tmp_path):
+    text = builtin_folder().joinpath("layered", "dust_over_plastic.toml").read_bytes()
+    lib.save(parse_preset(text, where="x").model_copy(update={"name": "dusty"}))
+    lib.update("dusty", {"description": "Mine."})
+    m = lib.load("dusty")
+    assert m.description == "Mine." and m.layers == BUILTIN.load("dust_over_plastic").layers
+
+
 def test_update_and_remove(lib, tmp_path):
     lib.save(PresetFile(name="mine", extends="gold"))
     lib.update("mine", {"roughness": 0.7, "tags": ["worn"]})
