@@ -14,6 +14,10 @@ Lobes at a view ωo and light ωi (both as BRDFs, i.e. Smits' lobes / π):
 * transmitted twins on the far side: Lambertian for diffuse, and for the highlights the
   view refracted by the IOR and reflected to the back side (:func:`.pixar_lobes.back_view`).
   Like Smits, no change of cone angle with the IOR and no total internal reflection.
+  Smits does not say at which angle the transmitted highlights blend their N/G weights;
+  we take the view's incidence on the front, where the light crosses the interface, so
+  the twelve weights partition energy at every incidence (blending by the back-side
+  half vector let a white glass reflect 1.8 at grazing: found by ``lookdev check``).
 
 The surface is two-sided: seen from below, the roles of the sides swap.
 

@@ -53,9 +53,10 @@ def test_integrated_lambda_against_scipy_double_integral():
     mu, r = 0.3, 0.4
     s = math.sqrt(1 - mu * mu)
 
-    def integrand(phi, t):
+    def integrand(phi, t):  # eq. 2 written out again, in plain floats
         c = s * math.sin(t) * math.cos(phi) + mu * math.cos(t)
-        return max(c, 0.0) * float(sheen.D(math.cos(t), r)) * math.sin(t)
+        d = (2 + 1 / r) * math.sin(t) ** (1 / r) / (2 * math.pi)
+        return max(c, 0.0) * d * math.sin(t)
 
     value, _ = integrate.dblquad(integrand, 0, math.pi / 2, 0, 2 * math.pi, epsabs=1e-9)
     assert sheen_fit.lambda_integrated(mu, r)[0] == pytest.approx(value / mu - 1.0, rel=1e-6)
@@ -179,7 +180,7 @@ def test_albedo_table_against_monte_carlo():
 def _layered_albedo(r: float, mu_o: float, soften: bool, n: int = 96) -> float:
     """∫ [f_sheen + base_scale · 1/π] cos θi dωi over a white Lambertian base."""
     xp = NumpyOps()
-    x, w = np.polynomial.legendre.leggauss(n)
+    x, w = sheen_fit.gauss_legendre(n)
     s, ws = 0.5 * (x + 1), 0.5 * w
     mu, wmu = s * s, ws * 2 * s
     phi = (np.arange(n) + 0.5) * (math.pi / n)

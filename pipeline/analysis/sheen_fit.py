@@ -7,7 +7,8 @@
       1 + Λ(ωo) = (1 / cos θo) ∫ ⟨ωo·m⟩ D(m) dm.
 
   The azimuthal integral of the clamped cosine is closed-form, so only θm is left to
-  quadrature, split where ⟨ωo·m⟩ starts to clip (θm = 90° − θo).
+  quadrature, split where ⟨ωo·m⟩ starts to clip (θm = 90° − θo); 128 Gauss-Legendre
+  nodes per piece agree with 1600 to 1.3e-10 relative over cos θ ∈ [0.01, 1], r = 0.08, 1.
 * :func:`lambda_fit_error` compares Conty-Kulla's fitted Λ (eq. 3, Table 1) against it.
 * :func:`albedo_integrated` is the lobe's directional albedo by product quadrature, the
   reference for the shipped albedo table; :func:`build_albedo_table`,
@@ -17,6 +18,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,6 +28,12 @@ import numpy as np
 
 from lookdev.materials import sheen
 from lookdev.materials.arrays import NumpyOps
+
+
+@functools.cache
+def gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes and weights on [−1, 1], computed once per n (an eigenproblem of size n)."""
+    return np.polynomial.legendre.leggauss(n)
 
 
 def _clamped_cosine_azimuthal(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -39,10 +47,10 @@ def _clamped_cosine_azimuthal(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.where(b >= a, 2.0 * math.pi * b, 2.0 * (a * np.sin(phi0) + b * phi0))
 
 
-def lambda_integrated(cos_theta: Any, r: float, n: int = 400) -> np.ndarray:
+def lambda_integrated(cos_theta: Any, r: float, n: int = 128) -> np.ndarray:
     """Λ(θ) of eq. 2's distribution by the projected-area integral (Heitz 2014)."""
     mu = np.atleast_1d(np.asarray(cos_theta, dtype=np.float64))
-    x, w = np.polynomial.legendre.leggauss(n)
+    x, w = gauss_legendre(n)
     sin_o = np.sqrt(np.maximum(0.0, 1.0 - mu * mu))
     split = np.arcsin(np.clip(mu, 0.0, 1.0))  # = 90° − θo
     total = np.zeros_like(mu)
@@ -84,7 +92,7 @@ def _worst(err_abs: np.ndarray, err_rel: np.ndarray, mu: np.ndarray, r: np.ndarr
     )
 
 
-def lambda_fit_error(cos_theta: Any = None, roughness: Any = None, *, n: int = 400) -> FitError:
+def lambda_fit_error(cos_theta: Any = None, roughness: Any = None, *, n: int = 128) -> FitError:
     """Conty-Kulla's fitted Λ against :func:`lambda_integrated` over θ × r.
 
     Defaults: cos θ from 0.01 (the fit is finite at 0, where Λ is not) to 1, r from
@@ -108,7 +116,7 @@ def albedo_integrated(cos_theta: Any, r: float, *, n: int = 96, soften: bool = T
     even in φ, so [0, π] is doubled.
     """
     mu_o = np.atleast_1d(np.asarray(cos_theta, dtype=np.float64))
-    x, w = np.polynomial.legendre.leggauss(n)
+    x, w = gauss_legendre(n)
     s, ws = 0.5 * (x + 1.0), 0.5 * w
     mu, wmu = s * s, ws * 2.0 * s
     phi = (np.arange(n) + 0.5) * (math.pi / n)
