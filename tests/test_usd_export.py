@@ -264,3 +264,50 @@ def test_layered_pixar_exports_its_lobe_weights(tmp_path):
     assert preview.GetAttribute("inputs:specularColor").Get()[0] == pytest.approx(0.9)
     ri = stage.GetPrimAtPath("/Materials/stack/ri_surface")
     assert ri.GetAttribute("inputs:diffuseGain").Get() == 0.0
+
+
+def _write_exr(path: Path, pixels) -> Path:
+    from lookdev.pipeline.export.usd.textures import write_image
+
+    write_image(path, pixels)
+    return path
+
+
+def test_texture_mask_and_normal_map_live(tmp_path):
+    """A texture mask is referenced where it is (relative path), not copied; the normal
+    map goes through UsdUVTexture's (2, -1) scale/bias, which the validator checks."""
+    import numpy as np
+
+    src = tmp_path / "src"
+    src.mkdir()
+    ramp = np.tile(np.linspace(0.0, 1.0, 8, dtype=np.float32), (8, 1))
+    _write_exr(src / "mask.exr", ramp)
+    bumps = np.dstack([0.5 + 0.2 * ramp, np.full_like(ramp, 0.5), np.full_like(ramp, 0.9)])
+    _write_exr(src / "bumps.exr", bumps)
+    (src / "scuffed.toml").write_text(
+        'name = "scuffed"\nmodel = "layered"\n'
+        '[[layers]]\npreset = "plastic_glossy"\n'
+        '[[layers]]\npreset = "rubber"\n'
+        'mask = { kind = "texture", path = "mask.exr" }\n'
+        'normal_map = { kind = "texture", path = "bumps.exr" }\n'
+    )
+    lib = Library([src], use_env=False)
+    out_dir = tmp_path / "out"
+    out_dir.mkdir()
+    scratch = tmp_path / "scratch"
+    scratch.mkdir()
+    source = source_for(
+        load_material("scuffed", lib), out_dir / "tex", 8, scratch=scratch, bake=False
+    )
+    export_usd([source], out_dir / "s.usda")
+    report = validate_usd(out_dir / "s.usda")
+    assert report.ok, report.errors
+    stage = Usd.Stage.Open(str(out_dir / "s.usda"))
+    mask = stage.GetPrimAtPath("/Materials/scuffed/mtlx_mask_1").GetAttribute("inputs:file")
+    assert mask.Get().path == "../src/mask.exr"
+    normal = stage.GetPrimAtPath("/Materials/scuffed/preview_normal_map")
+    assert tuple(normal.GetAttribute("inputs:scale").Get()) == (2.0, 2.0, 2.0, 1.0)
+    assert tuple(normal.GetAttribute("inputs:bias").Get()) == (-1.0, -1.0, -1.0, 0.0)
+    assert normal.GetAttribute("inputs:sourceColorSpace").Get() == "raw"
+    loss = stage.GetPrimAtPath("/Materials/scuffed/mtlx_surface").GetCustomDataByKey("lookdev:loss")
+    assert "no normal input" in loss

@@ -4,11 +4,11 @@
 material's lobe weights follow Burley 2012 §5 and Schutte 2018 §3: the dielectric part
 is weighted ``1 - metallic``; sheen and subsurface sit on the diffuse, which is further
 weighted ``1 - spec_trans``; ``diff_trans`` and ``flatness`` exist only on thin surfaces.
-A parameter of a dead lobe has no effect, so it is neither written nor compared. Weights
-are judged as USD stores them (float32).
+Smits' six lobes (Pixar) live where his weights are not zero (:mod:`.pixar`). A parameter
+of a dead lobe has no effect, so it is neither written nor compared. Weights are judged as
+USD stores them (float32).
 
 >>> from lookdev.materials.params import DisneyParams
-from lookdev.materials.pixar import PixarParams
 >>> on = active_lobes(canonical(DisneyParams(metallic=1.0, sheen=0.5)))
 >>> on["sheen"], on["dielectric"]
 (False, False)

@@ -112,6 +112,7 @@ class Source:
     spelling: str = "specular"
     description: str = ""
     layers: list[Any] = field(default_factory=list)  # live.LiveLayer, bottom first
+    notes: list[str] = field(default_factory=list)  # losses every context shares
 
     @property
     def lobes(self) -> dict[str, bool]:
@@ -188,7 +189,7 @@ def loss_note(source: Source, context: str, mapped: set[str], extra: str = "") -
         parts.append(f"{context} cannot express {shown}")
     if extra:
         parts.append(extra)
-    return "; ".join(parts)
+    return "; ".join(parts + source.notes)
 
 
 def same_or_eq(a: Any, b: Any) -> bool:

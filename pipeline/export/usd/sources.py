@@ -82,7 +82,15 @@ def baked_source(material: Any, texture_dir: Path, resolution: int, scratch: Pat
         normal_map=normal,
         spelling="specular",
         description=material.description,
+        notes=_specular_normal_note(blended),
     )
+
+
+def _specular_normal_note(blended) -> list[str]:
+    """No target has Burley's separate specular normal (§6): say so where a blend has one."""
+    if getattr(blended, "specular_normal_map", None) is None:
+        return []
+    return ["the specular normal map (Burley §6) is not written: no surface has a second normal"]
 
 
 def _constants(blended) -> dict[str, Any]:
@@ -125,4 +133,5 @@ def weights_source(material: Any, blended, texture_dir: Path) -> Source:
         maps=maps,
         normal_map=normal,
         description=material.description,
+        notes=_specular_normal_note(blended),
     )
