@@ -97,7 +97,8 @@ def test_check_json_reports_every_built_model(cli):
     assert {"sheen", "pixar"} <= set(data["models"])
     for name, m in data["models"].items():
         assert m["cases"] > 10_000, name
-        assert (m["nan"], m["inf"], m["negative"], m["energy_gain"]) == (0, 0, 0, 0), m["worst"]
+        found = (m["exception"], m["nan"], m["inf"], m["negative"], m["energy_gain"])
+        assert found == (0, 0, 0, 0, 0), m["worst"]
         assert m["worst"]["kind"] == "max_albedo"
         assert m["worst"]["value"] <= 1.0 + m["allowance"] + 0.05
     print(f"\nlookdev check --json: {data['seconds']} s")
@@ -120,6 +121,16 @@ def test_check_exits_1_when_a_model_fails(cli, broken_registered):
     assert data["worst"]["kind"] == "nan"
     human = cli("check", "--model", "broken")
     assert human.code == 1 and "FAILED" in human.out and "worst: nan" in human.out
+
+
+def test_a_model_that_raises_is_reported_not_fatal():
+    def explode(xp, prepared, wi, wo):
+        raise ZeroDivisionError("boom")
+
+    model = Model("explodes", LambertParams, _prepare, explode, _pdf, _sample)
+    report = stability.check_model("explodes", model)
+    assert report.failed and report.counts["exception"] > 0
+    assert report.worst.kind == "exception" and "ZeroDivisionError: boom" in report.worst.case
 
 
 def test_unknown_model_is_one_line_and_exit_2(cli):

@@ -16,10 +16,11 @@ float32 and float64:
 * **maps** — once more with every float and colour field given per element (mixing its
   extremes), the array code path that textures take.
 
-It counts queries whose output (f, pdf, sampled direction, weight) holds a NaN, an
-infinity or a negative value, and directional albedos (the model's own importance
-sampler, 2048 stratified samples per view at θo = 0, 45, 60, 75, 89, 89.99°, every colour
-white: a furnace) that exceed 1 + the model's allowance by more than four standard errors.
+It counts cases where the model raised (a finding, not a stop), queries whose output
+(f, pdf, sampled direction, weight) holds a NaN, an infinity or a negative value, and
+directional albedos (the model's own importance sampler, 2048 stratified samples per view
+at θo = 0, 45, 60, 75, 89, 89.99°, every colour white: a furnace) that exceed 1 + the
+model's allowance by more than four standard errors.
 
 Allowances: the Conty-Kulla lobe and Smits' model conserve energy by construction (sheen
 0.002: its albedo table's measured interpolation error; pixar 0). The Disney BRDF adds
@@ -192,7 +193,7 @@ def uniforms() -> np.ndarray:
 
 
 # -- findings ------------------------------------------------------------------------------
-KINDS = ("nan", "inf", "negative", "energy_gain")
+KINDS = ("exception", "nan", "inf", "negative", "energy_gain")
 
 
 @dataclass
@@ -226,7 +227,7 @@ class ModelReport:
 
     @property
     def worst(self) -> Finding | None:
-        """The most severe failure (NaN, then ∞, negative, energy), else the top albedo."""
+        """The most severe failure (a crash, NaN, ∞, negative, energy), else the top albedo."""
         for kind in KINDS:
             if kind in self.failures:
                 return self.failures[kind]
@@ -379,17 +380,19 @@ def check_model(
     for dtype in DTYPES:
         report.by_dtype[np.dtype(dtype).name] = dict.fromkeys(KINDS, 0)
         report.cases_by_dtype[np.dtype(dtype).name] = 0
-    for label, params in parameter_cases(model.params_type):
+    cases = [(label, params, False) for label, params in parameter_cases(model.params_type)]
+    for label, params, with_maps in [*cases, (MAPS_LABEL, model.params_type(), True)]:
         progress(label)
         for dtype in DTYPES:
-            with np.errstate(all="ignore"):
-                _sweep_queries(report, model, label, params, dtype)
-                if _plausible(params):
-                    _sweep_energy(report, model, label, params, dtype)
-    progress(MAPS_LABEL)
-    for dtype in DTYPES:
-        with np.errstate(all="ignore"):
-            _sweep_queries(report, model, MAPS_LABEL, model.params_type(), dtype, with_maps=True)
+            try:
+                with np.errstate(all="ignore"):
+                    _sweep_queries(report, model, label, params, dtype, with_maps)
+                    if _plausible(params) and not with_maps:
+                        _sweep_energy(report, model, label, params, dtype)
+            except Exception as exc:  # noqa: BLE001 — a crashing model is a finding, not a stop
+                name_ = np.dtype(dtype).name
+                case = f"{label}; {name_}: {type(exc).__name__}: {exc}"
+                report._count(name_, "exception", 1, Finding("exception", case))
     return report
 
 

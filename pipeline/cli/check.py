@@ -12,7 +12,7 @@ from lookdev.pipeline.analysis import stability
 
 from .common import console, err_console, print_json, table
 
-COLUMNS = ["precision", "cases", "NaN", "inf", "negative", "energy gain"]
+COLUMNS = ["precision", "cases", "raised", "NaN", "inf", "negative", "energy gain"]
 
 
 _MODEL_HELP = f"Only this model (repeatable): {', '.join(stability.MODEL_MODULES)}."
