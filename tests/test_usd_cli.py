@@ -69,7 +69,6 @@ def test_layered_export_writes_textures_beside_the_file(cli, tmp_path):
 def test_package_and_split(cli, tmp_path):
     assert cli("export", "usd", "rusty_iron", "-o", str(tmp_path / "r.usdz"), *MAPS).code == 0
     assert _files(tmp_path) == ["r.usdz"]
-    (tmp_path / "parts").mkdir()
     result = cli(
         "export",
         "usd",
@@ -82,6 +81,28 @@ def test_package_and_split(cli, tmp_path):
     )
     assert result.code == 0, result.err
     assert _files(tmp_path / "parts") == ["gold.usda", "iron.usda"]
+    again = cli(
+        "export",
+        "usd",
+        "gold",
+        "-o",
+        str(tmp_path / "lib.usda"),
+        "--split",
+        str(tmp_path / "parts"),
+    )  # an existing folder is fine; files are replaced
+    assert again.code == 0, again.err
+    line = _one_line_error(
+        cli(
+            "export",
+            "usd",
+            "gold",
+            "-o",
+            str(tmp_path / "x.usda"),
+            "--split",
+            str(tmp_path / "r.usdz"),
+        )
+    )
+    assert "--split takes a folder" in line
     assert cli("validate", "usd", str(tmp_path / "lib.usda")).code == 0
 
 

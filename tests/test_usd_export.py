@@ -178,8 +178,7 @@ def test_split_library_references_one_file_per_material(tmp_path):
         source_from_params(n, "disney", DisneyParams(roughness=r))
         for n, r in (("a", 0.1), ("b-2", 0.9))
     ]
-    (tmp_path / "parts").mkdir()
-    out = tmp_path / "library.usda"
+    out = tmp_path / "library.usda"  # the --split folder is created
     result = export_usd(sources, out, split_dir=tmp_path / "parts")
     assert {p.name for p in (tmp_path / "parts").iterdir()} == {"a.usda", "b_2.usda"}
     assert set(result.files) == {out, tmp_path / "parts/a.usda", tmp_path / "parts/b_2.usda"}

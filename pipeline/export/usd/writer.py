@@ -196,6 +196,16 @@ def check_writable(path: Path) -> None:
         raise ExportError("is a folder; give a file name", where=str(path))
 
 
+def check_folder(folder: Path) -> None:
+    """A folder to write into: existing, or creatable in an existing, writable parent."""
+    if folder.is_dir():
+        check_writable(folder / "x.usda")
+    elif folder.exists():
+        raise ExportError("is a file; --split takes a folder", where=str(folder))
+    else:
+        check_writable(folder)
+
+
 def images_of(specs: list[MaterialSpec]) -> list[Image]:
     """Every image the networks reference, once each."""
     seen: dict[Path, Image] = {}
@@ -246,9 +256,11 @@ def export_usd(
     if out.suffix not in (*USD_SUFFIXES, ".usdz"):
         raise ExportError("not a USD file name; use .usda, .usdc, .usd or .usdz", where=str(out))
     out = out.with_suffix(".usdz") if package else out
-    for path in (out, mtlx_path, split_dir and split_dir / "x.usda"):
+    for path in (out, mtlx_path):
         if path is not None:
             check_writable(Path(path))
+    if split_dir is not None:
+        check_folder(Path(split_dir))
     specs = [material_spec(s, contexts) for s in sources]
     _check_names(specs, out)
     images = images_of(specs)
@@ -288,6 +300,7 @@ def _write_all(specs, images, out, mtlx_path, package, split_dir, staging) -> li
                 write_image(target, image.pixels)
     files = [out, *(i.path for i in images if i.write and not package)]
     if split_dir is not None:
+        staging.folder(Path(split_dir))
         files += _write_split(specs, out, Path(split_dir), staging)
     else:
         layer = new_layer()
