@@ -260,35 +260,62 @@ def run(
 
 
 # -- output ----------------------------------------------------------------------------
+MARKERS = {
+    "quadrature": "o",
+    "monte carlo": "s",
+    "table": "*",
+    "fit (eq. 3)": "^",
+    "integral": "D",
+    "path tracer": "o",
+    "float32": "v",
+}
+
+
 def plot_error_vs_time(report: Report, path: Path) -> Path:
-    """Log-log error against seconds per call, one panel per item, one line per case."""
+    """Log-log error against seconds per call: a panel per item, a colour per case, a
+    marker per method, each legend beside its panel."""
+    from matplotlib.lines import Line2D
+
     from .plots import plt, save_figure
 
-    items = [i for i in ITEMS if any(r.item == i for r in report.rows)]
+    items = [i for i in ITEMS if any(r.item == i and r.error > 0 for r in report.rows)]
+    rows_n = max(1, (len(items) + 1) // 2)
     fig, axes = plt.subplots(
-        1,
-        max(len(items), 1),
-        figsize=(4.2 * max(len(items), 1), 3.8),
-        layout="constrained",
-        squeeze=False,
+        rows_n, 2, figsize=(15, 5 * rows_n), layout="constrained", squeeze=False
     )
-    for ax, item in zip(axes[0], items, strict=False):
-        rows = [r for r in report.rows if r.item == item]
-        for key in dict.fromkeys((r.case, r.method) for r in rows):
-            pts = [r for r in rows if (r.case, r.method) == key and r.error > 0]
-            if pts:
-                ax.loglog(
-                    [r.seconds for r in pts],
-                    [r.error for r in pts],
-                    "o-",
-                    ms=3,
-                    label=f"{key[0]}: {key[1]}",
-                )
-        ax.set_title(item)
+    for ax in axes.flat[len(items) :]:
+        ax.set_axis_off()
+    for ax, item in zip(axes.flat, items, strict=False):
+        rows = [r for r in report.rows if r.item == item and r.error > 0]
+        cases = list(dict.fromkeys(r.case for r in rows))
+        colours = plt.get_cmap("tab20")(np.linspace(0, 1, max(len(cases), 2)))
+        for case, method in dict.fromkeys((r.case, r.method) for r in rows):
+            pts = [r for r in rows if (r.case, r.method) == (case, method)]
+            ax.loglog(
+                [r.seconds for r in pts],
+                [r.error for r in pts],
+                "-",
+                marker=MARKERS.get(method, "o"),
+                ms=4,
+                lw=1,
+                color=colours[cases.index(case)],
+            )
+        handles = [Line2D([], [], color=colours[i], lw=2, label=c) for i, c in enumerate(cases)]
+        methods = dict.fromkeys(r.method for r in rows)
+        handles += [
+            Line2D([], [], color="k", ls="", marker=MARKERS.get(m, "o"), label=m) for m in methods
+        ]
+        ax.legend(
+            handles=handles,
+            fontsize="x-small",
+            loc="upper left",
+            bbox_to_anchor=(1.01, 1.0),
+            borderaxespad=0,
+        )
+        ax.set_title(f"{item}: {ERROR_NAMES[item]}")
         ax.set_xlabel("seconds per call")
         ax.set_ylabel(ERROR_NAMES[item])
         ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize="xx-small")
     return save_figure(fig, path)
 
 
