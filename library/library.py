@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 import lookdev.presets
+from lookdev.materials.errors import LookdevError
 
 from . import store
 from .errors import LibraryError, PresetError, PresetNotFoundError, did_you_mean
@@ -224,6 +225,53 @@ class Library:
                 out.append(h.name)
         return out
 
+    # -- checking ----------------------------------------------------------------------
+
+    def files_under(self, paths: Iterable[Path]) -> list[Path]:
+        """Preset files named by ``paths``: files as given, folders walked as libraries are."""
+        out: list[Path] = []
+        for p in paths:
+            if p.is_dir():
+                skip = (
+                    BUILTIN_OTHER_DATA
+                    if self.builtin and p.resolve() == self.builtin.resolve()
+                    else ()
+                )
+                out += [h.path for h in scan_folder(p, cache=False, skip=skip)]
+            elif p.exists():
+                out.append(p)
+            else:
+                raise PresetError("no such file or folder", where=str(p))
+        return out
+
+    def validate(self, files: Iterable[Path] | None = None) -> list[tuple[Path, str | None]]:
+        """Each file (default: every one on the path) with its one-line problem, or None.
+
+        A file is valid when it parses, resolves, and is not hidden by another file of
+        the same name in its own library (which would make it dead).
+        """
+        hidden = self._hidden_in_own_library()
+        return [
+            (f, hidden.get(f) or self._problem(f))
+            for f in files or [h.path for h in self.headers()]
+        ]
+
+    def _hidden_in_own_library(self) -> dict[Path, str]:
+        first: dict[tuple[str, str], Header] = {}
+        out = {}
+        for h in self.headers():
+            winner = first.setdefault((h.library, h.name), h)
+            if winner is not h:
+                out[h.path] = f"{h.file}: {h.name!r} is also defined by {winner.file}, which wins"
+        return out
+
+    def _problem(self, path: Path) -> str | None:
+        try:
+            self.load_file(path)
+        except LookdevError as exc:
+            return str(exc)
+        return None
+
     def _write(self, preset: PresetFile, path: Path) -> None:
         """Check that ``preset`` resolves in place at ``path``, then write it atomically."""
         resolve(preset.name, self._lookup_with(preset, path))
@@ -277,6 +325,14 @@ def apply_changes(preset: PresetFile, changes: dict[str, Any], *, where: str) ->
             bucket[field] = value
     data["params"] = params
     return build_preset(data, where=where)
+
+
+def set_by(material: Material) -> dict[str, Path]:
+    """For each parameter a file of the extends chain gives: the file that wins (the child's)."""
+    out: dict[str, Path] = {}
+    for path in material.chain:
+        out |= {key: path for key in read_preset(path).params if key not in out}
+    return out
 
 
 def _with_model(h: Header, winners: dict[str, Header]) -> Header:

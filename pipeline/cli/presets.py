@@ -13,10 +13,9 @@ from rich.table import Table
 
 from lookdev.library import Library, Material, PresetError, read_preset
 from lookdev.library.index import Header
-from lookdev.library.library import apply_changes
-from lookdev.library.preset import PresetFile, check_name, parse_value
+from lookdev.library.library import apply_changes, set_by
+from lookdev.library.preset import PresetFile, check_name, parse_value, preset_document
 from lookdev.library.schema import preset_schema
-from lookdev.materials.errors import LookdevError
 from lookdev.materials.layers import children
 
 from .common import console, err_console, print_json, table
@@ -134,7 +133,7 @@ def show(
             "file": str(path),
             "shadows": [str(p) for p in others],
         }
-        doc["preset"] = preset.model_dump(mode="json", exclude_defaults=True)
+        doc["preset"] = preset_document(preset)
         if material is not None:
             doc["resolved"] = _material_json(material)
         print_json(doc)
@@ -242,9 +241,7 @@ def validate(
     """
     # Folders named here join the search path, so their presets' parents are found.
     lib = Library([*[p if p.is_dir() else p.parent for p in paths or []], *(library or [])])
-    files = _files(paths) if paths else [h.path for h in lib.headers()]
-    hidden = _hidden_in_own_library(lib)
-    results = [(f, hidden.get(f) or _problem(lib, f)) for f in files]
+    results = lib.validate(lib.files_under(paths) if paths else None)
     bad = [(f, e) for f, e in results if e]
     if as_json:
         print_json([{"file": str(f), "ok": e is None, "error": e} for f, e in results])
@@ -252,7 +249,7 @@ def validate(
         for _, e in bad:
             err_console.print(f"lookdev: error: {e}", markup=False, highlight=False, soft_wrap=True)
         console.print(
-            f"{len(files) - len(bad)} of {len(files)} preset files valid", highlight=False
+            f"{len(results) - len(bad)} of {len(results)} preset files valid", highlight=False
         )
     if bad:
         raise typer.Exit(2)
@@ -360,7 +357,11 @@ def _material_json(m: Material) -> dict[str, Any]:
 
 def _print_resolved(m: Material) -> None:
     if m.params is not None:
-        rows = [[k, _value(v), _set_by(m, k)] for k, v in m.params.model_dump().items()]
+        origin = {k: p.name for k, p in set_by(m).items()}
+        values = m.params.model_dump()
+        if getattr(m.params, "uses_ior", False):  # Disney: one parameter, two spellings
+            values["specular"], origin["specular"] = m.params.effective_specular, "(from ior)"
+        rows = [[k, _value(v), origin.get(k, "default")] for k, v in values.items()]
         console.print(
             table(f"{m.name} ({m.model}, resolved)", ["parameter", "value", "set by"], rows)
         )
@@ -385,14 +386,6 @@ def _print_resolved(m: Material) -> None:
     )
 
 
-def _set_by(m: Material, key: str) -> str:
-    """The first file of the extends chain (child first) that gives ``key``, or 'default'."""
-    for path in m.chain:
-        if key in read_preset(path).params:
-            return path.name
-    return "default"
-
-
 def _value(v: Any) -> str:
     if isinstance(v, tuple | list):
         return "[" + ", ".join(f"{x:.4g}" for x in v) + "]"
@@ -408,41 +401,6 @@ def _mask_text(mask: Any) -> str:
         fields["path"] = Path(fields["path"]).name
     args = [_mask_text(c) for c in children(mask)] + [f"{k}={v}" for k, v in fields.items()]
     return f"{mask.kind}({', '.join(args)})"
-
-
-def _files(paths: list[Path]) -> list[Path]:
-    out: list[Path] = []
-    for p in paths:
-        if p.is_dir():
-            out += sorted(
-                f
-                for f in p.rglob("*.toml")
-                if not any(part.startswith(".") for part in f.relative_to(p).parts)
-            )
-        elif p.exists():
-            out.append(p)
-        else:
-            raise PresetError("no such file or folder", where=str(p))
-    return out
-
-
-def _hidden_in_own_library(lib: Library) -> dict[Path, str]:
-    """Files that lose their name to another file of the same library: never used."""
-    first: dict[tuple[str, str], Header] = {}
-    out = {}
-    for h in lib.headers():
-        winner = first.setdefault((h.library, h.name), h)
-        if winner is not h:
-            out[h.path] = f"{h.file}: {h.name!r} is also defined by {winner.file}, which wins"
-    return out
-
-
-def _problem(lib: Library, path: Path) -> str | None:
-    try:
-        lib.load_file(path)
-    except LookdevError as exc:
-        return str(exc)
-    return None
 
 
 def _report(verb: str, name: str, path: Path, as_json: bool) -> None:
