@@ -6,6 +6,7 @@ models.
 
 from __future__ import annotations
 
+import gc
 import math
 
 import numpy as np
@@ -203,6 +204,13 @@ CASES = [
         "disney-ck-sheen",
         0.25,
     ),
+    # Pixar: "α" here is the reflection cone's half-angle in radians (10·r degrees).
+    ("pixar", {"roughness": 0.0}, "pixar-r0", math.radians(0.5)),
+    ("pixar", {"roughness": 0.3}, "pixar-r0.3", math.radians(3.0)),
+    ("pixar", {"roughness": 1.0}, "pixar-r1", None),
+    ("pixar", {"metallic": 1.0, "roughness": 0.4}, "pixar-metal", math.radians(4.0)),
+    ("pixar", {"clear": 1.0, "roughness": 0.6, "ior": 1.5}, "pixar-clear", math.radians(6.0)),
+    ("pixar", {"back": 1.0, "roughness": 0.8}, "pixar-back", None),
 ]
 # Views: normal incidence, 60°, nearly grazing (85°), and from below for transmitters.
 VIEWS = {
@@ -211,13 +219,31 @@ VIEWS = {
     "85deg": (math.sin(math.radians(85)), 0.0, math.cos(math.radians(85))),
     "below": (0.3, 0.2, -0.93),
 }
-GLOBAL_MIN_ALPHA = 0.05  # narrower peaks need the zoomed chart (tests/_mitsuba_chi2.py)
-# float32: microfacet.sample_gtr takes sin θh as sqrt(1 − cos²θh), which at α = 1e-3 is
-# quantised to a few per cent near the peak (measured: 0.000977 vs 0.000998 at ξ = 0.05).
-GTR1_FLOAT32 = pytest.mark.xfail(
-    reason="GTR1 sampling loses sin θh to float32 at α = 1e-3 (materials/microfacet.py)",
-    strict=True,
-)
+GLOBAL_MIN_ALPHA = 0.1  # narrower peaks need the zoomed chart (tests/_mitsuba_chi2.py)
+# Dr.Jit's backend evaluates both branches of a select on Python floats, and its expm1
+# then divides by log(1) = 0: Pixar's weightS at roughness 0 (a constant) raises.
+EXPM1_OF_FLOATS = "arrays.DrJitOps.expm1 divides by zero on Python floats near 0"
+
+
+def _known_failure(name, check):
+    """Run ``check``; a known model-side failure ends as xfail with its BSDFs released.
+
+    Mitsuba traces every live BSDF instance in a render's virtual calls, so one that
+    raises while traced must not outlive its test (a failing test's traceback would keep
+    it alive and break every later render).
+    """
+    if name != "pixar-r0":
+        return check()
+    try:
+        check()
+    except ZeroDivisionError:
+        raised = True
+    else:
+        raised = False
+    gc.collect()
+    if raised:
+        pytest.xfail(EXPM1_OF_FLOATS)
+    pytest.fail(f"{name} passes now: remove it from the known failures")
 
 
 def _case_params(model_name, values):
@@ -240,7 +266,7 @@ def _plugin(mi, params):
 
 
 def _views(values):
-    transmits = values.get("spec_trans") or values.get("diff_trans")
+    transmits = any(values.get(k) for k in ("spec_trans", "diff_trans", "clear", "back"))
     return [v for v in VIEWS if v != "below" or transmits]
 
 
@@ -264,20 +290,14 @@ GLOBAL_CASES = [
     if alpha is None or alpha >= GLOBAL_MIN_ALPHA
 ]
 PEAK_CASES = [
-    pytest.param(
-        model,
-        values,
-        view,
-        peak,
-        min(max(12.0 * alpha, 0.01), 0.6),
-        id=f"{name}-{view}-{peak}",
-        marks=[GTR1_FLOAT32] if (name, view) == ("disney-coat1", "60deg") else [],
-    )
+    pytest.param(model, values, view, peak, alpha, name, id=f"{name}-{view}-{peak}")
     for model, values, name, alpha in CASES
     if alpha is not None
     for view in _views(values)
     for peak, _ in _peaks(values, VIEWS[view])
 ]
+
+CHI2_TESTS = len(GLOBAL_CASES) + len(PEAK_CASES)
 
 
 @pytest.mark.slow
@@ -286,25 +306,40 @@ def test_chi2_whole_sphere(mi, model_name, values, view):
     from _mitsuba_chi2 import chi2
 
     _, params = _case_params(model_name, values)
-    passed, test = chi2(_plugin(mi, params), _unit(VIEWS[view]))
+    passed, test = chi2(_plugin(mi, params), _unit(VIEWS[view]), test_count=CHI2_TESTS)
     assert passed, test.messages
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("model_name", "values", "view", "peak", "radius"), PEAK_CASES)
-def test_chi2_zoomed_on_peak(mi, model_name, values, view, peak, radius):
+@pytest.mark.parametrize(("model_name", "values", "view", "peak", "alpha", "name"), PEAK_CASES)
+def test_chi2_zoomed_on_peak(mi, model_name, values, view, peak, alpha, name):
+    _known_failure(name, lambda: _chi2_zoomed(mi, model_name, values, view, peak, alpha))
+
+
+def _chi2_zoomed(mi, model_name, values, view, peak, alpha):
     from _mitsuba_chi2 import chi2
 
     _, params = _case_params(model_name, values)
     axis = dict(_peaks(values, VIEWS[view]))[peak]
-    passed, test = chi2(_plugin(mi, params), _unit(VIEWS[view]), axis=axis, radius=radius)
+    # A dozen lobe widths, but the chart (corners at 1.41 radii) stays off the horizon,
+    # where the density jumps to zero and no per-cell quadrature is accurate.
+    elevation = math.asin(min(abs(axis[2]) / np.linalg.norm(axis), 1.0))
+    radius = min(max(12.0 * alpha, 0.01), 0.6, elevation / 1.5)
+    passed, test = chi2(
+        _plugin(mi, params), _unit(VIEWS[view]), axis=axis, radius=radius, test_count=CHI2_TESTS
+    )
     assert passed, test.messages
 
 
 @pytest.mark.parametrize(
-    ("model_name", "values"), [c[:2] for c in CASES], ids=[c[2] for c in CASES]
+    ("model_name", "values", "name", "alpha"),
+    [pytest.param(*c, id=c[2]) for c in CASES],
 )
-def test_drjit_eval_equals_numpy_eval(mi, model_name, values):
+def test_drjit_eval_equals_numpy_eval(mi, model_name, values, name, alpha):
+    _known_failure(name, lambda: _drjit_vs_numpy(mi, model_name, values))
+
+
+def _drjit_vs_numpy(mi, model_name, values):
     model, params = _case_params(model_name, values)
     rng = np.random.default_rng(7)
     view = _unit(rng.normal(size=(2048, 3)))
@@ -327,6 +362,8 @@ FURNACE_CASES = [
     ("disney", {"clearcoat": 1.0, "roughness": 0.7, "base_color": [0.2, 0.3, 0.8]}, "disney-coat"),
     ("disney", {"spec_trans": 1.0, "roughness": 0.0, "ior": 1.5}, "disney-glass"),
     ("sheen", {"roughness": 0.3, "color": [0.9, 0.5, 0.3]}, "sheen"),
+    ("pixar", {"roughness": 0.5, "surface_color": [0.7, 0.3, 0.2]}, "pixar-plastic"),
+    ("pixar", {"metallic": 1.0, "roughness": 0.3}, "pixar-metal"),
 ]
 
 

@@ -277,3 +277,70 @@ def test_cli_bad_input_exits_2_with_one_line(cli, tmp_path):
         assert result.code == 2
         assert result.err.startswith("lookdev: error:") and result.err.count("\n") == 1
         assert not out.exists()
+
+
+def test_forcing_all_lobes_traces_more_and_renders_the_same(mi, m, disney):
+    """The pruning baseline: a metal's diffuse lobe (weight 1 − metallic = 0) is traced."""
+    from lookdev.materials.params import DisneyParams
+
+    metal = DisneyParams(metallic=1.0, roughness=0.3, base_color=(0.9, 0.6, 0.3))
+    pruned = mi.load_dict(m.bsdf_dict(metal, allow_principled=False))
+    forced = mi.load_dict(m.bsdf_dict(metal, force_all_lobes=True))
+    assert not pruned.flags() & mi.BSDFFlags.Diffuse
+    assert forced.flags() & mi.BSDFFlags.DiffuseReflection
+    assert forced.flags() & mi.BSDFFlags.Transmission
+    images = []
+    for force in (False, True):
+        scene = m.scene_dict(metal, resolution=(16, 16), spp=16, force_all_lobes=force)
+        scene["ball"]["bsdf"] = m.bsdf_dict(metal, allow_principled=False, force_all_lobes=force)
+        images.append(_render(mi, scene, seed=3))
+    np.testing.assert_allclose(images[0], images[1], rtol=1e-4, atol=1e-5)
+
+
+def test_every_builtin_preset_becomes_a_bsdf(mi, m, disney):
+    """Each built-in preset exports (layered ones blended at 32²) and Mitsuba loads it."""
+    from lookdev.library import Library
+
+    library = Library(use_env=False)
+    for name in library.names():
+        material = library.load(name)
+        if any(layer.material.model == "pixar" for layer in material.layers):
+            with pytest.raises(LookdevError, match="layered Pixar materials cannot be rendered"):
+                m.flatten(material, 32)
+            continue
+        flat = m.flatten(material, 32)
+        bsdf = mi.load_dict(m.bsdf_dict(flat))
+        assert bsdf.flags() != 0, name
+        assert m.max_depth_for(flat) in (
+            m.DEPTH_OPAQUE,
+            m.DEPTH_THIN_TRANSMISSION,
+            m.DEPTH_SOLID_TRANSMISSION,
+        )
+
+
+def test_cli_exports_a_layered_preset_with_its_maps(mi, cli, disney, tmp_path):
+    import json
+
+    out = tmp_path / "rust.xml"
+    result = cli(
+        "export",
+        "mitsuba",
+        "rusty_iron",
+        "-o",
+        str(out),
+        "--map-resolution",
+        "16",
+        "--resolution",
+        "8",
+        "8",
+        "--spp",
+        "2",
+        "--json",
+    )
+    assert result.code == 0, result.err
+    summary = json.loads(result.out)
+    assert summary["plugins"] and len(summary["textures"]) >= 2
+    assert all(p.startswith(str(tmp_path / "rust_textures")) for p in summary["textures"])
+    assert out.read_text().startswith("<!-- lookdev BSDF plugins")
+    image = np.array(mi.render(mi.load_file(str(out))))
+    assert image.shape == (8, 8, 3) and np.all(np.isfinite(image))

@@ -17,8 +17,8 @@ Parameters arrive as Mitsuba properties, one per schema field: a constant (float
 string, ``rgb``) or a texture (``bitmap`` …). Constants are handed to ``prepare`` as Python
 values, so a lobe whose weight is a constant zero is pruned while the kernel is traced;
 textures are evaluated at ``si`` and handed to ``prepare`` as ``maps``. With the boolean
-property ``force_all_lobes`` every parameter that is exactly zero is handed over as a Dr.Jit
-array instead: no weight is then a *known* zero and every lobe is traced (the benchmark
+property ``force_all_lobes`` every numeric parameter is handed over as an opaque Dr.Jit
+value instead: no weight is then a *known* zero and every lobe is traced (the benchmark
 baseline).
 """
 
@@ -191,10 +191,10 @@ def _plugin_class(variant: str) -> type:
             return dr.opaque(mi.Float, 0.5)
 
         def _forced(self) -> dict[str, Any]:
-            """Zero parameters as Dr.Jit arrays when every lobe must be traced.
+            """Every numeric parameter as an opaque Dr.Jit value, when all lobes must be traced.
 
-            Only a value that is exactly zero can make ``prepare`` prune a lobe, so only
-            those are handed over as arrays (which ``known_zero`` cannot see through).
+            ``known_zero`` cannot see through an opaque value, so no lobe weight derived
+            from one (``spec_trans``, or ``1 − metallic`` of a metal) is pruned.
             """
             if not self.force_all_lobes:
                 return {}
@@ -202,10 +202,10 @@ def _plugin_class(variant: str) -> type:
             for key, value in self.params.model_dump().items():
                 if key in self.textures or isinstance(value, bool):
                     continue
-                if isinstance(value, float) and value == 0.0:
-                    forced[key] = dr.opaque(mi.Float, 0.0)
-                elif isinstance(value, tuple) and not any(value):
-                    forced[key] = self.xp.Array3(*(dr.opaque(mi.Float, 0.0) for _ in value))
+                if isinstance(value, float):
+                    forced[key] = dr.opaque(mi.Float, value)
+                elif isinstance(value, tuple):
+                    forced[key] = self.xp.Array3(*(dr.opaque(mi.Float, c) for c in value))
             return forced
 
         def _prepare(self, si: mi.SurfaceInteraction3f, active: mi.Bool) -> Any:

@@ -143,6 +143,16 @@ def _given(params: Params) -> dict[str, Any]:
 
 
 def _from_blended(blended: Any) -> Flat:
+    fields = model_for(blended.model).params_type.model_fields
+    foreign = sorted(set(blended.constants) - set(fields)) + sorted(set(blended.maps) - set(fields))
+    if foreign:
+        # Pixar stacks composite lobe weights (Smits, "Layering"), which the Pixar Model's
+        # prepare() does not take as inputs: such a material has no BSDF to render yet.
+        raise MitsubaExportError(
+            f"blended {blended.model} material carries {', '.join(foreign[:3])}… which are "
+            f"not {blended.model} parameters; layered Pixar materials cannot be rendered yet",
+            where=blended.name,
+        )
     constants = {k: _plain(v) for k, v in dict(blended.constants).items() if v is not None}
     maps = {k: np.asarray(v, dtype=np.float32) for k, v in dict(blended.maps).items()}
     if getattr(blended, "specular_normal_map", None) is not None:
