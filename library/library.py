@@ -84,7 +84,8 @@ class Library:
         out: list[Header] = []
         for folder in self.folders:
             if not folder.is_dir():
-                raise LibraryError("library folder does not exist", where=str(folder))
+                what = "is a file, not a folder" if folder.exists() else "does not exist"
+                raise LibraryError(f"library folder {what}", where=str(folder))
             try:
                 out += self._scan(folder)
             except OSError as exc:

@@ -152,6 +152,12 @@ def test_writes_need_a_user_library_that_is_writable(cli, tmp_path):
     )
 
 
+def test_library_must_be_a_folder(cli, tmp_path):
+    one_line_error(cli("presets", "list", "-L", str(tmp_path / "nope")), "does not exist")
+    (tmp_path / "f").write_text("")
+    one_line_error(cli("presets", "list", "-L", str(tmp_path / "f")), "is a file, not a folder")
+
+
 def test_rm_refuses_while_others_build_on_it(cli, tmp_path):
     lib = str(tmp_path)
     assert cli("presets", "new", "base", "--from", "gold", "-L", lib).code == 0

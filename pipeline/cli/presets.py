@@ -39,7 +39,6 @@ LibraryOpt = Annotated[
         "-L",
         help="Preset folder searched before LOOKDEV_LIBRARY_PATH and the built-ins; repeatable. "
         "The first one receives writes.",
-        file_okay=False,
     ),
 ]
 TABLE_MAX_ROWS = 500
