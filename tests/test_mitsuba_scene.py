@@ -344,3 +344,36 @@ def test_cli_exports_a_layered_preset_with_its_maps(mi, cli, disney, tmp_path):
     assert out.read_text().startswith("<!-- lookdev BSDF plugins")
     image = np.array(mi.render(mi.load_file(str(out))))
     assert image.shape == (8, 8, 3) and np.all(np.isfinite(image))
+
+
+def test_normal_maps_wrap_our_bsdf(mi, m, tmp_path):
+    """A flat normal map (all +z) changes nothing; a tilted one changes the shading."""
+    from lookdev.pipeline.export.mitsuba import xml
+
+    flat_normals = np.zeros((4, 4, 3), np.float32)
+    flat_normals[..., 2] = 1.0
+    plain = _blended()
+    bumped = _blended()
+    bumped.normal_map = flat_normals
+    d = m.bsdf_dict(bumped)
+    assert d["type"] == "normalmap" and d["bsdf"]["type"] == "lookdev_tiny_test"
+    np.testing.assert_allclose(
+        np.array(d["normalmap"]["data"]), [0.5, 0.5, 1.0] * np.ones((4, 4, 1))
+    )
+    scenes = [m.scene_dict(b, resolution=(16, 16), spp=64) for b in (plain, bumped)]
+    a, b = (_render(mi, s, seed=4) for s in scenes)
+    np.testing.assert_allclose(a.mean(), b.mean(), rtol=0.01)
+    tilted = _blended()
+    tilted.normal_map = np.broadcast_to(np.array([0.6, 0.0, 0.8], np.float32), (4, 4, 3)).copy()
+    assert (
+        abs(_render(mi, m.scene_dict(tilted, resolution=(16, 16), spp=64)).mean() - a.mean()) > 0.01
+    )
+    text = xml.to_xml(m.scene_dict(bumped, texture_dir=tmp_path), relative_to=tmp_path)
+    assert '<bsdf type="normalmap"' in text and "tiled_normal.exr" in text
+
+
+def test_specular_normal_map_is_reported_not_silently_dropped(m):
+    blended = _blended()
+    blended.specular_normal_map = np.zeros((2, 2, 3), np.float32)
+    with pytest.warns(RuntimeWarning, match="specular normal map"):
+        m.flatten(blended)
