@@ -45,6 +45,7 @@ from typing import Any
 
 from . import fresnel as fr
 from . import microfacet as mf
+from .arrays import NumpyOps
 from .bsdf import Model, density, draw, evaluate
 from .params import SPECULAR_F0_SCALE, DisneyParams
 
@@ -215,8 +216,7 @@ def _normalise(xp: Any, est: dict[str, Any], lobes: tuple[str, ...]) -> dict[str
 # -- the frame: thin sheets are two-sided, a solid is seen from inside only through glass --
 def _orient(xp: Any, wi: Any, wo: Any) -> tuple[Any, Any, Any]:
     """(wi, wo) mirrored so that wo is in the upper hemisphere, and the mirror sign ±1."""
-    one = xp.full(wo[2], 1.0)  # of the directions' dtype: float32 stays float32
-    s = xp.select(wo[2] < 0.0, -one, one)
+    s = xp.copysign(1.0, wo[2])  # of the directions' dtype: float32 stays float32
     return xp.vec3(wi[0], wi[1], wi[2] * s), xp.vec3(wo[0], wo[1], wo[2] * s), s
 
 
@@ -243,7 +243,8 @@ def _diffuse_shape(xp: Any, pr: dict[str, Any], ci: Any, co: Any, cos2_d: Any) -
     # Hanrahan-Krueger; F_ss90 = cos²θd·roughness as the BRDF Explorer (Schutte: roughness²).
     fss90 = cos2_d * pr["roughness"]
     fss = _mix(1.0, fss90, fl) * _mix(1.0, fss90, fv)
-    hk = 1.25 * (fss * (1.0 / xp.maximum(ci + co, xp.tiny) - 0.5) + 0.5)
+    # 1e-20 keeps HK's integrable 1/(cos θl + cos θv) finite at ci = co = 0 (float32 too).
+    hk = 1.25 * (fss * (1.0 / xp.maximum(ci + co, 1e-20) - 0.5) + 0.5)
     shape = retro + lambert * _mix(1.0, hk, flat)  # 2015 flatness (Schutte)
     return _mix(shape, hk, sss)  # 2012 subsurface (BRDF Explorer)
 
@@ -273,6 +274,15 @@ def _q(pr: dict[str, Any], w: Any, z2: Any, prefix: str = "") -> Any:
     return ax2 * (w[0] * w[0]) + ay2 * (w[1] * w[1])
 
 
+def _masked(xp: Any, cond: Any, x: Any) -> Any:
+    """x where cond, else 0, for an ``x`` that is finite everywhere.
+
+    With numpy a product with the boolean mask: ``np.where`` costs 20 times as much on
+    the random masks of a BSDF (measured: 0.5 ms against 0.023 ms for 125k float32).
+    """
+    return x * cond if isinstance(xp, NumpyOps) else xp.select(cond, x, 0.0)
+
+
 def _times(x: Any, front: Any) -> Any:
     return x if front is None else x * front
 
@@ -284,8 +294,10 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
     maps), so each lobe costs one colour product. The half vector is h = wi + wo,
     unnormalised: |h|² = 4 cos²θd and D is homogeneous in h.
     """
-    lobes, ci, co = pr["lobes"], wi[2], wo[2]
-    up = (ci > 0.0) & (co > 0.0)
+    lobes = pr["lobes"]
+    up = (wi[2] > 0.0) & (wo[2] > 0.0)
+    # Clamped cosines keep every term finite where ``up`` is false, so masking is a product.
+    ci, co = xp.maximum(wi[2], 0.0), xp.maximum(wo[2], 0.0)
     cos2_d = xp.maximum(0.5 + 0.5 * xp.dot(wi, wo), 0.0)  # cos²θd = (1 + wi·wo)/2
     cos_d = xp.sqrt(cos2_d)
     w = fr.schlick_weight(xp, cos_d)
@@ -299,7 +311,7 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
         g = mf.g1_over_cos(xp, ci, _q(pr, wi, zi2), zi2) * mf.g1_over_cos(
             xp, co, _q(pr, wo, zo2), zo2
         )
-        dg = xp.select(up, 0.25 * d * g, 0.0)
+        dg = _masked(xp, up, 0.25 * d * g)
         a, b, c = pr["spec_a"], pr["spec_b"], pr["spec_c"]
         dg_out = _times(dg, front)
         terms += [(a * scale, dg_out), ((b - a) * scale, dg_out * w)]
@@ -310,14 +322,14 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
     if "diffuse" in lobes:
         shape = _diffuse_shape(xp, pr, ci, co, cos2_d)
         k = _times(pr["diffuse"] * INV_PI * shape, front)
-        terms.append((pr["base"] * scale, xp.select(up, k, 0.0)))
+        terms.append((pr["base"] * scale, _masked(xp, up, k)))
     if "sheen" in lobes:
         if pr["sheen_model"] == "conty_kulla":
             lobe = _conty_kulla().lobe(xp, wi, wo, xp.asarray(pr["sheen_r"]), True)
         else:
             lobe = w  # 2014 addendum: sheen · (1 − cos θd)⁵, no 1/π (BRDF Explorer)
         k = _times(lobe * pr["sheen"], front)
-        terms.append((pr["sheen_color"], xp.select(up, k, 0.0)))
+        terms.append((pr["sheen_color"], _masked(xp, up, k)))
     if "clearcoat" in lobes:
         inv_h2 = 1.0 / xp.maximum(h2, xp.tiny)
         sin2_h = (h[0] * h[0] + h[1] * h[1]) * inv_h2  # not 1 − cos²: the α = 10⁻³ peak
@@ -329,22 +341,22 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
         f = fr.schlick(xp, CLEARCOAT_F0, cos_d)
         # Burley's clearcoat keeps the 1/(4 cos cos) that Schutte and Mitsuba leave out.
         k = _times((0.25 * pr["clearcoat"]) * f * d * g, front)
-        terms.append((None, xp.select(up, k, 0.0)))
+        terms.append((None, xp.select(up, k, 0.0)))  # D is 0/0 at wi = −wo: a true select
     return terms
 
 
-def _transmission(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> tuple[Any, Any]:
-    """(f, pdf) of the specular transmission, without weight and colour, wi below."""
+def _transmission(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any, pdf: bool) -> Any:
+    """f (without weight and colour) of the specular transmission, or its pdf; wi below."""
     ax, ay = pr["tax"], pr["tay"]
     if pr["thin"]:
         # Schutte: reflection about the rougher thin α, mirrored through the sheet.
         wm = xp.vec3(wi[0], wi[1], -wi[2])
         h = xp.normalize(wm + wo)
         oh = xp.dot(wo, h)
+        if pdf:
+            return mf.visible_ggx_pdf(xp, wo, h, ax, ay) / xp.maximum(4.0 * oh, xp.tiny)
         g = mf.g1_over_cos(xp, wm[2], _qt(pr, wm)) * mf.g1_over_cos(xp, wo[2], _qt(pr, wo))
-        d = mf.ggx_d(xp, h, ax, ay)
-        f = (1.0 - fr.dielectric(xp, oh, pr["eta"])) * d * g * 0.25
-        return f, mf.visible_ggx_pdf(xp, wo, h, ax, ay) / xp.maximum(4.0 * oh, xp.tiny)
+        return (1.0 - fr.dielectric(xp, oh, pr["eta"])) * mf.ggx_d(xp, h, ax, ay) * g * 0.25
     # Walter et al. 2007 / pbrt-v4 DielectricBxDF in radiance mode (the 1/η'² included).
     etap = _pick(xp, front, pr["eta"], 1.0 / pr["eta"])
     h = mf.transmission_half(xp, wi, wo, etap)
@@ -352,11 +364,12 @@ def _transmission(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> 
     ok = (ih < 0.0) & (oh > 0.0)
     denom = ih + oh / etap
     denom2 = xp.maximum(denom * denom, xp.tiny)
+    if pdf:
+        return xp.select(ok, mf.visible_ggx_pdf(xp, wo, h, ax, ay) * xp.abs(ih) / denom2, 0.0)
     g = mf.g1_over_cos(xp, -wi[2], _qt(pr, wi)) * mf.g1_over_cos(xp, wo[2], _qt(pr, wo))
     d = mf.ggx_d(xp, h, ax, ay)
     f = (1.0 - fr.dielectric(xp, oh, etap)) * d * g * xp.abs(ih * oh) / (denom2 * etap * etap)
-    pdf = mf.visible_ggx_pdf(xp, wo, h, ax, ay) * xp.abs(ih) / denom2
-    return xp.select(ok, f, 0.0), xp.select(ok, pdf, 0.0)
+    return xp.select(ok, f, 0.0)
 
 
 def _qt(pr: dict[str, Any], w: Any) -> Any:
@@ -371,7 +384,7 @@ def _eval_oriented(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) ->
         down = (wi[2] < 0.0) & (wo[2] > 0.0)
         t = pr["diff_trans"] * INV_PI if "diff_trans" in lobes else 0.0
         if "spec_trans" in lobes:
-            t = t + pr["glass"] * _transmission(xp, pr, wi, wo, front)[0]
+            t = t + pr["glass"] * _transmission(xp, pr, wi, wo, front, pdf=False)
         terms.append((pr["trans_color"], xp.select(down, t, 0.0)))
     grey = [s for c, s in terms if c is None]
     f = xp.zeros(wi[2]) * pr["base"] if not grey else None
@@ -415,7 +428,7 @@ def _pdf_oriented(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> 
         down = (ci < 0.0) & (co > 0.0)
         p_down = odds["diff_trans"] * -ci * INV_PI if "diff_trans" in odds else 0.0
         if "spec_trans" in odds:
-            p_down = p_down + odds["spec_trans"] * _transmission(xp, pr, wi, wo, front)[1]
+            p_down = p_down + odds["spec_trans"] * _transmission(xp, pr, wi, wo, front, pdf=True)
         p = p + xp.select(down, p_down, 0.0)
     return p
 

@@ -120,7 +120,7 @@ def ggx_d(xp: Any, h: Any, ax: Any, ay: Any, n2: Any = None) -> Any:
     s = hx * hx + hy * hy + hz * hz
     if n2 is None:
         n2 = h[0] * h[0] + h[1] * h[1] + hz * hz
-    return (n2 * n2) / ((math.pi * ax * ay) * (s * s))
+    return (n2 * n2) / ((math.pi * ax * ay) * xp.maximum(s * s, xp.tiny))  # h = 0 gives 0
 
 
 def sample_ggx(xp: Any, ax: Any, ay: Any, u1: Any, u2: Any) -> Any:
@@ -149,7 +149,9 @@ def g1_over_cos(xp: Any, z: Any, q: Any, z2: Any = None) -> Any:
     z → 0, where G1 and cos θ both vanish.
     """
     z2 = z * z if z2 is None else z2
-    return 2.0 / xp.maximum(z + xp.sqrt(z2 + q), xp.tiny)
+    # For z ≥ 0 and α ≥ ALPHA_MIN the denominator is ≥ 10⁻³ or ≥ 2z; the floor 10⁻⁶ only
+    # keeps masked-out directions (z = 0, q = 0) finite.
+    return 2.0 / xp.maximum(z + xp.sqrt(z2 + q), 1e-6)
 
 
 def clearcoat_g1(xp: Any, w: Any) -> Any:
