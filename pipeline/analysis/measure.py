@@ -229,7 +229,12 @@ def bench_precision(case: str, model: Model, params: Any, n: int = 20000) -> lis
     # float32 overflowing or NaN where float64 is finite is an infinite error, not a skip
     rel = np.where(finite & ~np.isfinite(f32), np.inf, rel)
     bad32 = int((~np.isfinite(f32)).sum())
-    note = f"{n + 5} pairs" + (f", {bad32} non-finite" if bad32 else "")
+    per_pair = rel.max(axis=-1)
+    worst = int(np.argmax(per_pair))
+    note = (
+        f"{int(np.sum(per_pair > 1e-4))}/{len(wi)} pairs >1e-4; worst at cos θi, θo = "
+        f"{wi[worst, 2]:.2g}, {wo[worst, 2]:.2g}" + (f"; {bad32} non-finite" if bad32 else "")
+    )
     return [
         Row("precision", case, "float64", note, 0.0, t64, n + 5, "float64"),
         Row(
