@@ -10,8 +10,10 @@ benchmark and the MaterialX writer share one set of networks.
 from __future__ import annotations
 
 import re
+import struct
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -114,7 +116,7 @@ class Source:
     layers: list[Any] = field(default_factory=list)  # live.LiveLayer, bottom first
     notes: list[str] = field(default_factory=list)  # losses every context shares
 
-    @property
+    @cached_property
     def lobes(self) -> dict[str, bool]:
         """Lobes with weight; a mapped weight parameter counts as live."""
         values = dict(self.values)
@@ -123,7 +125,7 @@ class Source:
                 values[k] = max(values[k], 1e-6)
         return active_lobes(values, self.model)
 
-    @property
+    @cached_property
     def live_values(self) -> dict[str, Any]:
         """The values with every parameter of a dead lobe reset to its default."""
         return effective(self.values, self.model, self.lobes)
@@ -168,10 +170,29 @@ def surface_inputs(
 
 
 def same(a: Any, b: Any) -> bool:
-    """Equal as USD would store them (float32), for values and colour triples."""
-    a32 = np.asarray(a, dtype=np.float32)
-    b32 = np.asarray(b, dtype=np.float32)
-    return a32.shape == b32.shape and bool(np.all(a32 == b32))
+    """Equal as USD would store them (float32), for values and colour triples.
+
+    >>> same(0.1, 0.1 + 1e-12), same((1.0, 0.5, 0.0), (1.0, 0.5, 1e-3))
+    (True, False)
+    """
+    if isinstance(a, tuple) or isinstance(b, tuple):
+        return (
+            isinstance(a, tuple)
+            and isinstance(b, tuple)
+            and len(a) == len(b)
+            and all(map(same, a, b))
+        )
+    return _f32(a) == _f32(b)
+
+
+def _f32(x: Any) -> float:
+    try:
+        return _FLOAT32.unpack(_FLOAT32.pack(x))[0]
+    except OverflowError:  # beyond float32: stored as infinity
+        return float(np.float32(x))
+
+
+_FLOAT32 = struct.Struct("f")
 
 
 def loss_note(source: Source, context: str, mapped: set[str], extra: str = "") -> str:
