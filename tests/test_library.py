@@ -6,6 +6,7 @@ import doctest
 import importlib
 import json
 import os
+import re
 import tomllib
 from pathlib import Path
 
@@ -28,7 +29,7 @@ from lookdev.library.preset import check_params
 from lookdev.library.schema import preset_schema
 from lookdev.materials.errors import LookdevError, ParameterError
 from lookdev.materials.layers import CombineMask, TextureMask, textures
-from lookdev.materials.params import srgb_to_linear
+from lookdev.materials.params import SPECULAR_F0_SCALE, srgb_to_linear
 
 BUILTIN = Library(use_env=False)
 BUILTIN_NAMES = BUILTIN.names()
@@ -87,6 +88,21 @@ def test_builtin_values_are_the_cited_measurements():
     assert BUILTIN.load("water").params.ior == 1.333
     assert BUILTIN.load("glass_clear").params.effective_ior == 1.52
     assert BUILTIN.load("glass_frosted").params.ior == 1.52  # inherited
+
+
+@pytest.mark.parametrize("name", BUILTIN_NAMES)
+def test_source_notes_agree_with_the_values(name):
+    """Every 'IOR x' and 'F0 f, so specular s' a preset cites is the value it uses."""
+    m = BUILTIN.load(name)
+    note = m.citation or ""
+    if m.params is None or not note:
+        return
+    for ior in re.findall(r"IOR (\d+\.\d+)(?![\d-])", note):
+        ior_used = m.params.ior if m.model == "pixar" else m.params.effective_ior
+        assert ior_used == pytest.approx(float(ior), abs=0.01), note
+    for f0, specular in re.findall(r"F0 (\d\.\d+), so specular (\d\.\d+)", note):
+        assert m.params.specular == float(specular)
+        assert float(specular) * SPECULAR_F0_SCALE == pytest.approx(float(f0), abs=0.002)
 
 
 def test_issue_looks_use_the_features_they_name():
