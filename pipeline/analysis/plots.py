@@ -185,6 +185,7 @@ def draw_albedo(ax: Any, subject: Subject) -> None:
                 lw=1,
                 label="table" if c == 0 else None,
             )
+    ax.axhline(1.0, color="0.4", ls=":", lw=1)  # above it the material creates energy
     ax.set_xlim(0, 90)
     ax.set_ylim(0, max(1.05, float(mc.albedo.max()) * 1.1))
     ax.set_xlabel("incidence angle θ (°)")
