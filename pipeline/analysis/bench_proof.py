@@ -22,7 +22,6 @@ the same run (no absolute timings are asserted).
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import asdict, dataclass
 from typing import Annotated, Any
@@ -58,29 +57,57 @@ def _frames(n: int) -> list[Any]:
     return frames(n - n // 2, n // 2)
 
 
-def time_pipeline(bsdf: dict, depth: int, env: Any, s: Settings) -> tuple[float, list[float]]:
-    """Seconds for a whole turntable (scene load included) and each frame's noise."""
+@dataclass(frozen=True)
+class Timing:
+    """Wall-clock and CPU seconds (all threads) of a run; its mean relative noise."""
+
+    wall: float = 0.0
+    cpu: float = 0.0
+    noise: float | None = None
+
+    def __add__(self, other: Timing) -> Timing:
+        return Timing(self.wall + other.wall, self.cpu + other.cpu, self.noise)
+
+    def to_json(self) -> dict[str, Any]:
+        return {"wall_s": self.wall, "cpu_s": self.cpu}
+
+
+class Clock:
+    """``with Clock() as c: …`` then ``c.timing``: wall and process CPU time between."""
+
+    def __enter__(self) -> Clock:
+        self._start = (time.perf_counter(), time.process_time())
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        wall, cpu = self._start
+        self.timing = Timing(time.perf_counter() - wall, time.process_time() - cpu)
+
+
+def time_pipeline(bsdf: dict, depth: int, env: Any, s: Settings) -> Timing:
+    """A whole turntable (scene load included), with the frames' mean noise."""
     from lookdev.pipeline.proof.turntable import Turntable, render_frame
 
-    start = time.perf_counter()
-    table = Turntable(bsdf, env.pixels, s.resolution, depth)
-    noise = [render_frame(table, f, s.spp, seed=f.index).noise_relative for f in _frames(s.frames)]
-    return time.perf_counter() - start, noise
+    with Clock() as clock:
+        table = Turntable(bsdf, env.pixels, s.resolution, depth)
+        noise = [render_frame(table, f, s.spp, seed=f.index) for f in _frames(s.frames)]
+    mean_noise = float(np.mean([r.noise_relative for r in noise]))
+    return Timing(clock.timing.wall, clock.timing.cpu, mean_noise)
 
 
-def time_bare(bsdf: dict, depth: int, env: Any, s: Settings) -> float:
-    """Seconds inside ``mi.render`` alone for the same frames and samples."""
+def time_bare(bsdf: dict, depth: int, env: Any, s: Settings) -> Timing:
+    """Time inside ``mi.render`` alone for the same frames and samples."""
     import mitsuba as mi
 
     from lookdev.pipeline.proof.turntable import Turntable
 
     table = Turntable(bsdf, env.pixels, s.resolution, depth)
-    total = 0.0
+    total = Timing()
     for f in _frames(s.frames):
         table.set_frame(f)
-        start = time.perf_counter()
-        np.array(mi.render(table.scene, spp=s.spp, seed=f.index))
-        total += time.perf_counter() - start
+        with Clock() as clock:
+            np.array(mi.render(table.scene, spp=s.spp, seed=f.index))
+        total += clock.timing
     return total
 
 
@@ -103,38 +130,35 @@ def naive_scene(bsdf: dict, depth: int, env: Any, s: Settings, frame: Any) -> di
     return scene
 
 
-def time_naive(bsdf: dict, depth: int, env: Any, s: Settings) -> float:
-    """Seconds to rebuild and render the scene for every frame."""
+def time_naive(bsdf: dict, depth: int, env: Any, s: Settings) -> Timing:
+    """Rebuilding and rendering the scene for every frame."""
     import mitsuba as mi
 
-    start = time.perf_counter()
-    for f in _frames(s.frames):
-        scene = mi.load_dict(naive_scene(bsdf, depth, env, s, f))
-        np.array(mi.render(scene, spp=s.spp, seed=f.index))
-    return time.perf_counter() - start
+    with Clock() as clock:
+        for f in _frames(s.frames):
+            scene = mi.load_dict(naive_scene(bsdf, depth, env, s, f))
+            np.array(mi.render(scene, spp=s.spp, seed=f.index))
+    return clock.timing
 
 
-def interleaved(cases: dict[str, Any], repeat: int) -> dict[str, Any]:
-    """Each case's fastest result over ``repeat`` rounds, after one warm-up round.
+def interleaved(cases: dict[str, Any], repeat: int) -> dict[str, Timing]:
+    """Each case's least-CPU run over ``repeat`` rounds, after one warm-up round.
 
     Rounds run the cases in turn (A B C A B C …), so a machine busy with other work
-    slows every case alike instead of whichever happened to run then.
+    slows every case alike instead of whichever happened to run then; CPU time (all
+    threads) is what a busy machine disturbs least, so it picks the best run.
     """
-    best: dict[str, Any] = {}
+    best: dict[str, Timing] = {}
     for round_ in range(repeat + 1):
         for name, fn in cases.items():
             result = fn()
-            if round_ and (name not in best or _seconds(result) < _seconds(best[name])):
+            if round_ and (name not in best or result.cpu < best[name].cpu):
                 best[name] = result
     return best
 
 
-def _seconds(result: Any) -> float:
-    return result[0] if isinstance(result, tuple) else result
-
-
 def run(s: Settings) -> dict[str, Any]:
-    """Every measurement of the benchmark, as one JSON-able dict."""
+    """Every measurement of the benchmark, as one JSON-able dict (ratios on CPU time)."""
     from lookdev.library import load_material
     from lookdev.pipeline.proof import ibl
     from lookdev.pipeline.proof.turntable import material_bsdf
@@ -154,26 +178,25 @@ def run(s: Settings) -> dict[str, Any]:
         },
         s.repeat,
     )
-    (pipeline, noise), bare, naive = got["pipeline"], got["bare"], got["naive"]
-    all_on, forced_noise = got["all_lobes"]
+    pipeline, bare, naive, all_on = (got[k] for k in ("pipeline", "bare", "naive", "all_lobes"))
     return {
         "variant": variant,
         "settings": asdict(s),
         "bsdf": bsdf.get("type"),
         "turntable": {
-            "pipeline_s": pipeline,
-            "bare_render_s": bare,
-            "naive_rebuild_s": naive,
-            "speedup_vs_naive": naive / pipeline,
-            "overhead_vs_bare": pipeline / bare - 1.0,
+            "pipeline": pipeline.to_json(),
+            "bare_render": bare.to_json(),
+            "naive_rebuild": naive.to_json(),
+            "speedup_vs_naive": naive.cpu / pipeline.cpu,
+            "overhead_vs_bare": pipeline.cpu / bare.cpu - 1.0,
+            "wall_speedup_vs_naive": naive.wall / pipeline.wall,
+            "wall_overhead_vs_bare": pipeline.wall / bare.wall - 1.0,
             "targets": {"speedup_vs_naive": ">= 3", "overhead_vs_bare": "< 0.10"},
         },
         "pruning": {
-            "pruned_s": pipeline,
-            "all_lobes_s": all_on,
-            "speedup": all_on / pipeline,
-            "pruned_noise_relative": float(np.mean(noise)),
-            "all_lobes_noise_relative": float(np.mean(forced_noise)),
+            "pruned": pipeline.to_json() | {"noise_relative": pipeline.noise},
+            "all_lobes": all_on.to_json() | {"noise_relative": all_on.noise},
+            "speedup": all_on.cpu / pipeline.cpu,
         },
     }
 
@@ -198,7 +221,9 @@ def command(
 
     Renders a FRAMES-frame turntable of PRESET (half element, half lighting rotation)
     four ways in one run and prints the ratios against their targets: at least 3× faster
-    than rebuilding the scene per frame, under 10 % over the bare render calls.
+    than rebuilding the scene per frame, under 10 % over the bare render calls. Ratios
+    use CPU time (all threads), which other work on a shared machine disturbs least;
+    wall-clock times are shown beside them.
     """
     from lookdev.pipeline.cli.common import console, print_json, table
 
@@ -213,29 +238,27 @@ def command(
         print_json(report)
         return
     t, p = report["turntable"], report["pruning"]
+    base = t["pipeline"]["cpu_s"]
     rows = [
-        ["pipeline (traverse updates)", t["pipeline_s"], "1", ""],
-        ["bare mi.render, same frames", t["bare_render_s"], _ratio(t["bare_render_s"], t), ""],
-        [
-            "naive: rebuild every frame",
-            t["naive_rebuild_s"],
-            _ratio(t["naive_rebuild_s"], t),
-            f"target ≥ 3× slower ({'met' if t['speedup_vs_naive'] >= 3 else 'missed'})",
-        ],
+        [name, r["wall_s"], r["cpu_s"], r["cpu_s"] / base]
+        for name, r in (
+            ("pipeline (traverse updates)", t["pipeline"]),
+            ("bare mi.render, same frames", t["bare_render"]),
+            ("naive: rebuild every frame", t["naive_rebuild"]),
+        )
     ]
     title = f"{s.frames}-frame turntable, {s.preset} × {s.ibl}, {report['variant']}"
-    console.print(table(title, ["run", "seconds", "× pipeline", "note"], rows))
-    overhead = t["overhead_vs_bare"]
-    met = "met" if overhead < 0.10 else "missed"
-    console.print(f"pipeline overhead over bare mi.render: {overhead:+.1%} (target < 10 %: {met})")
+    console.print(table(title, ["run", "wall s", "CPU s", "× pipeline (CPU)"], rows))
+    for what, value, target, ok in (
+        ("speed-up over the naive script", f"{t['speedup_vs_naive']:.2f}×", "≥ 3×",
+         t["speedup_vs_naive"] >= 3),
+        ("overhead over bare mi.render", f"{t['overhead_vs_bare']:+.1%}", "< 10 %",
+         t["overhead_vs_bare"] < 0.10),
+    ):  # fmt: skip
+        console.print(f"{what}: {value} (target {target}: {'met' if ok else 'missed'})")
     rows = [
-        ["pruned (as exported)", p["pruned_s"], p["pruned_noise_relative"]],
-        ["every lobe forced on", p["all_lobes_s"], p["all_lobes_noise_relative"]],
+        [name, r["wall_s"], r["cpu_s"], r["noise_relative"]]
+        for name, r in (("pruned (as exported)", p["pruned"]), ("every lobe on", p["all_lobes"]))
     ]
-    console.print(
-        table(f"lobe pruning at {s.spp} spp", ["material", "seconds", "noise (rel)"], rows)
-    )
-
-
-def _ratio(seconds: float, t: dict[str, Any]) -> str:
-    return f"{seconds / t['pipeline_s']:.2f}" if math.isfinite(seconds) else "-"
+    columns = ["material", "wall s", "CPU s", "noise (rel)"]
+    console.print(table(f"lobe pruning at {s.spp} spp", columns, rows))

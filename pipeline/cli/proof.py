@@ -25,7 +25,7 @@ REPRESENTATIVE = (
     "glass_clear",
     "rusty_car_paint",
 )
-"""The default subjects: a metal, a coated dielectric, cloth, glass and a layered material."""
+"""The default subjects: a metal, a glossy plastic, cloth, glass and a layered material."""
 
 
 def representative_presets(library: Any) -> list[str]:

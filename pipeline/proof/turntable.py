@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import math
 import time
-import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -50,53 +49,16 @@ def frames(element: int, light: int) -> list[Frame]:
 
 
 def material_bsdf(material: Any, *, force_all_lobes: bool = False) -> tuple[dict, int]:
-    """The Mitsuba BSDF dict of a material and the path depth it needs.
+    """The Mitsuba BSDF dict of a material (our plugins) and the path depth it needs.
 
-    Our plugins through :func:`lookdev.pipeline.export.mitsuba.bsdf_dict`. While a model's
-    plugin is not available yet, a Disney material falls back to Mitsuba's ``principled``
-    (with one warning): it differs from Burley on tinted and dielectric speculars and on
-    the clearcoat (DESIGN.md, Traps), so such a proof is a stand-in, not the model.
+    A layered material is blended once (:func:`~lookdev.pipeline.export.mitsuba.scene.flatten`)
+    and both answers come from that.
     """
-    from lookdev.pipeline.export.mitsuba import MitsubaExportError, bsdf_dict, max_depth_for
+    from lookdev.pipeline.export.mitsuba import bsdf_dict, max_depth_for
+    from lookdev.pipeline.export.mitsuba.scene import flatten
 
-    try:
-        return bsdf_dict(material, force_all_lobes=force_all_lobes), max_depth_for(material)
-    except MitsubaExportError as exc:
-        params = getattr(material, "params", None)
-        if "not available" not in str(exc) or getattr(material, "model", "") != "disney":
-            raise
-    warnings.warn(
-        f"{material.name}: the disney plugin is not available; proofing with Mitsuba's "
-        "principled as a stand-in",
-        RuntimeWarning,
-        stacklevel=2,
-    )
-    return _principled(params), 12 if params.spec_trans > 0 else 4
-
-
-_PRINCIPLED_FIELDS = (
-    "metallic",
-    "roughness",
-    "anisotropic",
-    "specular",
-    "spec_tint",
-    "sheen",
-    "sheen_tint",
-    "clearcoat",
-    "clearcoat_gloss",
-    "spec_trans",
-    "flatness",
-)
-
-
-def _principled(params: Any) -> dict[str, Any]:
-    values = params.model_dump()
-    values["spec_tint"] = values["specular_tint"]
-    values["specular"] = params.effective_specular
-    out: dict[str, Any] = {"type": "principled"}
-    out["base_color"] = {"type": "rgb", "value": list(params.base_color)}
-    out.update({k: float(values[k]) for k in _PRINCIPLED_FIELDS})
-    return out
+    flat = flatten(material)
+    return bsdf_dict(flat, force_all_lobes=force_all_lobes), max_depth_for(flat)
 
 
 class Turntable:
