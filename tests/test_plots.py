@@ -259,3 +259,37 @@ def test_layered_preset_is_plotted_at_its_centre_texel():
     assert subject.label == "rusty_iron (centre texel)"
     assert subject.params == blended.params_at(n, n)
     assert subject.model is P.model_named(blended.model)
+
+
+LAMBERTIAN_PRESET = """\
+name = "matte"
+model = "pixar"
+description = "Pixar's all-diffuse end: roughness 1 is a Lambertian surface."
+[params]
+surface_color = [0.8, 0.5, 0.2]
+roughness = 1.0
+"""
+
+
+@pytest.fixture
+def lambertian_preset(tmp_path):
+    try:
+        P.model_named("pixar")
+    except P.PlotError:
+        pytest.skip("the pixar model has not landed yet")
+    path = tmp_path / "matte.toml"
+    path.write_text(LAMBERTIAN_PRESET)
+    return P.subject_for(str(path))
+
+
+def test_lambertian_preset_views_match_closed_forms(lambertian_preset):
+    s = lambertian_preset
+    (curve,) = P.albedo_curves(s)  # what the albedo view draws
+    np.testing.assert_allclose(curve.albedo, np.tile(RHO, (len(curve.theta), 1)), rtol=1e-12)
+    _, lum = P.polar_curves(s.model, s.params, [0, 60, 89])
+    np.testing.assert_allclose(lum, RHO @ S.REC709_Y / math.pi, rtol=1e-12)
+    light = np.array([-1.0, 1.0, 1.0]) / math.sqrt(3.0)
+    img = S.point_light_sphere(s.model, s.params, resolution=32, light=tuple(light), irradiance=1.0)
+    n, inside = S.sphere_normals(32)
+    expected = np.clip(n @ light, 0, None)[..., None] * RHO / math.pi * inside[..., None]
+    np.testing.assert_allclose(img, expected, atol=1e-15)
