@@ -10,12 +10,14 @@ all three render contexts) into an in-memory stage:
   no change block, so every edit notifies and recomposes.
 
 Reported: materials per second of each, ``ratio_fast_to_naive`` (target ≥ 5), the time
-to build the networks (shared by both, not in either figure), and whether the two
-layers hold identical specs (``same_layers``).
+to build the networks (shared by both, not in either figure), whether the two layers hold
+identical specs (``same_layers``), and the whole export as a user runs it (networks,
+authoring, the .usda written): ``end_to_end_materials_per_s``.
 """
 
 from __future__ import annotations
 
+import tempfile
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -28,10 +30,12 @@ from lookdev.pipeline.export.usd.network import (
     CONTEXTS,
     Connection,
     MaterialSpec,
+    Source,
     source_from_params,
 )
 from lookdev.pipeline.export.usd.writer import (
     author,
+    export_usd,
     material_spec,
     new_layer,
     prim_name,
@@ -74,6 +78,8 @@ def run(count: int, *, repeat: int = 3) -> dict[str, Any]:
     base = Path.cwd()
     fast_s = best_time(lambda: author_fast(specs, base), repeat=repeat)
     naive_s = best_time(lambda: author_naive(specs, base), repeat=max(1, repeat - 1))
+    with tempfile.TemporaryDirectory(prefix="lookdev-bench-usd-") as tmp:
+        end_to_end_s = best_time(lambda: end_to_end(count, Path(tmp)), repeat=1)
     naive_stage = author_naive(specs, base)  # keeps its root layer alive
     same = _specs_of(author_fast(specs, base)) == _specs_of(naive_stage.GetRootLayer())
     return {
@@ -87,13 +93,15 @@ def run(count: int, *, repeat: int = 3) -> dict[str, Any]:
         "naive_materials_per_s": count / naive_s,
         "ratio_fast_to_naive": naive_s / fast_s,
         "same_layers": same,
+        "end_to_end_s": end_to_end_s,
+        "end_to_end_materials_per_s": count / end_to_end_s,
     }
 
 
-def bench_specs(count: int, seed: int = 7) -> list[MaterialSpec]:
-    """``count`` varied Disney materials (metals, coats, sheen, glass …), all contexts."""
+def bench_sources(count: int, seed: int = 7) -> list[Source]:
+    """``count`` varied Disney materials (metals, coats, sheen, glass …)."""
     rng = np.random.default_rng(seed)
-    specs = []
+    sources = []
     for i in range(count):
         r = rng.random(8)
         params = DisneyParams(
@@ -105,8 +113,19 @@ def bench_specs(count: int, seed: int = 7) -> list[MaterialSpec]:
             spec_trans=float(r[6] > 0.85),
             specular=float(0.2 + 0.6 * r[7]),
         )
-        specs.append(material_spec(source_from_params(f"m{i:05d}", "disney", params), CONTEXTS))
-    return specs
+        sources.append(source_from_params(f"m{i:05d}", "disney", params))
+    return sources
+
+
+def bench_specs(count: int) -> list[MaterialSpec]:
+    """The networks of :func:`bench_sources`, all three contexts."""
+    return [material_spec(s, CONTEXTS) for s in bench_sources(count)]
+
+
+def end_to_end(count: int, folder: Path) -> None:
+    """What ``lookdev export usd`` does for ``count`` constant materials: networks, Sdf
+    authoring, the .usda written (atomically) into ``folder``."""
+    export_usd(bench_sources(count), folder / "bench.usda")
 
 
 def author_fast(specs: list[MaterialSpec], base: Path):
