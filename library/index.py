@@ -4,7 +4,7 @@
 parameters. Each folder keeps ``.lookdev-index.json``: for every preset file its
 ``(mtime_ns, size, inode)`` and its header. A listing stats the files (one ``scandir``
 per folder) and re-reads only those whose stat changed, so over an unchanged library it
-costs a directory walk and one small JSON read instead of opening every file.
+costs a directory walk and one JSON read instead of opening every file.
 
 A file changed twice within the filesystem's timestamp granularity could keep its stat;
 as in git's "racy" check, headers of files modified less than :data:`RACY_S` before the

@@ -71,8 +71,11 @@ class Library:
             user += [
                 Path(p).expanduser() for p in os.environ.get(ENV_PATH, "").split(os.pathsep) if p
             ]
-        self.user_folders: list[Path] = list(dict.fromkeys(user))
         self.builtin = builtin_folder() if builtin else None
+        builtin_key = self.builtin.resolve() if self.builtin else None
+        self.user_folders: list[Path] = [
+            f for f in dict.fromkeys(user) if not builtin_key or f.resolve() != builtin_key
+        ]
         self.builtin_str = str(self.builtin) if builtin else None
         self.folders = [*self.user_folders, *([self.builtin] if self.builtin else [])]
         self._builtin_headers: list[Header] | None = None

@@ -292,6 +292,13 @@ def test_search_order_user_libraries_first_then_env_then_builtin(tmp_path, monke
     assert Library().load("gold").params.roughness == 0.2
 
 
+def test_builtin_folder_named_again_is_not_searched_twice():
+    lib = Library([builtin_folder()], use_env=False)
+    assert lib.folders == [builtin_folder()] and lib.definitions("gold") == BUILTIN.definitions(
+        "gold"
+    )
+
+
 def test_unknown_name_suggests_close_ones(lib):
     with pytest.raises(PresetNotFoundError, match="did you mean 'copper'"):
         lib.load("coper")
