@@ -290,9 +290,9 @@ def command(
 ) -> None:
     """Evaluate the Disney BSDF on N direction pairs: numpy, Dr.Jit and Mitsuba's principled.
 
-    Eight materials share the pairs so that every lobe runs. Throughputs are measured in
-    one process; the ratios to Mitsuba's C++ plugin are the figures (targets: Dr.Jit
-    ≥ 0.5, numpy ≥ 0.1). First-call (compile) times are shown apart.
+    Eight materials share the pairs, so every lobe runs; all three are timed in one run.
+    The figures are throughput ratios to Mitsuba's C++ plugin: Dr.Jit ≥ 0.5, numpy ≥ 0.1.
+    First-call (tracing + compile) times are shown apart and excluded from the rates.
     """
     from rich.progress import Progress
 
