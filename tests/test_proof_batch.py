@@ -127,10 +127,12 @@ def test_a_rerun_skips_verified_frames_and_redoes_damaged_ones(mitsuba, gold, tm
     assert len(repaired["frames"]) == 3
 
 
-def test_changed_settings_render_everything_again(mitsuba, gold, tmp_path):
+def test_changed_settings_render_everything_again_and_drop_stray_frames(mitsuba, gold, tmp_path):
     batch.run_job(_job(gold, tmp_path))
-    more = batch.Settings(element_frames=2, light_frames=1, spp=6, resolution=(32, 16))
-    assert batch.run_job(_job(gold, tmp_path, more))["rendered"] == 3
+    fewer = batch.Settings(element_frames=1, light_frames=1, spp=6, resolution=(32, 16))
+    assert batch.run_job(_job(gold, tmp_path, fewer))["rendered"] == 2
+    frames = sorted(p.name for p in (tmp_path / "gold" / "studio").glob("frame_*"))
+    assert frames == ["frame_000.exr", "frame_000.png", "frame_001.exr", "frame_001.png"]
 
 
 def test_a_batch_runs_on_a_dask_cluster(mitsuba, gold, tmp_path):
@@ -197,13 +199,17 @@ def test_proof_command_default_executor_is_a_process_pool(cli, tmp_path):
         (["gold", "--ibl", "missing.exr"], "missing.exr: no such IBL file"),
         (["gold", "--ibl", "JUNK"], "cannot decode"),
         (["gold", "-o", "FILE/sub"], "not writable"),
+        (["gold", "--ibl", "studio", "--ibl", "STUDIO_EXR"], "two IBLs would share"),
     ],
 )
 def test_bad_input_is_one_line_exit_2_and_leaves_no_frames(cli, tmp_path, args, message):
     junk = tmp_path / "junk.exr"
     junk.write_bytes(b"\x76\x2f\x31\x01garbage")
     (tmp_path / "file").write_text("a file, not a folder")
-    args = [str(junk) if a == "JUNK" else a.replace("FILE", str(tmp_path / "file")) for a in args]
+    studio = tmp_path / "studio.exr"
+    studio.write_bytes(ibl.resolve("studio", 32).read_bytes())
+    named = {"JUNK": str(junk), "STUDIO_EXR": str(studio)}
+    args = [named.get(a, a.replace("FILE", str(tmp_path / "file"))) for a in args]
     if "-o" not in args:
         args += ["-o", str(tmp_path / "out")]
     r = cli("proof", *args, "-n", "1", "-m", "0", "-s", "2", "-r", "16", "8")

@@ -127,9 +127,10 @@ def proof(
     from lookdev.pipeline.proof import batch, ibl
 
     lib = Library(library or None)
-    names = presets or representative_presets(lib)
+    names = list(dict.fromkeys(presets or representative_presets(lib)))
     materials = [load_material(name, lib) for name in names]
-    environments = [ibl.load(name, ibl_width) for name in (ibls or ibl.builtin_names())]
+    ibl_names = list(dict.fromkeys(ibls or ibl.builtin_names()))
+    environments = [ibl.load(name, ibl_width) for name in ibl_names]
     if resolution[0] < 8 or resolution[1] < 8:
         raise batch.ProofError(f"resolution {resolution} is below 8×8", field="--resolution")
     batch.check_writable(output)

@@ -149,6 +149,7 @@ def run_job(job: Job) -> dict[str, Any]:
             doc["frames"] = sorted([*doc["frames"], entry], key=lambda e: e["index"])
             write_json(doc, folder / MANIFEST)
             rendered += 1
+    _remove_strays(folder, doc)
     doc["contact_sheet"] = file_entry(_sheet(job, doc))
     write_json(doc, folder / MANIFEST)
     return doc | {"rendered": rendered, "skipped": len(done)}
@@ -176,6 +177,14 @@ def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
             "noise_rmse": r.noise_rmse,
             "noise_relative": r.noise_relative,
         }
+
+
+def _remove_strays(folder: Path, doc: dict[str, Any]) -> None:
+    """Delete frame files the manifest does not list (left by a run with more frames)."""
+    keep = {f[kind]["file"] for f in doc["frames"] for kind in ("exr", "png")}
+    for path in folder.glob("frame_*"):
+        if path.name not in keep:
+            path.unlink(missing_ok=True)
 
 
 def _sheet(job: Job, doc: dict[str, Any]) -> Path:
@@ -214,6 +223,16 @@ def make_jobs(
     materials: list[Any], environments: list[Any], out: Path, settings: Settings
 ) -> list[Job]:
     """Every material under every environment (``ibl.Environment``), in that order."""
+    for kind, names in (
+        ("material", [m.name for m in materials]),
+        ("IBL", [e.name for e in environments]),
+    ):
+        slugs = [_slug(n) for n in names]
+        clash = next((n for n, sl in zip(names, slugs, strict=True) if slugs.count(sl) > 1), None)
+        if clash is not None:
+            raise ProofError(
+                f"two {kind}s would share the folder {_slug(clash)!r}; rename one", where=clash
+            )
     return [
         Job(m, env.name, env.pixels, out / _slug(m.name) / _slug(env.name), settings)
         for m in materials
