@@ -4,7 +4,7 @@ A reader never sees a half-written preset: the new bytes go to a hidden temporar
 beside the target, are flushed to disk, and replace the target in one ``os.replace``
 (atomic on POSIX and Windows), after which the folder entry itself is flushed. A process
 killed at any point leaves either the old file or the new one, plus at worst a stale
-hidden ``.NAME.toml.PID.tmp`` that listing ignores.
+hidden ``.NAME.toml.PID.tmp`` that listing ignores and the next locked write removes.
 
 Two processes writing into one library serialise on ``.lookdev.lock`` (``filelock``),
 so a read-modify-write (``presets set``) or a check-then-create (``presets new``) never
@@ -46,9 +46,16 @@ def locked(folder: Path, *, timeout: float = LOCK_TIMEOUT_S) -> Iterator[None]:
     except OSError as exc:
         raise unwritable(folder, exc) from None
     try:
+        _remove_stale_temporaries(folder)
         yield
     finally:
         lock.release()
+
+
+def _remove_stale_temporaries(folder: Path) -> None:
+    """Temporaries of killed saves: every writer holds the lock, so none is in use now."""
+    for tmp in folder.glob(".*.toml.*.tmp"):
+        tmp.unlink(missing_ok=True)
 
 
 def atomic_write(path: Path, data: bytes) -> None:

@@ -63,8 +63,10 @@ def test_sigkill_in_the_middle_of_a_save_leaves_the_old_file(tmp_path):
     assert lib.load("mine").params.roughness == 0.3
     # The stale temporary is invisible, and the dead process's lock does not block.
     assert lib.names().count("mine") == 1 and "mine" in lib.names()
+    assert list(tmp_path.glob(".mine.toml.*.tmp"))
     lib.update("mine", {"roughness": 0.5})
     assert lib.load("mine").params.roughness == 0.5
+    assert not list(tmp_path.glob(".mine.toml.*.tmp"))  # the next locked write cleans up
 
 
 KEYS = {
