@@ -18,6 +18,7 @@ from __future__ import annotations
 import html
 import json
 import os
+import urllib.parse
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -273,7 +274,8 @@ img.sheet{width:100%;max-width:960px}
 
 
 def _img(src: Path, base: Path, alt: str, cls: str = "") -> str:
-    rel = Path(os.path.relpath(src, base)).as_posix()
+    # URL-quoted: a '#' or '?' in a file name would otherwise end the path
+    rel = urllib.parse.quote(Path(os.path.relpath(src, base)).as_posix())
     c = f' class="{cls}"' if cls else ""
     return f'<img{c} src="{html.escape(rel)}" alt="{html.escape(alt)}">'
 
