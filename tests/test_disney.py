@@ -144,7 +144,7 @@ def test_each_lobe_sampling_matches_its_pdf_chi2(lobe, wo):
 
 def test_thin_glass_lobe_at_roughness_one_chi2():
     p = DisneyParams(spec_trans=1.0, roughness=1.0, thin=True, anisotropic=1.0)
-    r = chi2_details(disney.lobe_model("spec_trans"), p, _view(60), 100_000, 12)
+    r = chi2_details(disney.lobe_model("spec_trans"), p, _view(60), 100_000, 12, alpha=SIGNIFICANCE)
     assert r.passed, (r.p_value, r.statistic, r.dof)
 
 
@@ -494,3 +494,20 @@ def test_drjit_backend_equals_numpy_float32(mitsuba, params):
     assert same.mean() > 0.95
     # At α = 10⁻³ a pdf of 10⁵ moves by 10⁻³ of itself when wi moves by a float32 ulp.
     assert relative_difference(np.array(s_p)[same], n_p[same]) < 1e-2
+
+
+def test_bench_eval_prints_one_json_object_with_the_ratios(cli, mitsuba):
+    import json
+
+    r = cli("bench", "eval", "--n", "8000", "--repeat", "1", "--json")
+    assert r.code == 0, r.err
+    out = json.loads(r.out)
+    assert out["n"] == 8000 and len(out["materials"]) == 8
+    for key in ("ratio_drjit_to_mitsuba", "ratio_numpy_to_mitsuba", "evals_per_s_mitsuba"):
+        assert out[key] > 0 and math.isfinite(out[key])
+    assert out["numpy_dtype"] in ("float32", "float64")
+
+
+def test_bench_eval_rejects_a_bad_size_in_one_line(cli):
+    r = cli("bench", "eval", "--n", "10")
+    assert r.code == 2 and "Traceback" not in r.err
