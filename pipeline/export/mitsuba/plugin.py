@@ -48,37 +48,26 @@ _GLOSSY_R = "GlossyReflection"
 _DIFFUSE_T = "DiffuseTransmission"
 _GLOSSY_T = "GlossyTransmission"
 LOBE_KINDS: dict[str, str] = {
-    # Disney (Burley 2012, Schutte 2015)
+    # Disney (materials/disney.py LOBES) and Conty-Kulla (materials/sheen.py)
     "diffuse": _DIFFUSE_R,
-    "retro": _DIFFUSE_R,
-    "retro_reflection": _DIFFUSE_R,
-    "subsurface": _DIFFUSE_R,
-    "flatness": _DIFFUSE_R,
     "sheen": _GLOSSY_R,
     "specular": _GLOSSY_R,
     "clearcoat": _GLOSSY_R,
     "spec_trans": _GLOSSY_T,
-    "specular_transmission": _GLOSSY_T,
-    "transmission": _GLOSSY_T,
     "diff_trans": _DIFFUSE_T,
-    "diffuse_transmission": _DIFFUSE_T,
-    # Pixar (Smits): diffuse, specular, reflection and their transmitted twins
+    # Pixar (materials/pixar.py LOBES): the transmitted twins of the three lobes
     "reflection": _GLOSSY_R,
     "diffuse_t": _DIFFUSE_T,
     "specular_t": _GLOSSY_T,
     "reflection_t": _GLOSSY_T,
-    "diff": _DIFFUSE_R,
-    "spec": _GLOSSY_R,
-    "refl": _GLOSSY_R,
-    "diff_t": _DIFFUSE_T,
-    "spec_t": _GLOSSY_T,
-    "refl_t": _GLOSSY_T,
 }
 
 
 def lobes_of(prepared: Any) -> tuple[str, ...]:
     """The lobe names a prepared material kept (``prepared["lobes"]`` or ``.lobes``)."""
-    lobes = prepared.get("lobes") if isinstance(prepared, dict) else prepared.lobes
+    lobes = (
+        prepared.get("lobes") if isinstance(prepared, dict) else getattr(prepared, "lobes", None)
+    )
     if lobes is None:
         raise MitsubaExportError("the model's prepare() does not record its 'lobes'")
     return tuple(lobes)

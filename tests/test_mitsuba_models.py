@@ -1,0 +1,249 @@
+"""The shipped models (Disney, Conty-Kulla sheen, Pixar) through the Mitsuba plugin.
+
+Each passes ``mitsuba.chi2`` over a grid with the extremes, its Dr.Jit evaluation equals
+the numpy one to float32 precision, and a rendered sphere under a white sky shows the
+directional albedo the numpy backend computes.
+"""
+
+from __future__ import annotations
+
+import gc
+import math
+
+import numpy as np
+import pytest
+from _mitsuba_helpers import interaction as _interaction
+from _mitsuba_helpers import mitsuba_module
+from _mitsuba_helpers import pixel_view_angles as _pixel_view_angles
+from _mitsuba_helpers import unit as _unit
+
+from lookdev.materials.bsdf import evaluate
+
+pytestmark = pytest.mark.render
+_mi = pytest.fixture(scope="module", name="mi")(mitsuba_module)
+
+
+# -- the shipped models ------------------------------------------------------------------
+# (model, parameters, id, sharpest α or None): the grid of the issue, extremes included.
+CASES = [
+    ("sheen", {"roughness": 0.0}, "sheen-r0", None),
+    ("sheen", {"roughness": 0.3, "color": [0.9, 0.5, 0.3]}, "sheen-r0.3", None),
+    ("sheen", {"roughness": 1.0, "terminator_softening": False}, "sheen-r1-reciprocal", None),
+    ("disney", {"roughness": 0.0}, "disney-r0", 1e-3),
+    ("disney", {"roughness": 1.0}, "disney-r1", 1.0),
+    ("disney", {"roughness": 0.3, "anisotropic": 1.0}, "disney-aniso1", 0.028),
+    ("disney", {"metallic": 1.0, "roughness": 0.2}, "disney-metal", 0.04),
+    ("disney", {"metallic": 0.0, "roughness": 0.5, "specular_tint": 1.0}, "disney-tinted", 0.25),
+    ("disney", {"clearcoat": 1.0, "clearcoat_gloss": 1.0, "roughness": 0.6}, "disney-coat1", 1e-3),
+    ("disney", {"clearcoat": 1.0, "clearcoat_gloss": 0.5, "roughness": 0.6}, "disney-coat.5", 0.05),
+    ("disney", {"spec_trans": 1.0, "roughness": 0.1, "ior": 1.5}, "disney-glass", 0.01),
+    ("disney", {"spec_trans": 1.0, "roughness": 0.3, "thin": True}, "disney-thin-glass", 0.035),
+    ("disney", {"diff_trans": 0.7, "thin": True, "flatness": 0.5}, "disney-leaf", 0.25),
+    ("disney", {"sheen": 1.0, "sheen_tint": 0.5, "subsurface": 1.0}, "disney-sheen", 0.25),
+    (
+        "disney",
+        {"sheen": 1.0, "sheen_model": "conty_kulla", "sheen_roughness": 0.5},
+        "disney-ck-sheen",
+        0.25,
+    ),
+    # Pixar: "α" here is the reflection cone's half-angle in radians (10·r degrees).
+    ("pixar", {"roughness": 0.0}, "pixar-r0", math.radians(0.5)),
+    ("pixar", {"roughness": 0.3}, "pixar-r0.3", math.radians(3.0)),
+    ("pixar", {"roughness": 1.0}, "pixar-r1", None),
+    ("pixar", {"metallic": 1.0, "roughness": 0.4}, "pixar-metal", math.radians(4.0)),
+    ("pixar", {"clear": 1.0, "roughness": 0.6, "ior": 1.5}, "pixar-clear", math.radians(6.0)),
+    ("pixar", {"back": 1.0, "roughness": 0.8}, "pixar-back", None),
+]
+# Views: normal incidence, 60°, nearly grazing (85°), and from below for transmitters.
+VIEWS = {
+    "normal": (0.0, 0.0, 1.0),
+    "60deg": (math.sin(math.radians(60)), 0.0, math.cos(math.radians(60))),
+    "85deg": (math.sin(math.radians(85)), 0.0, math.cos(math.radians(85))),
+    "below": (0.3, 0.2, -0.93),
+}
+GLOBAL_MIN_ALPHA = 0.1  # narrower peaks need the zoomed chart (tests/_mitsuba_chi2.py)
+# Dr.Jit's backend evaluates both branches of a select on Python floats, and its expm1
+# then divides by log(1) = 0: Pixar's weightS at roughness 0 (a constant) raises.
+EXPM1_OF_FLOATS = "arrays.DrJitOps.expm1 divides by zero on Python floats near 0"
+
+
+def _known_failure(name, check):
+    """Run ``check``; a known model-side failure ends as xfail with its BSDFs released.
+
+    Mitsuba traces every live BSDF instance in a render's virtual calls, so one that
+    raises while traced must not outlive its test (a failing test's traceback would keep
+    it alive and break every later render).
+    """
+    if name != "pixar-r0":
+        return check()
+    try:
+        check()
+    except ZeroDivisionError:
+        raised = True
+    else:
+        raised = False
+    gc.collect()
+    if raised:
+        pytest.xfail(EXPM1_OF_FLOATS)
+    pytest.fail(f"{name} passes now: remove it from the known failures")
+
+
+def _case_params(model_name, values):
+    from lookdev.pipeline.export.mitsuba.plugin import MitsubaExportError
+    from lookdev.pipeline.export.mitsuba.scene import model_for
+
+    try:
+        model = model_for(model_name)
+    except MitsubaExportError as exc:
+        pytest.skip(str(exc))
+    return model, model.params_type.parse(values)
+
+
+def _plugin(mi, params):
+    from lookdev.pipeline.export.mitsuba.scene import bsdf_dict
+
+    d = bsdf_dict(params, allow_principled=False)
+    assert d["type"].startswith("lookdev_")
+    return d
+
+
+def _views(values):
+    transmits = any(values.get(k) for k in ("spec_trans", "diff_trans", "clear", "back"))
+    return [v for v in VIEWS if v != "below" or transmits]
+
+
+def _peaks(values, wi):
+    """(name, axis) of each narrow peak seen from ``wi``: mirror, refraction, or through."""
+    wi = _unit(wi)
+    peaks = [("mirror", np.array([-wi[0], -wi[1], wi[2]]))]
+    if values.get("spec_trans") and values.get("thin"):
+        peaks.append(("through", -wi))
+    elif values.get("spec_trans"):
+        eta = values.get("ior", 1.5) if wi[2] > 0 else 1.0 / values.get("ior", 1.5)
+        cos_t = -np.sign(wi[2]) * math.sqrt(1.0 - (1.0 - wi[2] ** 2) / eta**2)
+        peaks.append(("refract", -wi / eta + np.array([0.0, 0.0, wi[2] / eta + cos_t])))
+    return peaks
+
+
+GLOBAL_CASES = [
+    pytest.param(model, values, view, id=f"{name}-{view}")
+    for model, values, name, alpha in CASES
+    for view in _views(values)
+    if alpha is None or alpha >= GLOBAL_MIN_ALPHA
+]
+PEAK_CASES = [
+    pytest.param(model, values, view, peak, alpha, name, id=f"{name}-{view}-{peak}")
+    for model, values, name, alpha in CASES
+    if alpha is not None
+    for view in _views(values)
+    for peak, _ in _peaks(values, VIEWS[view])
+]
+
+CHI2_TESTS = len(GLOBAL_CASES) + len(PEAK_CASES)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("model_name", "values", "view"), GLOBAL_CASES)
+def test_chi2_whole_sphere(mi, model_name, values, view):
+    from _mitsuba_chi2 import chi2
+
+    _, params = _case_params(model_name, values)
+    passed, test = chi2(_plugin(mi, params), _unit(VIEWS[view]), test_count=CHI2_TESTS)
+    assert passed, test.messages
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("model_name", "values", "view", "peak", "alpha", "name"), PEAK_CASES)
+def test_chi2_zoomed_on_peak(mi, model_name, values, view, peak, alpha, name):
+    _known_failure(name, lambda: _chi2_zoomed(mi, model_name, values, view, peak, alpha))
+
+
+def _chi2_zoomed(mi, model_name, values, view, peak, alpha):
+    from _mitsuba_chi2 import chi2
+
+    _, params = _case_params(model_name, values)
+    axis = dict(_peaks(values, VIEWS[view]))[peak]
+    # A dozen lobe widths, but the chart (corners at 1.41 radii) stays off the horizon,
+    # where the density jumps to zero and no per-cell quadrature is accurate.
+    elevation = math.asin(min(abs(axis[2]) / np.linalg.norm(axis), 1.0))
+    radius = min(max(12.0 * alpha, 0.01), 0.6, elevation / 1.5)
+    passed, test = chi2(
+        _plugin(mi, params), _unit(VIEWS[view]), axis=axis, radius=radius, test_count=CHI2_TESTS
+    )
+    assert passed, test.messages
+
+
+@pytest.mark.parametrize(
+    ("model_name", "values", "name", "alpha"),
+    [pytest.param(*c, id=c[2]) for c in CASES],
+)
+def test_drjit_eval_equals_numpy_eval(mi, model_name, values, name, alpha):
+    _known_failure(name, lambda: _drjit_vs_numpy(mi, model_name, values))
+
+
+def _drjit_vs_numpy(mi, model_name, values):
+    model, params = _case_params(model_name, values)
+    rng = np.random.default_rng(7)
+    view = _unit(rng.normal(size=(2048, 3)))
+    light = _unit(rng.normal(size=(2048, 3)))
+    view[:64, 2] = np.abs(view[:64, 2]) * 1e-3  # grazing
+    view = _unit(view)
+    bsdf = mi.load_dict(_plugin(mi, params))
+    si = _interaction(mi, view)
+    got = np.array(bsdf.eval(mi.BSDFContext(), si, mi.Vector3f(light.astype(np.float32).T))).T
+    view32, light32 = np.array(si.wi).T.astype(np.float64), light.astype(np.float32)
+    want = evaluate(model, params, light32.astype(np.float64), view32) * np.abs(light32[:, 2:3])
+    assert np.all(np.isfinite(got))
+    scale = max(float(np.max(np.abs(want))), 1e-6)
+    np.testing.assert_allclose(got, want, rtol=2e-4, atol=2e-5 * scale)
+
+
+FURNACE_CASES = [
+    ("disney", {"roughness": 0.5, "base_color": [0.8, 0.4, 0.2]}, "disney-plastic"),
+    ("disney", {"metallic": 1.0, "roughness": 0.2}, "disney-metal"),
+    ("disney", {"clearcoat": 1.0, "roughness": 0.7, "base_color": [0.2, 0.3, 0.8]}, "disney-coat"),
+    ("disney", {"spec_trans": 1.0, "roughness": 0.0, "ior": 1.5}, "disney-glass"),
+    ("sheen", {"roughness": 0.3, "color": [0.9, 0.5, 0.3]}, "sheen"),
+    ("pixar", {"roughness": 0.5, "surface_color": [0.7, 0.3, 0.2]}, "pixar-plastic"),
+    ("pixar", {"metallic": 1.0, "roughness": 0.3}, "pixar-metal"),
+]
+
+
+@pytest.mark.parametrize(
+    ("model_name", "values"), [c[:2] for c in FURNACE_CASES], ids=[c[2] for c in FURNACE_CASES]
+)
+def test_white_furnace_sphere_matches_numpy_albedo(mi, model_name, values):
+    """Single scattering on a convex sphere under a white sky: radiance = albedo(θ)."""
+    from lookdev.pipeline.analysis.albedo import albedo_monte_carlo
+    from lookdev.pipeline.export.mitsuba.scene import scene_dict
+
+    model, params = _case_params(model_name, values)
+    scene = scene_dict(params, resolution=(32, 32), spp=512, max_depth=2)
+    scene["ball"]["bsdf"] = _plugin(mi, params)
+    image = np.array(mi.render(mi.load_dict(scene), seed=1))
+    rows, cols = np.mgrid[14:18, 14:18]
+    # The window's pixels see the sphere at three distinct angles (by symmetry).
+    theta, count = np.unique(np.round(_pixel_view_angles(scene, rows, cols), 9), return_counts=True)
+    albedo = albedo_monte_carlo(model, params, theta, n_samples=65536).albedo
+    expected = (albedo * count[:, None]).sum(axis=0) / count.sum()
+    got = image[14:18, 14:18].reshape(-1, 3).mean(axis=0)
+    np.testing.assert_allclose(got, expected, rtol=0.02, atol=2e-3)
+
+
+def test_sampled_eta_follows_refraction(mi):
+    import drjit as dr
+
+    _, params = _case_params("disney", {"spec_trans": 1.0, "roughness": 0.2, "ior": 1.5})
+    bsdf = mi.load_dict(_plugin(mi, params))
+    n = 4096
+    for side, want in ((1.0, 1.5), (-1.0, 1.0 / 1.5)):
+        si = dr.zeros(mi.SurfaceInteraction3f, n)
+        si.wi = mi.Vector3f(0.0, 0.0, side)
+        rng = np.random.default_rng(5)
+        u = rng.random((3, n))
+        bs, value = bsdf.sample(mi.BSDFContext(), si, mi.Float(u[0]), mi.Point2f(u[1], u[2]))
+        eta, z = np.array(bs.eta), np.array(bs.wo)[2]
+        ok = np.array(bs.pdf) > 0
+        assert np.any(ok & (z * side < 0)) and np.any(ok & (z * side > 0))
+        np.testing.assert_allclose(eta[ok & (z * side < 0)], want, rtol=1e-6)
+        np.testing.assert_allclose(eta[ok & (z * side > 0)], 1.0)
