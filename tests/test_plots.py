@@ -293,3 +293,20 @@ def test_lambertian_preset_views_match_closed_forms(lambertian_preset):
     n, inside = S.sphere_normals(32)
     expected = np.clip(n @ light, 0, None)[..., None] * RHO / math.pi * inside[..., None]
     np.testing.assert_allclose(img, expected, atol=1e-15)
+
+
+@pytest.mark.parametrize("model_name", ["disney", "pixar", "sheen"])
+@pytest.mark.parametrize("roughness", [0.0, 1.0])
+def test_views_of_every_model_are_finite_at_the_roughness_edges(model_name, roughness):
+    try:
+        model = P.model_named(model_name)
+    except P.PlotError:
+        pytest.skip(f"the {model_name} model has not landed yet")
+    params = model.params_type().replace(roughness=roughness)
+    with np.errstate(all="raise"):  # the views themselves must not over/underflow
+        _, _, f = P.brdf_slice(model, params, n=24)
+        _, lum = P.polar_curves(model, params, [0, 89.5], n=91)
+        (curve, *_) = P.albedo_curves(P.Subject(model_name, model, params), n_theta=10)
+        img = S.point_light_sphere(model, params, resolution=16)
+    for a in (f, lum, curve.albedo, curve.stderr, img):
+        assert np.all(np.isfinite(a)) and np.all(a >= 0)
