@@ -65,10 +65,19 @@ def _floored(xp: Any, p: Any) -> Any:
     return xp.maximum(p, xp.tiny)
 
 
+def _expm1(xp: Any, x: Any) -> Any:
+    """e^x − 1; a constant (a Python float, known when the kernel is traced) folds here.
+
+    Dr.Jit's select evaluates both branches on Python floats, so the shim's Kahan expm1
+    divides by log(1) = 0 for a constant near 0 (Smits' weightS at roughness 0).
+    """
+    return math.expm1(x) if isinstance(x, float) else xp.expm1(x)
+
+
 def weight(xp: Any, p: Any) -> Any:
     """weightS = p / (1 − e^(−p)) through expm1, continuous into its limit 1 at p = 0."""
     q = _floored(xp, p)
-    return q / -xp.expm1(-q)
+    return q / -_expm1(xp, -q)
 
 
 def distribution(xp: Any, sin2_h: Any, p: Any) -> Any:
@@ -108,7 +117,7 @@ def sample_half_vector(xp: Any, p: Any, u1: Any, u2: Any) -> Any:
     limit is taken outright where u (1 − e^(−p)) underflows.
     """
     q = _floored(xp, p)
-    x = u1 * xp.expm1(-q)
+    x = u1 * _expm1(xp, -q)
     s = xp.clip(xp.select(x == 0.0, u1, -xp.log1p(x) / q), 0.0, 1.0)
     sin_t = xp.sqrt(s)
     phi = 2.0 * math.pi * u2
