@@ -249,3 +249,13 @@ def test_schlick_edges():
     assert fr.schlick(XP, 0.04, np.float64(0.0)) == 1.0
     assert fr.schlick(XP, 0.04, np.float64(1.0)) == 0.04
     assert fr.schlick_weight(XP, np.float64(1.0 + 1e-9)) == 0.0
+
+
+@pytest.mark.parametrize("name", ["microfacet", "fresnel", "disney"])
+def test_doctests(name):
+    import doctest
+    import importlib
+
+    module = importlib.import_module(f"lookdev.materials.{name}")
+    result = doctest.testmod(module)
+    assert result.failed == 0 and result.attempted > 0
