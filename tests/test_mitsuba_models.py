@@ -7,7 +7,6 @@ directional albedo the numpy backend computes.
 
 from __future__ import annotations
 
-import gc
 import math
 
 import numpy as np
@@ -62,30 +61,6 @@ VIEWS = {
     "below": (0.3, 0.2, -0.93),
 }
 GLOBAL_MIN_ALPHA = 0.1  # narrower peaks need the zoomed chart (tests/_mitsuba_chi2.py)
-# Dr.Jit's backend evaluates both branches of a select on Python floats, and its expm1
-# then divides by log(1) = 0: Pixar's weightS at roughness 0 (a constant) raises.
-EXPM1_OF_FLOATS = "arrays.DrJitOps.expm1 divides by zero on Python floats near 0"
-
-
-def _known_failure(name, check):
-    """Run ``check``; a known model-side failure ends as xfail with its BSDFs released.
-
-    Mitsuba traces every live BSDF instance in a render's virtual calls, so one that
-    raises while traced must not outlive its test (a failing test's traceback would keep
-    it alive and break every later render).
-    """
-    if name != "pixar-r0":
-        return check()
-    try:
-        check()
-    except ZeroDivisionError:
-        raised = True
-    else:
-        raised = False
-    gc.collect()
-    if raised:
-        pytest.xfail(EXPM1_OF_FLOATS)
-    pytest.fail(f"{name} passes now: remove it from the known failures")
 
 
 def _case_params(model_name, values):
@@ -132,7 +107,7 @@ GLOBAL_CASES = [
     if alpha is None or alpha >= GLOBAL_MIN_ALPHA
 ]
 PEAK_CASES = [
-    pytest.param(model, values, view, peak, alpha, name, id=f"{name}-{view}-{peak}")
+    pytest.param(model, values, view, peak, alpha, id=f"{name}-{view}-{peak}")
     for model, values, name, alpha in CASES
     if alpha is not None
     for view in _views(values)
@@ -153,12 +128,8 @@ def test_chi2_whole_sphere(mi, model_name, values, view):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("model_name", "values", "view", "peak", "alpha", "name"), PEAK_CASES)
-def test_chi2_zoomed_on_peak(mi, model_name, values, view, peak, alpha, name):
-    _known_failure(name, lambda: _chi2_zoomed(mi, model_name, values, view, peak, alpha))
-
-
-def _chi2_zoomed(mi, model_name, values, view, peak, alpha):
+@pytest.mark.parametrize(("model_name", "values", "view", "peak", "alpha"), PEAK_CASES)
+def test_chi2_zoomed_on_peak(mi, model_name, values, view, peak, alpha):
     from _mitsuba_chi2 import chi2
 
     _, params = _case_params(model_name, values)
@@ -174,14 +145,9 @@ def _chi2_zoomed(mi, model_name, values, view, peak, alpha):
 
 
 @pytest.mark.parametrize(
-    ("model_name", "values", "name", "alpha"),
-    [pytest.param(*c, id=c[2]) for c in CASES],
+    ("model_name", "values"), [c[:2] for c in CASES], ids=[c[2] for c in CASES]
 )
-def test_drjit_eval_equals_numpy_eval(mi, model_name, values, name, alpha):
-    _known_failure(name, lambda: _drjit_vs_numpy(mi, model_name, values))
-
-
-def _drjit_vs_numpy(mi, model_name, values):
+def test_drjit_eval_equals_numpy_eval(mi, model_name, values):
     model, params = _case_params(model_name, values)
     rng = np.random.default_rng(7)
     view = _unit(rng.normal(size=(2048, 3)))
