@@ -243,9 +243,11 @@ def _selection(xp: Any, prep: dict[str, Any], wo: Any) -> dict[str, Any]:
     est = {}
     for lobe in prep["lobes"]:
         n, g = w[_PREFIX[lobe] + "N"], w[_PREFIX[lobe] + "G"]
-        # A diffuse lobe's albedo is exactly N + (G − N)/21 (∫ 2(1 − μ)⁵ μ dμ = 1/21).
-        blend = n + (g - n) / 21.0 if lobe.startswith("diffuse") else None
-        est[lobe] = _mean(blend if blend is not None else lobes.frn_blend(xp, n, g, wo[2]))
+        if lobe.startswith("diffuse"):
+            albedo = n + (g - n) / 21.0  # exact: ∫ 2(1 − μ)⁵ μ dμ = 1/21
+        else:
+            albedo = lobes.frn_blend(xp, n, g, wo[2])  # the highlight's weight at its peak
+        est[lobe] = _mean(albedo)
     total = sum(est.values()) if est else 0.0
     inv = xp.select(total > 0.0, 1.0 / xp.maximum(total, xp.tiny), 0.0)
     return {lobe: e * inv for lobe, e in est.items()}
