@@ -229,13 +229,14 @@ def test_package_holds_stage_and_textures(tmp_path):
     scratch = tmp_path / "scratch"
     scratch.mkdir()
     source = source_for(material, scratch / "tex", MAP_RES, scratch=scratch)
-    result = export_usd([source], tmp_path / "r.usdz", contexts=CONTEXTS)
+    result = export_usd([source], tmp_path / "r.usdz", contexts=CONTEXTS, workdir=scratch)
     assert result.files == [tmp_path / "r.usdz"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.usdz", "scratch"]
     with zipfile.ZipFile(tmp_path / "r.usdz") as z:
         names = z.namelist()
     assert names[0].endswith(".usdc")
     assert sum(n.endswith(".exr") for n in names) == len(result.images)
+    assert all(n.startswith("tex/") for n in names[1:])  # packaged by their path from the stage
     assert validate_usd(tmp_path / "r.usdz").ok
 
 

@@ -120,7 +120,13 @@ def export_usd(
                 source_for(material, texture_dir, resolution, scratch=Path(scratch), bake=bake_maps)
             )
         result = write(
-            sources, out, contexts=contexts, mtlx_path=mtlx_file, package=package, split_dir=split
+            sources,
+            out,
+            contexts=contexts,
+            mtlx_path=mtlx_file,
+            package=package,
+            split_dir=split,
+            workdir=Path(scratch),
         )
     summary = {
         "output": str(result.files[0]),

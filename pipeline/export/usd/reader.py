@@ -201,7 +201,9 @@ def _read_surface(net, surface, context, model, values, result) -> None:
             continue  # there `ior` only refracts and equals the specular's IOR by construction
         given = surface.inputs.get(slot.input)
         if given is not None and isinstance(given[1], Connection):
-            result.maps[slot.param] = _texture_file(nodes, given[1])
+            path = _texture_file(nodes, given[1])  # None for a live mix chain
+            if path is not None:
+                result.maps.setdefault(slot.param, path)
         elif given is not None:
             values[slot.param] = slot.from_target(given[1])
         elif defaults is not None and slot.input in defaults:

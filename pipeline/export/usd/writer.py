@@ -243,11 +243,14 @@ def export_usd(
     mtlx_path: Path | None = None,
     package: bool = False,
     split_dir: Path | None = None,
+    workdir: Path | None = None,
 ) -> ExportResult:
     """Export ``sources`` to ``out`` (``.usda``/``.usdc``/``.usd``, or ``.usdz`` to package).
 
     ``split_dir``: one file per material there, ``out`` a library referencing them.
-    ``mtlx_path``: also a standalone MaterialX document. Nothing is left behind on error.
+    ``mtlx_path``: also a standalone MaterialX document. ``workdir`` (packages): where the
+    stage is staged before packaging; textures below it keep their path relative to it
+    inside the ``.usdz``. Nothing is left behind on error.
     """
     out = Path(out)
     package = package or out.suffix == ".usdz"
@@ -267,7 +270,13 @@ def export_usd(
     check_images(images)
     staging = Staging()
     try:
-        files = _write_all(specs, images, out, mtlx_path, package, split_dir, staging)
+        if package:
+            files = _write_package(specs, images, out, Path(workdir or out.parent), staging)
+        else:
+            files = _write_all(specs, images, out, mtlx_path, split_dir, staging)
+        if mtlx_path is not None:
+            mtlx.write_document(specs, staging.temp_for(Path(mtlx_path)), where=mtlx_path)
+            files.append(Path(mtlx_path))
         staging.commit()
     except BaseException:
         staging.abort()
@@ -289,34 +298,56 @@ def _check_names(specs: list[MaterialSpec], out: Path) -> None:
         raise ExportError("no materials to export", where=str(out))
 
 
-def _write_all(specs, images, out, mtlx_path, package, split_dir, staging) -> list[Path]:
+def _write_all(specs, images, out, mtlx_path, split_dir, staging) -> list[Path]:
     for image in images:
         if image.write:
             staging.folder(image.path.parent)
-            target = image.path if package else staging.temp_for(image.path)
-            if image.origin is not None:
-                shutil.copyfile(image.origin, target)
-            else:
-                write_image(target, image.pixels)
-    files = [out, *(i.path for i in images if i.write and not package)]
+            _write_image(image, staging.temp_for(image.path))
+    files = [out, *(i.path for i in images if i.write)]
     if split_dir is not None:
         staging.folder(Path(split_dir))
-        files += _write_split(specs, out, Path(split_dir), staging)
-    else:
-        layer = new_layer()
-        paths = author(layer, specs, out.parent)
-        if len(specs) > 1:
-            add_switch(
-                layer, {prim_name(s.name): ("", p) for s, p in zip(specs, paths, strict=True)}
-            )
-        if package:
-            _package(layer, out, staging)
-        else:
-            _export_layer(layer, staging.temp_for(out))
-    if mtlx_path is not None:
-        mtlx.write_document(specs, staging.temp_for(Path(mtlx_path)), where=mtlx_path)
-        files.append(Path(mtlx_path))
+        return files + _write_split(specs, out, Path(split_dir), staging)
+    layer = _one_layer(specs, out.parent)
+    _export_layer(layer, staging.temp_for(out))
     return files
+
+
+def _write_package(specs, images, out: Path, workdir: Path, staging: Staging) -> list[Path]:
+    """A ``.usdz`` holding the stage and every texture it references."""
+    from pxr import UsdUtils
+
+    for image in images:
+        if image.write:
+            image.path.parent.mkdir(parents=True, exist_ok=True)
+            _write_image(image, image.path)
+    root = workdir / f"{out.stem}.usdc"  # the package's root layer keeps the output's name
+    if root.exists():  # not a private folder: never overwrite what is there
+        fd, name = tempfile.mkstemp(prefix=f".{out.stem}.", suffix=".usdc", dir=workdir)
+        os.close(fd)
+        root = Path(name)
+    try:
+        _export_layer(_one_layer(specs, workdir), root)
+        if not UsdUtils.CreateNewUsdzPackage(str(root), str(staging.temp_for(out))):
+            raise ExportError("USD could not write the package", where=str(out))
+    finally:
+        root.unlink(missing_ok=True)
+    return [out]
+
+
+def _one_layer(specs: list[MaterialSpec], base: Path):
+    """Every material in one layer, with the ``/Look`` switch when there are several."""
+    layer = new_layer()
+    paths = author(layer, specs, base)
+    if len(specs) > 1:
+        add_switch(layer, {prim_name(s.name): ("", p) for s, p in zip(specs, paths, strict=True)})
+    return layer
+
+
+def _write_image(image: Image, target: Path) -> None:
+    if image.origin is not None:
+        shutil.copyfile(image.origin, target)
+    else:
+        write_image(target, image.pixels)
 
 
 def _write_split(specs, out: Path, folder: Path, staging: Staging) -> list[Path]:
@@ -343,18 +374,3 @@ def _write_split(specs, out: Path, folder: Path, staging: Staging) -> list[Path]
 def _export_layer(layer, path: Path) -> None:
     if not layer.Export(str(path)):
         raise ExportError("USD could not write the layer", where=str(path))
-
-
-def _package(layer, out: Path, staging: Staging) -> None:
-    """A ``.usdz`` holding the layer and every texture it references."""
-    from pxr import UsdUtils
-
-    fd, name = tempfile.mkstemp(prefix=f".{out.stem}.", suffix=".usdc", dir=out.parent)
-    os.close(fd)
-    root = Path(name)
-    try:
-        _export_layer(layer, root)
-        if not UsdUtils.CreateNewUsdzPackage(str(root), str(staging.temp_for(out))):
-            raise ExportError("USD could not write the package", where=str(out))
-    finally:
-        root.unlink(missing_ok=True)
