@@ -273,7 +273,7 @@ def export_usd(
         if package:
             files = _write_package(specs, images, out, Path(workdir or out.parent), staging)
         else:
-            files = _write_all(specs, images, out, mtlx_path, split_dir, staging)
+            files = _write_all(specs, images, out, split_dir, staging)
         if mtlx_path is not None:
             mtlx.write_document(specs, staging.temp_for(Path(mtlx_path)), where=mtlx_path)
             files.append(Path(mtlx_path))
@@ -298,7 +298,7 @@ def _check_names(specs: list[MaterialSpec], out: Path) -> None:
         raise ExportError("no materials to export", where=str(out))
 
 
-def _write_all(specs, images, out, mtlx_path, split_dir, staging) -> list[Path]:
+def _write_all(specs, images, out, split_dir, staging) -> list[Path]:
     for image in images:
         if image.write:
             staging.folder(image.path.parent)
