@@ -149,18 +149,20 @@ def lambda_fit() -> Callable[[np.ndarray, float], np.ndarray] | None:
 
 
 def render_cases(library: Any = None) -> tuple[list[tuple[str, dict, int]], dict[str, str]]:
-    """(label, Mitsuba BSDF dict, max depth) per render case, and the reasons for gaps."""
-    cases, missing = [], {}
+    """(label, Mitsuba BSDF dict, max depth) per render case, as the proofs build them,
+    and the reasons for any gaps."""
     try:
         from lookdev.library import load_material
-        from lookdev.pipeline.export.mitsuba import bsdf_dict, max_depth_for, register_plugins
+        from lookdev.pipeline.export.mitsuba import register_plugins
+        from lookdev.pipeline.proof.turntable import material_bsdf
     except ImportError as exc:
         return [], {f"render: {label}": f"not available: {exc}" for label in RENDER_PRESETS}
     register_plugins()
+    cases, missing = [], {}
     for label, preset in RENDER_PRESETS.items():
         try:
-            material = load_material(preset, library)
-            cases.append((f"{label} ({preset})", bsdf_dict(material), max_depth_for(material)))
+            bsdf, depth = material_bsdf(load_material(preset, library))
+            cases.append((f"{label} ({preset})", bsdf, depth))
         except LookdevError as exc:
             missing[f"render: {label}"] = str(exc)
     return cases, missing

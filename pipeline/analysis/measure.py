@@ -260,42 +260,6 @@ def relative_mse(image: np.ndarray, reference: np.ndarray, eps: float = 1e-2) ->
     return float(np.mean((image - reference) ** 2 / (reference**2 + eps)))
 
 
-def proof_scene(bsdf: dict, environment: np.ndarray, resolution: int, max_depth: int) -> Any:
-    """A sphere on black, lit by ``environment``, seen by a perspective camera.
-
-    The environment is hidden from the camera and alpha is kept, so the error is taken
-    over the material's pixels only, not diluted by a noiseless background.
-    """
-    import mitsuba as mi
-
-    return mi.load_dict(
-        {
-            "type": "scene",
-            "integrator": {"type": "path", "max_depth": max_depth, "hide_emitters": True},
-            "sensor": {
-                "type": "perspective",
-                "fov": 30,
-                "to_world": mi.ScalarTransform4f().look_at(
-                    origin=[0, 0, 4.2], target=[0, 0, 0], up=[0, 1, 0]
-                ),
-                "film": {
-                    "type": "hdrfilm",
-                    "width": resolution,
-                    "height": resolution,
-                    "pixel_format": "rgba",
-                    "rfilter": {"type": "box"},
-                },
-                "sampler": {"type": "independent"},
-            },
-            "emitter": {
-                "type": "envmap",
-                "bitmap": mi.Bitmap(np.ascontiguousarray(environment, dtype=np.float32)),
-            },
-            "shape": {"type": "sphere", "bsdf": bsdf},
-        }
-    )
-
-
 def bench_render(
     case: str,
     bsdf: dict,
@@ -308,20 +272,22 @@ def bench_render(
 ) -> list[Row]:
     """relMSE against a ``reference_spp`` render, and render time, for each rung.
 
-    The reference's own noise adds about ``spp / reference_spp`` of a rung's relMSE
-    (6 % at 64 against 1024 spp); the time is the best of two renders after a warm-up
-    render that compiles the kernels.
+    The scene is the proofs' own (:class:`lookdev.pipeline.proof.turntable.Turntable`:
+    shader ball and cup under ``environment``) at ``2·resolution × resolution``, and the
+    error is taken over the whole frame, as the proofs' noise estimate is. The
+    reference's own noise adds about ``spp / reference_spp`` of a rung's relMSE (6 % at
+    64 against 1024 spp); the time is the best of two renders after a warm-up render
+    that compiles the kernels.
     """
-    import mitsuba as mi
+    from lookdev.pipeline.proof.turntable import Turntable
 
-    scene = proof_scene(bsdf, environment, resolution, max_depth)
+    size = (2 * resolution, resolution)
+    table = Turntable(bsdf, np.asarray(environment, dtype=np.float32), size, max_depth)
 
     def render(spp: int, seed: int) -> np.ndarray:
-        return np.array(mi.render(scene, spp=spp, seed=seed), dtype=np.float64)
+        return table.render(spp, seed).astype(np.float64)
 
     reference = render(reference_spp, seed=10_000)
-    covered = reference[..., 3] > 0.5
-    reference = reference[covered, :3]
     rows = []
     for k, spp in enumerate(ladder):
         image, t = timed(lambda spp=spp, k=k: render(spp, seed=k + 1), repeat=2)
@@ -331,9 +297,9 @@ def bench_render(
                 case,
                 "path tracer",
                 f"{spp} spp",
-                relative_mse(image[covered, :3], reference),
+                relative_mse(image, reference),
                 t,
-                resolution * resolution * spp,
+                size[0] * size[1] * spp,
                 f"{reference_spp} spp render",
             )
         )
