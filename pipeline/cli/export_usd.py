@@ -176,9 +176,9 @@ def import_usd(
     """Read materials from a USD file back into presets.
 
     Reads UsdPreviewSurface networks from any tool, and lookdev's own MaterialX and
-    RenderMan networks, which carry every parameter. A parameter fed by a texture is
-    listed with its map's path (a preset holds constants; bake the map into a layered
-    preset to use it).
+    RenderMan networks, which carry every parameter. A preset holds constants: a
+    parameter fed by a texture is named with its map's path in a comment of the TOML
+    (and under "maps" with --json), and what a surface could not say is listed too.
 
     Examples:
 
