@@ -221,12 +221,16 @@ class DrJitOps:
 
     def log1p(self, x: Any) -> Any:
         # Dr.Jit has no log1p: Goldberg's trick makes log(1 + x) exact to a few ulp.
+        if isinstance(x, int | float):
+            return math.log1p(x)
         dr = self.dr
         u = 1.0 + x
         return dr.select(u == 1.0, x, dr.log(u) * x / (u - 1.0))
 
     def expm1(self, x: Any) -> Any:
         # Kahan's trick for exp(x) - 1, stable near zero.
+        if isinstance(x, int | float):
+            return math.expm1(x)
         dr = self.dr
         u = dr.exp(x)
         return dr.select(u == 1.0, x, dr.select(u - 1.0 == -1.0, -1.0, (u - 1.0) * x / dr.log(u)))

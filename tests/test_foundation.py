@@ -104,3 +104,13 @@ def test_drjit_shim_matches_numpy_on_stable_forms():
     assert np.allclose(got, np.log1p(x), rtol=1e-6)
     got = np.array(dj.expm1(dj.Float(x)))
     assert np.allclose(got, np.expm1(x), rtol=1e-5)
+
+
+def test_drjit_stable_forms_take_python_floats():
+    from lookdev.materials.arrays import DrJitOps
+    from lookdev.pipeline.variant import use_mitsuba
+
+    use_mitsuba()
+    dj = DrJitOps.for_mitsuba()
+    for x in (0.0, 1e-12, 0.5):
+        assert dj.log1p(x) == math.log1p(x) and dj.expm1(x) == math.expm1(x)
