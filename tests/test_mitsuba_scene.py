@@ -144,7 +144,9 @@ def test_xml_loads_and_renders_like_the_dict(mi, m, tmp_path):
     trans = np.zeros((4, 4), np.float32)
     trans[:2] = 0.5
     blended = _blended(translucency=trans)
-    path = xml.export_scene(blended, tmp_path / "out" / "scene.xml", resolution=(16, 16), spp=8)
+    path = tmp_path / "out" / "scene.xml"
+    written = xml.export_scene(blended, path, resolution=(16, 16), spp=8)
+    assert written["ball"]["bsdf"]["translucency"]["filename"].endswith("tiled_translucency.exr")
     text = path.read_text()
     first = text.splitlines()[0]
     assert first.startswith("<!--") and "register_plugins()" in first and first.endswith("-->")
@@ -267,6 +269,7 @@ def test_cli_export_mitsuba(mi, cli, disney, tmp_path):
     assert result.code == 0, result.err
     summary = json.loads(result.out)
     assert summary["scene"] == str(out) and summary["max_depth"] == 4
+    assert summary["bsdf"] == "principled" and not summary["plugins"]  # untextured metal
     assert np.all(np.isfinite(np.array(mi.render(mi.load_file(str(out))))))
 
 
@@ -339,7 +342,8 @@ def test_cli_exports_a_layered_preset_with_its_maps(mi, cli, disney, tmp_path):
     )
     assert result.code == 0, result.err
     summary = json.loads(result.out)
-    assert summary["plugins"] and len(summary["textures"]) >= 2
+    assert summary["plugins"] and summary["bsdf"] == "lookdev_disney"
+    assert len(summary["textures"]) >= 2
     assert all(p.startswith(str(tmp_path / "rust_textures")) for p in summary["textures"])
     assert out.read_text().startswith("<!-- lookdev BSDF plugins")
     image = np.array(mi.render(mi.load_file(str(out))))

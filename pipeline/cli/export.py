@@ -91,8 +91,8 @@ def mitsuba(
       lookdev export mitsuba rusty_iron -o rust/scene.xml --ibl studio --spp 64
     """
     from lookdev.library import Library, load_material
-    from lookdev.pipeline.export.mitsuba import MitsubaExportError, export_scene, max_depth_for
-    from lookdev.pipeline.export.mitsuba.scene import flatten
+    from lookdev.pipeline.export.mitsuba import MitsubaExportError, export_scene
+    from lookdev.pipeline.export.mitsuba.scene import files_of, flatten, uses_our_plugins
 
     if min(resolution) < 1:
         raise MitsubaExportError(
@@ -102,29 +102,30 @@ def mitsuba(
     material = load_material(preset, Library(library or None))
     env = _environment(environment)
     with console.status(f"exporting {material.name}…", spinner="dots"):
-        flat = flatten(material, map_resolution)
-        path = export_scene(
-            flat,
+        scene = export_scene(
+            flatten(material, map_resolution),
             output,
             resolution=resolution,
             spp=spp,
             environment=env,
             force_all_lobes=force_all_lobes,
         )
-    written = sorted(str(p) for p in (path.parent / f"{path.stem}_textures").glob("*.exr"))
-    with path.open(encoding="utf-8") as handle:
-        uses_plugins = "register_plugins()" in handle.readline()
+    bsdf = scene["ball"]["bsdf"]
     summary = {
         "preset": material.name,
-        "scene": str(path),
-        "textures": written,
-        "max_depth": max_depth_for(flat),
-        "plugins": uses_plugins,
+        "scene": str(output),
+        "bsdf": bsdf["bsdf"]["type"] if bsdf["type"] == "normalmap" else bsdf["type"],
+        "plugins": uses_our_plugins(scene),
+        "max_depth": scene["integrator"]["max_depth"],
+        "textures": [f for f in files_of(scene) if f != str(env)],
     }
     if as_json:
         print_json(summary)
         return
-    console.print(f"wrote [bold]{path}[/] ({len(written)} maps, max_depth {summary['max_depth']})")
+    console.print(
+        f"wrote [bold]{output}[/]: {summary['bsdf']}, {len(summary['textures'])} maps, "
+        f"max_depth {summary['max_depth']}"
+    )
     if summary["plugins"]:
         console.print(
             "load it after: import lookdev.pipeline.export.mitsuba as m; m.register_plugins()",

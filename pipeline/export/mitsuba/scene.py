@@ -388,3 +388,12 @@ def uses_our_plugins(tree: Mapping[str, Any]) -> bool:
     if str(tree.get("type", "")).startswith("lookdev_"):
         return True
     return any(isinstance(v, Mapping) and uses_our_plugins(v) for v in tree.values())
+
+
+def files_of(tree: Mapping[str, Any]) -> list[str]:
+    """Every ``filename`` a scene or BSDF dict refers to (textures, environment maps)."""
+    out = [str(v) for k, v in tree.items() if k == "filename"]
+    for value in tree.values():
+        if isinstance(value, Mapping):
+            out += files_of(value)
+    return out

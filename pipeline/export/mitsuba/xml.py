@@ -136,12 +136,17 @@ def write_xml(tree: Mapping[str, Any], path: str | Path) -> Path:
     return path
 
 
-def export_scene(material: Any, path: str | Path, **scene_options: Any) -> Path:
-    """Write ``material``'s export scene to ``path``; maps go to ``<stem>_textures/``."""
+def export_scene(material: Any, path: str | Path, **scene_options: Any) -> dict[str, Any]:
+    """Write ``material``'s export scene to ``path``; maps go to ``<stem>_textures/``.
+
+    Returns the scene dict that was written (texture paths absolute).
+    """
     path = Path(path)
     _check_writable(path.parent)
     textures = path.parent.resolve() / f"{path.stem}_textures"
-    return write_xml(scene_dict(material, texture_dir=textures, **scene_options), path)
+    scene = scene_dict(material, texture_dir=textures, **scene_options)
+    write_xml(scene, path)
+    return scene
 
 
 def _check_writable(folder: Path) -> None:
