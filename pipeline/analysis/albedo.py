@@ -151,12 +151,12 @@ def _stratified_uniforms(rng: np.random.Generator, n: int) -> np.ndarray:
 def sheen_table(params: Any, cos_theta: np.ndarray) -> np.ndarray:
     """Conty-Kulla sheen: its shipped E(μ, r) table (F = 1) times the sheen colour F.
 
-    The table is made with the terminator softening on (eq. 4); with it off the
-    difference is the table's error, which the error bench measures.
+    The model ships one table with the terminator softening (eq. 4) and one without;
+    the one matching ``params.terminator_softening`` is read.
     """
     from lookdev.materials import sheen
 
-    e = sheen.albedo(cos_theta, params.roughness)
+    e = sheen.albedo(cos_theta, params.roughness, params.terminator_softening)
     return e[..., None] * np.asarray(params.color, dtype=np.float64)
 
 
