@@ -28,7 +28,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from lookdev.materials.errors import ParameterError
 from lookdev.materials.layers import ConstantMask, LayerSpec
-from lookdev.materials.params import DisneyParams, Params
+from lookdev.materials.params import DisneyParams, Params, parameter_error
 from lookdev.materials.pixar import PixarParams
 
 from .errors import PresetError
@@ -155,12 +155,19 @@ def parse_toml(data: bytes, *, where: str) -> dict[str, Any]:
 
 
 def check_params(model: str, params: dict[str, Any], *, where: str | None, prefix: str = "params"):
-    """Validate ``params`` against ``model``'s schema; errors name ``prefix.field``."""
+    """Validate ``params`` against ``model``'s schema; errors name ``prefix.field``.
+
+    Strictly, as TOML is typed: ``roughness = "0.5"`` or ``roughness = true`` is a typo,
+    not 0.5 or 1.0 (pydantic's lax mode would take both). TOML arrays become the tuples
+    that strict validation wants for colours.
+    """
+    data = {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
     try:
-        return MODELS[model].parse(params)
-    except ParameterError as exc:
-        field = f"{prefix}.{exc.field}" if exc.field else prefix
-        raise ParameterError(exc.message, where=where, field=field) from None
+        return MODELS[model].model_validate(data, strict=True)
+    except ValidationError as exc:
+        err = parameter_error(exc)
+        field = f"{prefix}.{err.field}" if err.field else prefix
+        raise ParameterError(err.message, where=where, field=field) from None
 
 
 def _validate(doc: dict[str, Any], *, where: str) -> PresetFile:

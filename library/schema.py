@@ -4,7 +4,8 @@ Editors that read JSON Schema for TOML (Taplo / Even Better TOML, via a
 ``#:schema ./preset.schema.json`` first line or their settings) then complete field
 names, show the descriptions and ranges, and flag mistakes while typing. The schema
 is the pydantic one plus what pydantic cannot see: ``[params]`` follows the preset's
-``model``, colours may also be ``"#rrggbb"`` strings, and a bare number is a mask.
+``model``, a colour may also be a ``"#rrggbb"`` string or one grey number, and a bare
+number is a mask.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from lookdev.materials.params import Params, parse_color
 from .preset import MODELS, NAME_RE, PresetFile
 
 HEX_COLOR = {"type": "string", "pattern": "^#?[0-9a-fA-F]{6}$", "description": "sRGB '#rrggbb'"}
+GREY = {"type": "number", "minimum": 0, "maximum": 1, "description": "grey: r = g = b"}
 BARE_MASK = {"type": "number", "minimum": 0, "maximum": 1, "description": "constant mask"}
 
 
@@ -43,7 +45,7 @@ def params_schema(cls: type[Params], defs: dict[str, Any]) -> dict[str, Any]:
         if any(getattr(m, "func", None) is parse_color for m in field.metadata):
             prop = schema["properties"][name]
             meta = {k: prop.pop(k) for k in ("title", "description", "default") if k in prop}
-            schema["properties"][name] = {"anyOf": [prop, HEX_COLOR], **meta}
+            schema["properties"][name] = {"anyOf": [prop, HEX_COLOR, GREY], **meta}
     return schema
 
 

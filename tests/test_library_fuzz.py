@@ -7,12 +7,16 @@ never another exception, never a multi-line message.
 
 from __future__ import annotations
 
+import jsonschema
 import tomli_w
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
-from lookdev.library import Library, Material, dump_preset, read_preset
+from lookdev.library import Library, Material, PresetFile, dump_preset, read_preset
 from lookdev.library.index import read_header
+from lookdev.library.library import apply_changes
+from lookdev.library.preset import build_preset
+from lookdev.library.schema import preset_schema
 from lookdev.materials.errors import LookdevError
 from lookdev.materials.params import DisneyParams
 
@@ -140,3 +144,38 @@ def test_generated_documents_that_load_round_trip(tmp_path, doc):
     again.parent.mkdir(exist_ok=True)
     again.write_text(dump_preset(read_preset(path)))
     assert library.load_file(again).params == material.params
+
+
+SCHEMA = jsonschema.Draft202012Validator(preset_schema())
+
+
+@SETTINGS
+@given(doc=documents())
+def test_the_json_schema_accepts_every_file_the_loader_accepts(doc):
+    # Editors must never flag a preset lookdev loads (the converse needs other files).
+    try:
+        build_preset(doc, where="p.toml")
+    except LookdevError:
+        return
+    errors = [e.message for e in SCHEMA.iter_errors(doc)]
+    assert not errors, errors
+
+
+@SETTINGS
+@given(
+    changes=st.dictionaries(
+        st.sampled_from([*PARAM_NAMES, "description", "tags", "extends", "name", "params.x"]),
+        st.one_of(st.none(), wild_values, unit),
+        max_size=3,
+    )
+)
+def test_any_set_either_applies_or_fails_in_one_line(changes):
+    base = PresetFile(name="p", extends="gold", params={"roughness": 0.3})
+    try:
+        edited = apply_changes(base, changes, where="p.toml")
+    except LookdevError as exc:
+        assert "\n" not in str(exc)
+        return
+    for key, value in changes.items():
+        if value is not None and key in PARAM_NAMES:
+            assert edited.params[key] == value
