@@ -318,7 +318,8 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
         if not xp.known_zero(c):
             # The glass reflects the exact Fresnel on either side; inside, nothing else does.
             f_exact = fr.dielectric(xp, cos_d, _pick(xp, front, pr["eta"], 1.0 / pr["eta"]))
-            terms.append((None, f_exact * dg * _pick(xp, front, c, pr["glass"])))
+            k = f_exact * dg * _pick(xp, front, c, pr["glass"])
+            terms.append((None if isinstance(scale, float) else scale, k))
     if "diffuse" in lobes:
         shape = _diffuse_shape(xp, pr, ci, co, cos2_d)
         k = _times(pr["diffuse"] * INV_PI * shape, front)
