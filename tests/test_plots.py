@@ -310,3 +310,12 @@ def test_views_of_every_model_are_finite_at_the_roughness_edges(model_name, roug
         img = S.point_light_sphere(model, params, resolution=16)
     for a in (f, lum, curve.albedo, curve.stderr, img):
         assert np.all(np.isfinite(a)) and np.all(a >= 0)
+
+
+def test_clear_glass_albedo_adds_the_transmitted_share_compressed_by_eta_squared():
+    glass = _preset("glass_clear")
+    total = P.total_curve(glass, n_theta=3)
+    eta = glass.params.ior
+    f0 = ((eta - 1) / (eta + 1)) ** 2  # Fresnel at normal incidence, an independent number
+    assert total.albedo[0] == pytest.approx(np.full(3, f0 + (1 - f0) / eta**2), rel=0.02)
+    assert P.total_curve(_preset("gold")) is None  # an opaque metal transmits nothing

@@ -169,10 +169,35 @@ def albedo_curves(subject: Subject, n_theta: int = 46) -> list:
     return [mc] + ([table] if table is not None else [])
 
 
+def total_curve(subject: Subject, n_theta: int = 46):
+    """Reflected plus transmitted albedo, or None for a model that transmits nothing.
+
+    Same seed and samples as the reflected curve, so the two differ exactly by what
+    went through the surface. Transmitted radiance is compressed by 1/η² entering a
+    denser medium, so clear glass totals 0.04 + 0.96/1.52² ≈ 0.46 here, not 1.
+    """
+    theta = np.radians(np.linspace(0.0, 89.5, n_theta))
+    both = albedo_monte_carlo(
+        subject.model, subject.params, theta, n_samples=ALBEDO_SAMPLES, hemisphere="both"
+    )
+    reflect = albedo_monte_carlo(subject.model, subject.params, theta, n_samples=ALBEDO_SAMPLES)
+    return both if np.any(both.albedo > reflect.albedo) else None
+
+
 def draw_albedo(ax: Any, subject: Subject) -> None:
     mc, *table = albedo_curves(subject)
+    total = total_curve(subject)
     deg = np.degrees(mc.theta)
     for c, colour in enumerate(CHANNEL_COLOURS):
+        if total is not None:
+            ax.plot(
+                deg,
+                total.albedo[:, c],
+                "-.",
+                color=colour,
+                lw=1,
+                label="reflected + transmitted" if c == 0 else None,
+            )
         ax.plot(deg, mc.albedo[:, c], color=colour, lw=1.6, label="RGB"[c])
         lo, hi = mc.albedo[:, c] - 2 * mc.stderr[:, c], mc.albedo[:, c] + 2 * mc.stderr[:, c]
         ax.fill_between(deg, lo, hi, color=colour, alpha=0.2, lw=0, label="±2σ" if c == 0 else None)
@@ -187,11 +212,12 @@ def draw_albedo(ax: Any, subject: Subject) -> None:
             )
     ax.axhline(1.0, color="0.4", ls=":", lw=1)  # above it the material creates energy
     ax.set_xlim(0, 90)
-    ax.set_ylim(0, max(1.05, float(mc.albedo.max()) * 1.1))
+    top = mc.albedo.max() if total is None else max(mc.albedo.max(), total.albedo.max())
+    ax.set_ylim(0, max(1.05, float(top) * 1.1))
     ax.set_xlabel("incidence angle θ (°)")
     ax.set_ylabel(f"directional albedo (MC, {ALBEDO_SAMPLES} spp)")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize="small", loc="lower left")
+    ax.legend(fontsize="small", loc="best")
 
 
 # -- polar ---------------------------------------------------------------------------
