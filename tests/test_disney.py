@@ -125,6 +125,15 @@ def test_solid_glass_seen_from_inside_chi2(params):
     assert r.passed, (r.p_value, r.statistic, r.dof, r.failures, r.expected_failures)
 
 
+@pytest.mark.parametrize("thin", [False, True])
+@pytest.mark.parametrize("wo", [(0.6, 0.0, 0.8), (0.2, 0.1, -0.97)], ids=["outside", "below"])
+def test_glass_at_roughness_zero_chi2(thin, wo):
+    # α = 10⁻³: the adaptive quadrature of the harness resolves the near-delta lobes.
+    p = DisneyParams(spec_trans=1.0, roughness=0.0, thin=thin, clearcoat=1.0)
+    r = chi2_details(disney.MODEL, p, wo, 100_000, 12, alpha=SIGNIFICANCE)
+    assert r.passed, (r.p_value, r.statistic, r.dof, r.failures, r.expected_failures)
+
+
 LOBE_CASES = {
     "diffuse": DisneyParams(roughness=1.0, subsurface=0.5),
     "diff_trans": DisneyParams(diff_trans=1.0, thin=True),
