@@ -53,6 +53,7 @@ class MaskSampler:
         self._images: dict[tuple, tuple[np.ndarray, tuple[float, float]]] = (
             {} if images is None else images
         )
+        self._tap_cache: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
 
     def image(self, tex: TextureMask, count: int = 1, *, where: str | None = None) -> np.ndarray:
         """The source channels of ``tex`` (cached), float32 (h, w, count) in UV order."""
@@ -69,9 +70,16 @@ class MaskSampler:
         src = self.image(tex, count, where=where)
         h, w = src.shape[:2]
         (su, sv), (ou, ov) = tex.uv_scale, tex.uv_offset
-        v_taps = taps(self.height, h, sv, ov, tex.wrap, rows)
-        u_taps = taps(self.width, w, su, ou, tex.wrap)
-        return resample(src, v_taps, u_taps)
+        v_idx, v_w = self._taps(self.height, h, sv, ov, tex.wrap)
+        rows = rows or slice(0, self.height)
+        u_taps = self._taps(self.width, w, su, ou, tex.wrap)
+        return resample(src, (v_idx[rows], v_w[rows]), u_taps)
+
+    def _taps(self, *key) -> tuple[np.ndarray, np.ndarray]:
+        """Taps of a whole axis (:func:`.resample.taps`), computed once per sampler."""
+        if key not in self._tap_cache:
+            self._tap_cache[key] = taps(*key)
+        return self._tap_cache[key]
 
     def evaluate(self, mask: Mask, rows: slice | None = None, *, where=None) -> np.ndarray:
         """Coverage of ``mask`` on output rows ``rows`` (all rows by default), float32 (n, W)."""
@@ -214,31 +222,36 @@ def fractal_noise(mask: NoiseMask, u: np.ndarray, v: np.ndarray, height: int, wi
     would only alias.
     """
     nyquist = min(height, width) / 2.0
-    total = np.zeros(np.broadcast_shapes(u.shape, v.shape), dtype=np.float64)
+    total = np.zeros(np.broadcast_shapes(u.shape, v.shape), dtype=np.float32)
     norm = 0.0
     for k in range(mask.octaves):
         amp = mask.gain**k
         period = max(1, round(mask.scale * mask.lacunarity**k))
         octave = 0.5 if period > nyquist else _value_noise(u, v, period, mask.seed, k)
-        total += amp * octave
+        total += np.float32(amp) * octave
         norm += amp
-    return (total / norm).astype(np.float32)
+    return total * np.float32(1.0 / norm)
 
 
 def _value_noise(u: np.ndarray, v: np.ndarray, period: int, seed: int, octave: int):
-    """Periodic value noise: hashed lattice values, quintic fade, bilinear mix."""
-    x, y = u * period, v * period
-    x0, y0 = np.floor(x), np.floor(y)
-    fx, fy = _fade(x - x0), _fade(y - y0)
-    x0, y0 = x0.astype(np.int64) % period, y0.astype(np.int64) % period
-    x1, y1 = (x0 + 1) % period, (y0 + 1) % period
+    """Periodic value noise at a row of u (1, W) and a column of v (n, 1): (n, W).
 
-    def corner(ix, iy):
-        return _hash01(ix, iy, seed, octave)
+    The lattice (period² hashed values) is built once; bilinear interpolation with the
+    quintic fade is separable, so rows are mixed in v first (n × period), then in u.
+    """
+    cells = np.arange(period)
+    lattice = _hash01(cells[None, :], cells[:, None], seed, octave).astype(np.float32)
+    x0, fx = _cell(u[0], period)
+    y0, fy = _cell(v[:, 0], period)
+    rows = lattice[y0] * (1.0 - fy[:, None]) + lattice[(y0 + 1) % period] * fy[:, None]
+    return rows[:, x0] * (1.0 - fx) + rows[:, (x0 + 1) % period] * fx
 
-    bottom = corner(x0, y0) * (1 - fx) + corner(x1, y0) * fx
-    top = corner(x0, y1) * (1 - fx) + corner(x1, y1) * fx
-    return bottom * (1 - fy) + top * fy
+
+def _cell(t: np.ndarray, period: int) -> tuple[np.ndarray, np.ndarray]:
+    """Lattice cell (wrapped) and faded position inside it of coordinates ``t``."""
+    x = t * period
+    x0 = np.floor(x)
+    return x0.astype(np.int64) % period, _fade(x - x0).astype(np.float32)
 
 
 def _fade(t: np.ndarray) -> np.ndarray:
