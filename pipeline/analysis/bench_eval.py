@@ -8,8 +8,9 @@ over :data:`PARAM_SETS` (eight materials that between them switch on every lobe)
   float64, channel-first arrays prepared beforehand (the layout change of the public
   wrappers is not evaluation);
 - ``drjit``: the same Python model traced by Dr.Jit (LLVM), forced with ``dr.eval`` and
-  waited for; the first call (tracing + kernel compilation) is reported on its own and
-  excluded from the throughput;
+  waited for; the first call (tracing + kernel compilation, or a hit in Dr.Jit's on-disk
+  kernel cache after an earlier run) is reported on its own and excluded from the
+  throughput;
 - ``mitsuba``: the C++ ``principled`` plugin with the nearest parameters (see
   :func:`principled_dict`; the two models differ where DESIGN.md says), same pairs.
 
