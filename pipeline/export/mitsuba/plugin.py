@@ -227,7 +227,8 @@ def _plugin_class(variant: str) -> type:
             same_side = cos_view * cos_light > 0
             want_r = _is_enabled(ctx, self.components[0], self.component_index[0])
             want_t = _is_enabled(ctx, self.components[1], self.component_index[1])
-            return (same_side & want_r) | (~same_side & want_t)
+            # select, not ~: on scalar variants the mask is a Python bool, and ~True is -2.
+            return dr.select(same_side, want_r, want_t)
 
         def eval(self, ctx, si, wo, active=True):
             prepared = self._prepare(si, active)
