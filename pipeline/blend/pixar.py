@@ -88,7 +88,8 @@ class Part:
     @property
     def energy(self) -> Any:
         """Channel mean of (N + G)/2: the weight for energy-weighted blending."""
-        return (np.mean(self.n, axis=-1) + np.mean(self.g, axis=-1)) * 0.5
+        total = self.n + self.g  # channels summed by hand: a mean over a last axis of 3 is slow
+        return (total[..., 0] + total[..., 1] + total[..., 2]) * (1.0 / 6.0)
 
 
 Lobes = dict[str, Part]
@@ -320,15 +321,20 @@ def _outputs(top_first: list[Entry], sampler: MaskSampler, progress, mode: str):
     height, width = sampler.height, sampler.width
     rows_per_tile = max(1, TILE_TEXELS // width)
     out: dict[str, np.ndarray] = {}
+    per_layer = {
+        (i, cos_view): layer_lobes(e.params, cos_view)
+        for i, e in enumerate(top_first)
+        for cos_view in VIEWS.values()
+    }
     for r0 in range(0, height, rows_per_tile):
         rows = slice(r0, min(height, r0 + rows_per_tile))
         n = rows.stop - rows.start
-        alphas = [np.broadcast_to(e.coverage(sampler, rows), (n, width)) for e in top_first]
+        alphas = [e.coverage(sampler, rows) for e in top_first]  # scalars where uniform
         normals = [_entry_normals(e, sampler, rows) for e in top_first]
         for suffix, cos_view in VIEWS.items():
             stack = [
-                (layer_lobes(e.params, cos_view, nm), a)
-                for e, nm, a in zip(top_first, normals, alphas, strict=True)
+                (_with_normals(per_layer[i, cos_view], nm), a)
+                for i, (nm, a) in enumerate(zip(normals, alphas, strict=True))
             ]
             lobes, group_normals = composite(stack, mode)
             for lobe, part in lobes.items():
@@ -344,6 +350,16 @@ def _outputs(top_first: list[Entry], sampler: MaskSampler, progress, mode: str):
         if progress is not None:
             progress(rows.stop, height)
     return out
+
+
+def _with_normals(lobes: Lobes, normals: dict[str, Any]) -> Lobes:
+    """``lobes`` with the diffuse and highlight normals of this tile where a map gives one."""
+    if not normals:
+        return lobes
+    return {
+        lobe: Part(p.n, p.g, p.cone, normals.get(GROUP[lobe], p.normal))
+        for lobe, p in lobes.items()
+    }
 
 
 def _entry_normals(entry: Entry, sampler: MaskSampler, rows: slice) -> dict[str, Any]:
