@@ -24,6 +24,7 @@ use to compare the two models where they coincide.
 
 from __future__ import annotations
 
+import math
 import time
 from typing import Annotated, Any
 
@@ -236,17 +237,18 @@ def _mitsuba_runner(wi: np.ndarray, wo: np.ndarray):
     return run
 
 
-def _first_and_best(fn: Any, repeat: int) -> tuple[float, float]:
-    from lookdev.pipeline.cli.bench import best_time
-
+def _timed(fn: Any) -> float:
     t0 = time.perf_counter()
     fn()
-    first = time.perf_counter() - t0
-    return first, best_time(fn, repeat=repeat)
+    return time.perf_counter() - t0
 
 
-def run(n: int = 1_000_000, *, repeat: int = 3, progress: Any = None) -> dict[str, Any]:
-    """Every figure of the benchmark (see the module docstring)."""
+def run(n: int = 1_000_000, *, repeat: int = 5, progress: Any = None) -> dict[str, Any]:
+    """Every figure of the benchmark (see the module docstring).
+
+    The backends are timed in interleaved rounds (each once per round, best of
+    ``repeat`` rounds kept), so a change in machine load between them skews no ratio.
+    """
     from lookdev.pipeline.variant import use_mitsuba
 
     variant = use_mitsuba()
@@ -257,11 +259,13 @@ def run(n: int = 1_000_000, *, repeat: int = 3, progress: Any = None) -> dict[st
         "drjit": _drjit_runner(wi, wo),
         "mitsuba": _mitsuba_runner(wi, wo),
     }
-    first, best = {}, {}
-    for name, fn in runners.items():
+    first = {name: _timed(fn) for name, fn in runners.items()}
+    best = dict.fromkeys(runners, math.inf)
+    for round_ in range(repeat):
         if progress is not None:
-            progress(name)
-        first[name], best[name] = _first_and_best(fn, repeat)
+            progress(round_)
+        for name, fn in runners.items():
+            best[name] = min(best[name], _timed(fn))
     rate = {k: n / v for k, v in best.items()}
     numpy_dtype = max(("float32", "float64"), key=lambda d: rate[f"numpy_{d}"])
     return {
@@ -286,7 +290,9 @@ def command(
     n: Annotated[
         int, typer.Option("--n", "-n", min=1000, max=50_000_000, help="Direction pairs.")
     ] = 1_000_000,
-    repeat: Annotated[int, typer.Option(min=1, max=20, help="Timed runs; the best counts.")] = 3,
+    repeat: Annotated[
+        int, typer.Option(min=1, max=20, help="Interleaved timing rounds; the best counts.")
+    ] = 5,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
     """Evaluate the Disney BSDF on N direction pairs: numpy, Dr.Jit and Mitsuba's principled.
@@ -300,12 +306,10 @@ def command(
     from lookdev.pipeline.cli.common import console, err_console, print_json, table
 
     with Progress(console=err_console, transient=True, disable=as_json) as bar:
-        task = bar.add_task("timing", total=4)
+        task = bar.add_task("compiling and timing", total=repeat)
 
-        def step(name: str) -> None:
-            bar.update(
-                task, description=f"timing {name}", advance=0 if name == "numpy_float32" else 1
-            )
+        def step(round_: int) -> None:
+            bar.update(task, completed=round_, description=f"timing round {round_ + 1}")
 
         result = run(n, repeat=repeat, progress=step)
     if as_json:
