@@ -136,3 +136,39 @@ def test_cli_bad_texture_is_one_line_and_writes_nothing(cli, tmp_path):
 def test_cli_unknown_preset(cli, tmp_path):
     r = cli("blend", "no_such_preset", "-o", str(tmp_path))
     assert r.code == 2 and "no_such_preset" in r.err and "Traceback" not in r.err
+
+
+def test_cli_pixar_layering_option(cli, tmp_path):
+    base = 'model = "pixar"\n[params]\nroughness = 0.6\n'
+    (tmp_path / "clay.toml").write_text('name = "clay"\n' + base)
+    (tmp_path / "glaze.toml").write_text(
+        'name = "glaze"\nmodel = "pixar"\n[params]\nroughness = 0.1\nclear = 0.6\n'
+    )
+    (tmp_path / "glazed.toml").write_text(
+        'name = "glazed"\nmodel = "layered"\n[[layers]]\npreset = "clay"\n'
+        '[[layers]]\npreset = "glaze"\nmask = { kind = "noise", seed = 2 }\n'
+    )
+    out = {}
+    for mode in ("full", "simple"):
+        r = cli("blend", "glazed", "-L", str(tmp_path), "-o", str(tmp_path / mode), "-r", "8",
+                "--layering", mode, "--json")  # fmt: skip
+        assert r.code == 0, r.err
+        out[mode] = json.loads(r.out)
+        assert out[mode]["representation"] == "lobe_weights"
+    assert out["full"]["maps"]["diffN"] != out["simple"]["maps"]["diffN"]
+    r = cli("blend", "glazed", "-L", str(tmp_path), "-o", str(tmp_path), "--layering", "x")
+    assert r.code == 2 and "unknown Pixar layering 'x'" in r.err
+
+
+def test_bench_blend_smoke(cli):
+    r = cli("bench", "blend", "--resolution", "16", "--repeat", "1", "--json")
+    assert r.code == 0, r.err
+    doc = json.loads(r.out)
+    assert doc["maps"] == 16 and doc["layers"] == 4
+    assert doc["ratio_blend_to_copy"] > 0 and doc["peak_to_output"] > 0
+    saving = doc["pruning"]["hidden+zero layers"]
+    assert saving["layers_kept"] == saving["layers_total"] - 2
+    assert (
+        doc["pruning"]["rusty_car_paint"]["maps"]
+        < doc["pruning"]["rusty_car_paint"]["maps_without"]
+    )

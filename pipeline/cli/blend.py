@@ -28,6 +28,14 @@ def blend(
         list[Path] | None,
         typer.Option("--library", "-L", help="Extra preset folders searched before the built-ins."),
     ] = None,
+    layering: Annotated[
+        str,
+        typer.Option(
+            "--layering",
+            help="Pixar stacks: full (light through a layer meets the ones below, Smits' "
+            "table) or simple (A over B).",
+        ),
+    ] = "full",
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
     """Blend PRESET's layers; write the maps that vary as EXR and the rest as JSON.
@@ -50,7 +58,7 @@ def blend(
     material = load_material(preset, Library(library))
     t0 = time.perf_counter()
     with _progress(resolution * resolution >= LARGE) as (blend_cb, bake_cb):
-        blended = blend_material(material, resolution, progress=blend_cb)
+        blended = blend_material(material, resolution, progress=blend_cb, layering=layering)
         files = bake(blended, output, progress=bake_cb)
     seconds = time.perf_counter() - t0
     if as_json:
@@ -85,6 +93,7 @@ def _summary(blended, files: dict[str, Path], seconds: float) -> dict:
     return {
         "name": blended.name,
         "model": blended.model,
+        "representation": blended.representation,
         "resolution": list(blended.resolution),
         "sidecar": str(files["sidecar"]),
         "maps": {
