@@ -177,6 +177,20 @@ def test_conflicting_options_and_missing_presets(cli, tmp_path):
     )
     assert "--package and --split" in line
     assert "--all" in _one_line_error(cli("export", "usd", "-o", str(tmp_path / "a.usda")))
+    line = _one_line_error(
+        cli(
+            "export",
+            "usd",
+            "gold",
+            "-o",
+            str(tmp_path / "a.usda"),
+            "-c",
+            "universal",
+            "--mtlx",
+            str(tmp_path / "a.mtlx"),
+        )
+    )
+    assert "--context mtlx" in line
     assert "did you mean" in _one_line_error(
         cli("export", "usd", "gld", "-o", str(tmp_path / "a.usda"))
     )

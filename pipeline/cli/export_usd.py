@@ -102,7 +102,7 @@ def export_usd(
     from lookdev.pipeline.export.usd.writer import export_usd as write
 
     lib = Library(library or None)
-    names = list(presets or [])
+    names = list(dict.fromkeys(presets or []))  # a preset named twice is exported once
     if all_presets:
         names += [n for n in lib.names() if n not in names]
     if not names:

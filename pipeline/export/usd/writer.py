@@ -256,6 +256,8 @@ def export_usd(
     package = package or out.suffix == ".usdz"
     if package and split_dir is not None:
         raise ExportError("--package and --split exclude each other", where=str(out))
+    if mtlx_path is not None and "mtlx" not in contexts:
+        raise ExportError("--mtlx writes the mtlx context; add --context mtlx", where=str(out))
     if out.suffix not in (*USD_SUFFIXES, ".usdz"):
         raise ExportError("not a USD file name; use .usda, .usdc, .usd or .usdz", where=str(out))
     out = out.with_suffix(".usdz") if package else out
