@@ -112,8 +112,10 @@ def flatten(material: Any, resolution: int = DEFAULT_MAP_RESOLUTION) -> Flat:
     """A Params object, a library ``Material`` or a ``BlendedMaterial`` as a :class:`Flat`.
 
     Layered materials are blended first (:func:`lookdev.pipeline.blend.blend`) at
-    ``resolution`` texels a side.
+    ``resolution`` texels a side; a :class:`Flat` is returned as it is.
     """
+    if isinstance(material, Flat):
+        return material
     if isinstance(material, Params):
         return Flat(type(material).__name__, _model_of(material), _given(material))
     if getattr(material, "maps", None) is not None:  # a BlendedMaterial
@@ -183,7 +185,7 @@ def lobes_for(flat: Flat) -> tuple[str, ...]:
 
 def max_depth_for(material: Any) -> int:
     """Path-tracer depth the material needs: opaque < thin transmissive < solid glass."""
-    flat = material if isinstance(material, Flat) else flatten(material)
+    flat = flatten(material)
     kinds = lobe_kinds(lobes_for(flat), flat.model)
     if not any("Transmission" in k for k in kinds):
         return DEPTH_OPAQUE
@@ -235,7 +237,7 @@ def bsdf_dict(
     zero weight traced (the pruning benchmark's baseline) and never takes the
     ``principled`` fast path.
     """
-    flat = material if isinstance(material, Flat) else flatten(material, resolution)
+    flat = flatten(material, resolution)
     register_plugins()
     model = model_for(flat.model)
     model.params_type.parse(flat.constants, where=flat.name)  # one line on bad input, here
@@ -347,7 +349,7 @@ def scene_dict(
     """
     import mitsuba as mi
 
-    flat = material if isinstance(material, Flat) else flatten(material, map_resolution)
+    flat = flatten(material, map_resolution)
     _ensure_variant()
     width, height = resolution
     distance = 4.0
