@@ -150,8 +150,8 @@ def test_cli_pixar_layering_option(cli, tmp_path):
     )
     out = {}
     for mode in ("full", "simple"):
-        r = cli("blend", "glazed", "-L", str(tmp_path), "-o", str(tmp_path / mode), "-r", "8",
-                "--layering", mode, "--json")  # fmt: skip
+        args = ["-L", str(tmp_path), "-o", str(tmp_path / mode), "-r", "8", "--layering", mode]
+        r = cli("blend", "glazed", *args, "--json")
         assert r.code == 0, r.err
         out[mode] = json.loads(r.out)
         assert out[mode]["representation"] == "lobe_weights"
