@@ -186,6 +186,34 @@ def test_reflection_lobes_are_reciprocal(params):
     )
 
 
+@given(
+    st.floats(0, 1),
+    st.floats(0, 1),
+    st.floats(0, 1),
+    st.floats(0, 1),
+    st.floats(0, 1),
+    st.booleans(),
+    st.integers(0, 2**31),
+)
+@settings(max_examples=40, deadline=None)
+def test_reciprocity_for_any_parameters(rough, metal, aniso, subsurface, flat, thin, seed):
+    p = DisneyParams(
+        roughness=rough,
+        metallic=metal,
+        anisotropic=aniso,
+        subsurface=subsurface,
+        flatness=flat,
+        thin=thin,
+        sheen=0.7,
+        clearcoat=0.6,
+        specular_tint=0.4,
+    )
+    wi, wo = _dirs(256, seed % 1000), _dirs(256, seed % 1000 + 1)
+    np.testing.assert_allclose(
+        disney.eval(p, wi, wo), disney.eval(p, wo, wi), rtol=1e-9, atol=1e-15
+    )
+
+
 def test_thin_transmission_is_reciprocal():
     params = RECIPROCAL[3]
     wi, wo = _dirs(4000, 5, lower=True), _dirs(4000, 6)
