@@ -69,7 +69,7 @@ def scan_folder(folder: Path, *, cache: bool = True, skip: tuple[str, ...] = ())
     for rel, mtime, size, ino in found:
         e = cached.get(rel)
         try:
-            if e[1] != mtime or e[2] != size or e[3] != ino:
+            if e[1] != mtime or e[2] != size or e[3] != ino or not _well_typed(e):
                 raise LookupError("changed")
             header = Header(e[4], f"{root}{sep}{rel}", root, e[5], e[6], tuple(e[7]), e[8], e[9])
         except (LookupError, TypeError):  # not indexed, changed, or a malformed entry
@@ -165,6 +165,23 @@ def _scandir(folder: str) -> Iterator[Iterator[os.DirEntry]]:
             yield it
     finally:
         os.close(fd)
+
+
+_TEXT_OR_NONE = (str, type(None))
+
+
+def _well_typed(e: list[Any]) -> bool:
+    """An index row that is safe to show: a damaged or hand-edited index must not crash."""
+    return (
+        len(e) == 10
+        and type(e[4]) is str
+        and type(e[6]) is str
+        and isinstance(e[5], _TEXT_OR_NONE)
+        and isinstance(e[8], _TEXT_OR_NONE)
+        and isinstance(e[9], _TEXT_OR_NONE)
+        and type(e[7]) is list
+        and all(type(t) is str for t in e[7])
+    )
 
 
 def _read_index(folder: Path) -> dict[str, list[Any]]:

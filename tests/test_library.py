@@ -331,7 +331,17 @@ def test_listing_index_is_used_and_notices_changes(tmp_path):
     assert json.loads((tmp_path / INDEX_NAME).read_text())["entries"][0][0] == "a.toml"
     write(tmp_path, "a", 'name="a"\nmodel="disney"\ndescription="two"\n')
     assert scan_folder(tmp_path)[0].description == "two"
-    for junk in ("{not json", '{"version": 3, "entries": [["a.toml", "x"], 5]}', "[]"):
+    stat = os.stat(tmp_path / "a.toml")
+    key = f"{stat.st_mtime_ns}, {stat.st_size}, {stat.st_ino}"
+    well_formed_but_wrong_types = (
+        f'{{"version": 3, "entries": [["a.toml", {key}, "a", 5, [1], [2], null, null]]}}'
+    )
+    for junk in (
+        "{not json",
+        '{"version": 3, "entries": [["a.toml", "x"], 5]}',
+        "[]",
+        well_formed_but_wrong_types,
+    ):
         (tmp_path / INDEX_NAME).write_text(junk)
         assert scan_folder(tmp_path)[0].description == "two"
 
