@@ -129,6 +129,8 @@ def blend(
     Smits' ``"full"`` (transmitted light meets the layers below) or ``"simple"`` layering
     of Pixar stacks.
     """
+    if layering not in ("full", "simple"):
+        raise BlendError(f"unknown Pixar layering {layering!r}; allowed: full, simple")
     width, height = (resolution, resolution) if isinstance(resolution, int) else resolution
     if width < 1 or height < 1:
         raise BlendError(f"resolution {width}x{height} must be at least 1x1", where=material.name)

@@ -299,6 +299,11 @@ def blend_stack(
         hides=lambda e: mode == "simple" or opaque(e),
         enabled=prune,
     )
+    constant = all(
+        e.uniform and e.normal_map is None and e.specular_normal_map is None for e in kept
+    )
+    if constant and prune:  # nothing varies: one texel says it all
+        sampler = MaskSampler((1, 1))
     outputs = _outputs(kept[::-1], sampler, progress, mode)
     out = BlendedMaterial(name, "pixar", resolution, {}, decisions=decisions)
     out.representation = "lobe_weights"
