@@ -36,7 +36,6 @@ from . import measure
 from .measure import Row
 
 ITEMS = ("render", "albedo", "lambda", "precision")
-MODEL_NAMES = ("disney", "pixar", "sheen")
 
 RENDER_IBL = "studio"
 # Proof-render cases: label → built-in preset name.
@@ -101,19 +100,6 @@ class BenchError(LookdevError):
 
 
 # -- what there is to measure --------------------------------------------------------
-def available_models() -> dict[str, Model]:
-    """Every installed reflectance model by name."""
-    from .plots import PlotError, model_named
-
-    found = {}
-    for name in MODEL_NAMES:
-        try:
-            found[name] = model_named(name)
-        except PlotError:
-            continue
-    return found
-
-
 EDGE_CASES = {"roughness": (0.0, 1.0)}
 LOBE_CASES = ("clearcoat", "sheen", "spec_trans")  # switched fully on, one at a time
 
@@ -180,7 +166,11 @@ def run(
 ) -> Report:
     """Measure every asked item now. ``render``/``models`` override what is discovered."""
     report = Report()
-    models = available_models() if models is None else models
+    if models is None:
+        from .stability import available_models
+
+        models, missing = available_models()
+        report.skipped.update({f"model {name}": why for name, why in missing.items()})
     if not models:
         report.skipped["albedo, precision"] = "no reflectance model is installed"
     tasks: list[tuple[str, Callable[[], list[Row]]]] = []

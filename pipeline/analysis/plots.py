@@ -15,7 +15,6 @@ independent computations) and a ``draw_*`` function that puts them on a matplotl
 
 from __future__ import annotations
 
-import importlib
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -53,15 +52,19 @@ class PlotError(LookdevError):
 
 
 def model_named(name: str) -> Model:
-    """The :class:`Model` called ``name``, found in ``lookdev.materials.<name>``."""
+    """The installed :class:`Model` called ``name`` (the registry of ``lookdev check``)."""
+    from .stability import MODEL_MODULES, CheckError, available_models
+
     try:
-        module = importlib.import_module(f"lookdev.materials.{name}")
-    except ImportError:
-        module = None
-    for value in vars(module).values() if module else ():
-        if isinstance(value, Model) and value.name == name:
-            return value
-    raise PlotError(f"no reflectance model named {name!r} is installed", field="model")
+        models, missing = available_models([name])
+    except CheckError:
+        known = ", ".join(MODEL_MODULES)
+        raise PlotError(
+            f"no reflectance model named {name!r}; known: {known}", field="model"
+        ) from None
+    if name in missing:
+        raise PlotError(f"model {name!r} is {missing[name]}", field="model")
+    return models[name]
 
 
 LAYERED_RESOLUTION = 64
