@@ -22,6 +22,7 @@ the same run (no absolute timings are asserted).
 
 from __future__ import annotations
 
+import os
 import time
 from dataclasses import asdict, dataclass
 from typing import Annotated, Any
@@ -165,6 +166,7 @@ def run(s: Settings) -> dict[str, Any]:
     from lookdev.pipeline.variant import use_mitsuba
 
     variant = use_mitsuba()
+    load_before = os.getloadavg()[0]
     material = load_material(s.preset)
     env = ibl.load(s.ibl, s.ibl_width)
     bsdf, depth = material_bsdf(material)
@@ -183,6 +185,9 @@ def run(s: Settings) -> dict[str, Any]:
         "variant": variant,
         "settings": asdict(s),
         "bsdf": bsdf.get("type"),
+        # Other work on the machine inflates wall times (not CPU times): judge with this.
+        "load_average": [load_before, os.getloadavg()[0]],
+        "cpu_count": os.cpu_count(),
         "turntable": {
             "pipeline": pipeline.to_json(),
             "bare_render": bare.to_json(),
@@ -247,7 +252,11 @@ def command(
             ("naive: rebuild every frame", t["naive_rebuild"]),
         )
     ]
-    title = f"{s.frames}-frame turntable, {s.preset} × {s.ibl}, {report['variant']}"
+    load = "→".join(f"{v:.1f}" for v in report["load_average"])
+    title = (
+        f"{s.frames}-frame turntable, {s.preset} × {s.ibl}, {report['variant']}, "
+        f"load average {load} on {report['cpu_count']} cores"
+    )
     console.print(table(title, ["run", "wall s", "CPU s", "× pipeline (CPU)"], rows))
     for what, value, target, ok in (
         ("speed-up over the naive script", f"{t['speedup_vs_naive']:.2f}×", "≥ 3×",
