@@ -61,7 +61,10 @@ def list_(
     library: LibraryOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
-    """List the presets each name resolves to.
+    """List the presets each name resolves to (files that fail to parse are warned about).
+
+    Reads each file's header only, cached per library in .lookdev-index.json; run
+    `presets validate` to check parameters and references too.
 
     Examples:
 
