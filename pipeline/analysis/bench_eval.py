@@ -18,7 +18,7 @@ Reported: evaluations per second of each and the throughput ratios
 ``ratio_drjit_to_mitsuba`` (target ≥ 0.5) and ``ratio_numpy_to_mitsuba`` (target ≥ 0.1,
 with the faster numpy dtype, named in ``numpy_dtype``).
 
-The helpers :func:`principled_dict` and :func:`principled_eval` are also what the tests
+The helpers :func:`principled_dict` and :func:`mitsuba_eval` are also what the tests
 use to compare the two models where they coincide.
 """
 
@@ -90,7 +90,7 @@ def _vectors(mi: Any, a: np.ndarray) -> Any:
     return mi.Vector3f(*(mi.Float(np.ascontiguousarray(a[:, k])) for k in range(3)))
 
 
-def principled_eval(bsdf: Any, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
+def mitsuba_eval(bsdf: Any, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
     """f(wi, wo) of a Mitsuba BSDF without the cosine, our naming, shape (N, 3).
 
     Mitsuba's ``si.wi`` is our viewer ``wo`` and its ``wo`` our light ``wi``; its
@@ -154,7 +154,7 @@ def agreement(n: int = 4096, seed: int = 1) -> dict[str, float]:
     for name, (lobes, params) in AGREEMENT_CASES.items():
         model = disney.MODEL if lobes is None else disney.lobe_model(*lobes)
         ours = evaluate(model, params, wi, wo)
-        theirs = principled_eval(mi.load_dict(principled_dict(params)), wi, wo)
+        theirs = mitsuba_eval(mi.load_dict(principled_dict(params)), wi, wo)
         out[name] = relative_difference(ours, theirs)
     return out
 
