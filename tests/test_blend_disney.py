@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 from lookdev.library import Library, Material
 from lookdev.materials.layers import ConstantMask, NoiseMask, RampMask, TextureMask
 from lookdev.materials.params import DisneyParams
+from lookdev.materials.pixar import PixarParams
 from lookdev.pipeline.blend import BlendError, TextureError, blend, engine
 from lookdev.pipeline.blend.sheen import base_scale as sheen_base_scale
 
@@ -228,7 +229,7 @@ def test_separate_specular_normal(tmp_path):
 
 # -- bad input -----------------------------------------------------------------------------
 def test_mixed_models_name_the_layer():
-    pixar = Material(name="plastic_pixar", model="pixar", params=None)
+    pixar = Material(name="plastic_pixar", model="pixar", params=PixarParams())
     with pytest.raises(BlendError, match=r"layer 'top': is pixar .* layer 'gold' is disney"):
         blend(layered(layer(GOLD), layer(pixar, 0.5, name="top")), 4)
 
@@ -300,3 +301,53 @@ def test_sheen_scales_the_blended_base_per_texel():
 
 def test_no_conty_kulla_sheen_means_no_scaling():
     assert sheen_base_scale(blend(GOLD, 4)) == (1.0, 1.0, 1.0)
+
+
+def test_presence_scales_disney_coverage_too():
+    out = blend(layered(layer(GOLD), layer(RUBBER, 1.0, presence=0.5)), 2)
+    assert [d.kept for d in out.decisions] == [True, True]  # ½ coverage hides nothing
+    assert out.to_params().roughness == pytest.approx(0.55)
+
+
+def test_sheen_model_is_voted_only_by_layers_with_sheen():
+    velvet = disney("velvet", sheen=1.0, sheen_model="conty_kulla")
+    cloth = disney("cloth", sheen=0.5, sheen_model="disney")
+    assert blend(layered(layer(GOLD), layer(velvet, 0.5)), 2).constants["sheen_model"] == (
+        "conty_kulla"
+    )
+    with pytest.raises(BlendError, match="sheen_model"):
+        blend(layered(layer(cloth), layer(velvet, 0.5)), 2)
+
+
+def test_minified_normal_maps_average_then_renormalise(tmp_path):
+    n = np.zeros((8, 8, 3), dtype=np.float32)
+    n[:, 0::2] = (0.6, 0.0, 0.8)
+    n[:, 1::2] = (-0.6, 0.0, 0.8)
+    tex = TextureMask(path=write_image(tmp_path / "bumps.exr", 0.5 * n + 0.5))
+    out = blend(layered(layer(GOLD, normal_map=tex)), 2)
+    assert np.allclose(out.normal_map, (0.0, 0.0, 1.0), atol=1e-6)  # bumps filter out flat
+
+
+_coverage = st.one_of(
+    st.sampled_from([0.0, 1.0, 0.5]),
+    st.integers(0, 5).map(lambda seed: NoiseMask(scale=2, octaves=2, seed=seed)),
+)
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    st.lists(
+        st.tuples(st.sampled_from([0.1, 0.5, 0.9]), st.sampled_from([0.0, 1.0]), _coverage),
+        min_size=1,
+        max_size=5,
+    )
+)
+def test_pruning_never_changes_a_texel(spec):
+    layers = [
+        layer(disney(f"l{i}", roughness=r, metallic=m), cov) for i, (r, m, cov) in enumerate(spec)
+    ]
+    stack = layered(*layers)
+    pruned, naive = blend(stack, 4), blend(stack, 4, prune=False)
+    for name, full in naive.maps.items():
+        mine = pruned.maps.get(name, pruned.constants.get(name))
+        assert np.allclose(full, np.asarray(mine, dtype=np.float32), atol=1e-6), name
