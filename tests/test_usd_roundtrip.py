@@ -227,3 +227,21 @@ def test_pixar_ri_surface_carries_smits_weights(tmp_path):
     assert surface.GetAttribute("inputs:diffuseGain").Get() == 0.0
     assert not surface.GetAttribute("inputs:roughSpecularFaceColor").IsAuthored()
     assert not surface.GetAttribute("inputs:refractionGain").IsAuthored()
+
+
+def test_foreign_specular_workflow_reads_f0_as_specular(tmp_path):
+    """Burley §5.4: F0 = 0.08 × specular; a grey specularColor 0.04 is specular 0.5."""
+    path = tmp_path / "spec.usda"
+    stage = Usd.Stage.CreateNew(str(path))
+    material = UsdShade.Material.Define(stage, "/Looks/Tile")
+    surface = UsdShade.Shader.Define(stage, "/Looks/Tile/Surface")
+    surface.CreateIdAttr("UsdPreviewSurface")
+    surface.CreateInput("useSpecularWorkflow", Sdf.ValueTypeNames.Int).Set(1)
+    surface.CreateInput("specularColor", Sdf.ValueTypeNames.Color3f).Set((0.04, 0.04, 0.04))
+    surface.CreateInput("metallic", Sdf.ValueTypeNames.Float).Set(1.0)  # ignored by the workflow
+    material.CreateSurfaceOutput().ConnectToSource(surface.ConnectableAPI(), "surface")
+    stage.Save()
+    (found,) = import_usd(path)
+    assert "metallic" not in found.params
+    got = DisneyParams.parse(found.params)
+    assert got.effective_specular == pytest.approx(0.5, rel=1e-6)

@@ -165,6 +165,8 @@ def _imported(spec: MaterialSpec) -> Imported | None:
         if surface is None:
             continue
         _read_surface(net, surface, context, model, values, result)
+        if context == "universal" and model == "disney":
+            _specular_workflow(surface, values, result)
         result.contexts.append(context)
         if surface.custom.get("loss"):
             result.loss.append(f"{context}: {surface.custom['loss']}")
@@ -173,6 +175,32 @@ def _imported(spec: MaterialSpec) -> Imported | None:
     spelling = spec.custom.get("spelling") or "ior"
     result.params = _preset_params(values, model, spelling)
     return result
+
+
+REC709_Y = (0.2126, 0.7152, 0.0722)  # luminance weights of linear Rec.709
+
+
+def _specular_workflow(surface: Node, values: dict[str, Any], result: Imported) -> None:
+    """A foreign UsdPreviewSurface in its specular workflow: its specular colour is an F0.
+
+    Burley §5.4: F0 = 0.08 · specular, so ``specular`` = Y(specularColor) / 0.08 with
+    metallic 0 (that workflow has none). The colour's tint has no Disney equivalent.
+    """
+    flag = surface.inputs.get("useSpecularWorkflow")
+    if flag is None or not flag[1]:
+        return
+    kind, colour = surface.inputs.get("specularColor", ("color3f", (0.0, 0.0, 0.0)))
+    if isinstance(colour, Connection):
+        result.loss.append("universal: specularColor is a texture; its mean is unknown")
+        return
+    f0 = sum(w * c for w, c in zip(REC709_Y, colour, strict=True))
+    values["metallic"] = 0.0
+    values["specular"] = min(f0 / 0.08, 12.5)
+    values["ior"] = specular_to_ior(values["specular"])
+    if max(colour) - min(colour) > 1e-6:
+        result.loss.append(
+            f"universal: the tint of specularColor {colour} (only its luminance is read)"
+        )
 
 
 def _surface(net: Network | None, context: str, model: str) -> Node | None:
