@@ -22,6 +22,7 @@ def write_image(path: Path, pixels: np.ndarray, fmt=oiio.FLOAT, names=None) -> P
     spec = oiio.ImageSpec(width, height, channels, fmt)
     if names:
         spec.channelnames = tuple(names)
+    spec.attribute("oiio:UnassociatedAlpha", 1)  # store channels as given, even beside alpha
     buf = oiio.ImageBuf(spec)
     assert buf.set_pixels(oiio.ROI(0, width, 0, height, 0, 1, 0, channels), pixels)
     assert buf.write(str(path)), buf.geterror()

@@ -263,3 +263,12 @@ def test_any_mask_stays_in_0_1_and_within_its_bounds(mask):
     assert m.dtype == np.float32 and np.isfinite(m).all()
     assert 0.0 <= m.min() and m.max() <= 1.0
     assert lo - 1e-6 <= m.min() and m.max() <= hi + 1e-6
+
+
+def test_a_channel_beside_alpha_is_not_premultiplied(tmp_path):
+    rgba = np.zeros((2, 2, 4), dtype=np.float32)
+    rgba[..., 0], rgba[..., 3] = 0.8, 0.5  # PNG alpha is unassociated: R stays 0.8
+    path = write_image(tmp_path / "rgba.png", rgba, fmt=oiio.UINT8)
+    m = evaluate(TextureMask(path=path, channel="R"), 2)
+    assert np.allclose(m, round(0.8 * 255) / 255, atol=1e-6)
+    assert np.allclose(evaluate(TextureMask(path=path, channel="A"), 2), 128 / 255, atol=1e-6)

@@ -1,7 +1,8 @@
 """Reading mask textures with OpenImageIO and resampling them with a filter, not a point.
 
-Images are read as linear data: OpenImageIO normalises integer formats to 0..1 and no
-colour transform is applied (a mask or a normal map is data, not colour). Arrays here are
+Images are read as linear data: OpenImageIO normalises integer formats to 0..1, no
+colour transform is applied and alpha is not multiplied in (a mask or a normal map is
+data, not colour). Arrays here are
 in UV order, row 0 at v = 0 (the bottom of the image as a viewer shows it, the USD and
 OpenGL convention), so a file's rows are flipped once, on read.
 
@@ -30,6 +31,12 @@ from lookdev.materials.layers import TextureMask
 
 from .errors import TextureError
 
+_AS_DATA = oiio.ImageSpec()
+_AS_DATA.attribute("oiio:UnassociatedAlpha", 1)
+"""Read hint: keep colour channels as stored. By default OpenImageIO premultiplies formats
+with unassociated alpha (PNG, TGA, some TIFFs) on read, which would scale a mask channel
+by alpha."""
+
 _ALIASES = {"r": 0, "g": 1, "b": 2, "a": 3, "x": 0, "y": 1, "z": 2}
 """Channel letters understood when a file does not name its channels that way."""
 
@@ -43,7 +50,7 @@ def read_channels(tex: TextureMask, count: int = 1, *, where: str | None = None)
     path = Path(tex.path)
     if not path.is_file():
         raise TextureError(f"texture file {path} does not exist", where=where)
-    buf = oiio.ImageBuf(str(path))
+    buf = oiio.ImageBuf(str(path), 0, 0, _AS_DATA)
     spec = buf.spec()
     if buf.has_error or spec.nchannels == 0:
         raise TextureError(f"cannot decode {path}: {_oiio_error(buf)}", where=where)
