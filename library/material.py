@@ -24,7 +24,7 @@ from functools import partial
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from lookdev.materials.layers import CombineMask, ConstantMask, Mask, TextureMask, map_textures
 from lookdev.materials.params import DisneyParams
@@ -51,6 +51,15 @@ class Material(BaseModel):
     source: Path | None = None
     citation: str | None = Field(None, description="The preset's `source` note (measurements).")
     chain: list[Path] = Field(default_factory=list, description="Files merged, child first.")
+
+    @model_validator(mode="after")
+    def _params_fit_the_model(self) -> Material:
+        expected = MODELS.get(self.model)
+        if (self.params is None) != (expected is None) or (
+            expected is not None and not isinstance(self.params, expected)
+        ):
+            raise ValueError(f"a {self.model} material needs {getattr(expected, '__name__', None)}")
+        return self
 
 
 class Layer(BaseModel):
