@@ -67,14 +67,15 @@ def test_albedo_rows_compare_each_estimator_with_the_converged_quadrature():
     assert by[("monte carlo", "4096 spp")].error < by[("monte carlo", "64 spp")].error
     assert all(r.seconds > 0 and r.evaluations > 0 for r in rows)
     assert rows[0].reference == "quadrature 256×256"  # a smooth lobe: the grid converges
+    assert all(r.reference_seconds > 0 and r.speedup > 0 for r in rows)
 
 
 def test_a_near_delta_lobe_is_measured_against_monte_carlo_not_an_unresolved_grid():
     # exponent 1e5: a lobe ~0.3° wide that a 64×64 grid cannot see
-    ref, how = M.albedo_reference(
+    ref, how, seconds = M.albedo_reference(
         PHONG, PHONG.params_type(exponent=1e5), np.radians([0.0, 40.0]), 64, 4096
     )
-    assert how == "monte carlo 4096 spp"
+    assert how == "monte carlo 4096 spp" and seconds > 0
     np.testing.assert_allclose(ref[:, 0], [1.0, math.cos(math.radians(40))], rtol=1e-3)
 
 

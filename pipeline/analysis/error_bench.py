@@ -89,7 +89,12 @@ class Report:
             "settings": asdict(settings),
             "machine": {"python": platform.python_version(), "platform": platform.platform()},
             "rows": [
-                {**asdict(r), "seconds_per_evaluation": r.seconds_per_evaluation} for r in self.rows
+                {
+                    **asdict(r),
+                    "seconds_per_evaluation": r.seconds_per_evaluation,
+                    "speedup_vs_reference": r.speedup,
+                }
+                for r in self.rows
             ],
             "skipped": self.skipped,
         }
@@ -327,7 +332,7 @@ ERROR_NAMES = {
     "lambda": "relative RMS error",
     "precision": "max relative error of float32",
 }
-TABLE_COLUMNS = ["case", "method", "setting", "error", "ms/call", "ns/eval", "against"]
+TABLE_COLUMNS = ["case", "method", "setting", "error", "ms/call", "ns/eval", "× faster", "against"]
 
 
 def _table_row(r: Row) -> list[str]:
@@ -338,6 +343,7 @@ def _table_row(r: Row) -> list[str]:
         f"{r.error:.3g}",
         f"{r.seconds * 1e3:.3g}",
         f"{r.seconds_per_evaluation * 1e9:.3g}",
+        f"{r.speedup:.3g}" if r.reference_seconds else "",
         r.reference,
     ]
 

@@ -15,6 +15,7 @@ dimensionless; ``seconds`` is the best of a few calls after a warm-up.
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -38,10 +39,16 @@ class Row:
     seconds: float
     evaluations: int = 1
     reference: str = ""  # what the error is measured against
+    reference_seconds: float = 0.0  # what computing that reference took, same run
 
     @property
     def seconds_per_evaluation(self) -> float:
         return self.seconds / max(self.evaluations, 1)
+
+    @property
+    def speedup(self) -> float:
+        """How many times faster than its reference (0 when the reference is untimed)."""
+        return self.reference_seconds / self.seconds if self.seconds > 0 else 0.0
 
 
 def timed(fn: Callable[[], Any], repeat: int = 3) -> tuple[Any, float]:
@@ -50,6 +57,13 @@ def timed(fn: Callable[[], Any], repeat: int = 3) -> tuple[Any, float]:
 
     result = fn()
     return result, best_time(fn, repeat=repeat, min_time=2.0)
+
+
+def once(fn: Callable[[], Any]) -> tuple[Any, float]:
+    """(result, wall time) of a single call: for references too costly to repeat."""
+    t0 = time.perf_counter()
+    result = fn()
+    return result, time.perf_counter() - t0
 
 
 def relative_rms(estimate: np.ndarray, reference: np.ndarray, floor: float = 1e-3) -> float:
@@ -68,19 +82,19 @@ ALBEDO_ANGLES = np.radians([0.0, 20.0, 40.0, 60.0, 75.0, 85.0])
 
 def albedo_reference(
     model: Model, params: Any, theta: np.ndarray, nodes: int, samples: int
-) -> tuple[np.ndarray, str]:
-    """The converged albedo and how it was obtained.
+) -> tuple[np.ndarray, str, float]:
+    """The converged albedo, how it was obtained and how long that took.
 
     A fine quadrature is the most precise reference for smooth lobes, but no fixed grid
     resolves a near-delta lobe (roughness 0, a glossy clearcoat): there it is simply
     wrong. So it is checked against an independent many-sample Monte Carlo estimate and
     used only where the two agree within 4σ; otherwise the Monte Carlo one is.
     """
-    quad = albedo_quadrature(model, params, theta, n_mu=nodes, n_phi=nodes).albedo
-    mc = albedo_monte_carlo(model, params, theta, n_samples=samples, seed=7919)
-    if np.all(np.abs(quad - mc.albedo) <= 4.0 * mc.stderr + 1e-9):
-        return quad, f"quadrature {nodes}×{nodes}"
-    return mc.albedo, f"monte carlo {samples} spp"
+    quad, t_quad = once(lambda: albedo_quadrature(model, params, theta, n_mu=nodes, n_phi=nodes))
+    mc, t_mc = once(lambda: albedo_monte_carlo(model, params, theta, n_samples=samples, seed=7919))
+    if np.all(np.abs(quad.albedo - mc.albedo) <= 4.0 * mc.stderr + 1e-9):
+        return quad.albedo, f"quadrature {nodes}×{nodes}", t_quad
+    return mc.albedo, f"monte carlo {samples} spp", t_mc
 
 
 def bench_albedo(
@@ -95,7 +109,9 @@ def bench_albedo(
 ) -> list[Row]:
     """Error against time of each albedo estimator for one material."""
     theta = ALBEDO_ANGLES
-    reference, against = albedo_reference(model, params, theta, reference_nodes, reference_samples)
+    reference, against, t_ref = albedo_reference(
+        model, params, theta, reference_nodes, reference_samples
+    )
     rows = []
     for n in quadrature:
         curve, t = timed(lambda n=n: albedo_quadrature(model, params, theta, n_mu=n, n_phi=n))
@@ -109,6 +125,7 @@ def bench_albedo(
                 t,
                 n * n * len(theta),
                 against,
+                t_ref,
             )
         )
     for n in samples:
@@ -123,6 +140,7 @@ def bench_albedo(
                 t,
                 n * len(theta),
                 against,
+                t_ref,
             )
         )
     table, t = timed(lambda: albedo_tabulated(model, params, theta))
@@ -137,6 +155,7 @@ def bench_albedo(
                 t,
                 len(theta),
                 against,
+                t_ref,
             )
         )
     return rows
@@ -161,7 +180,7 @@ def bench_lambda(
     rows = []
     n_eval = len(LAMBDA_COS)
     for r in LAMBDA_ROUGHNESS:
-        ref = lambda_integrated(LAMBDA_COS, r, reference_nodes)
+        ref, t_ref = timed(lambda r=r: lambda_integrated(LAMBDA_COS, r, reference_nodes))
         against = f"integral {reference_nodes} nodes"
         case = f"r = {r:g}"
         if fit is not None:
@@ -176,6 +195,7 @@ def bench_lambda(
                     t,
                     n_eval,
                     against,
+                    t_ref,
                 )
             )
         for n in nodes:
@@ -190,6 +210,7 @@ def bench_lambda(
                     t,
                     n_eval,
                     against,
+                    t_ref,
                 )
             )
     return rows
@@ -236,7 +257,7 @@ def bench_precision(case: str, model: Model, params: Any, n: int = 20000) -> lis
         f"{wi[worst, 2]:.2g}, {wo[worst, 2]:.2g}" + (f"; {bad32} non-finite" if bad32 else "")
     )
     return [
-        Row("precision", case, "float64", note, 0.0, t64, n + 5, "float64"),
+        Row("precision", case, "float64", note, 0.0, t64, n + 5, "float64", t64),
         Row(
             "precision",
             case,
@@ -246,6 +267,7 @@ def bench_precision(case: str, model: Model, params: Any, n: int = 20000) -> lis
             t32,
             n + 5,
             "float64",
+            t64,
         ),
     ]
 
@@ -287,7 +309,8 @@ def bench_render(
     def render(spp: int, seed: int) -> np.ndarray:
         return table.render(spp, seed).astype(np.float64)
 
-    reference = render(reference_spp, seed=10_000)
+    render(1, seed=0)  # compiles the kernels, so the reference's time is rendering only
+    reference, t_ref = once(lambda: render(reference_spp, seed=10_000))
     rows = []
     for k, spp in enumerate(ladder):
         image, t = timed(lambda spp=spp, k=k: render(spp, seed=k + 1), repeat=2)
@@ -301,6 +324,7 @@ def bench_render(
                 t,
                 size[0] * size[1] * spp,
                 f"{reference_spp} spp render",
+                t_ref,
             )
         )
     return rows
