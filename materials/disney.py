@@ -358,19 +358,8 @@ def _transmission(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any, pdf
             return mf.visible_ggx_pdf(xp, wo, h, ax, ay) / xp.maximum(4.0 * oh, xp.tiny)
         g = mf.g1_over_cos(xp, wm[2], _qt(pr, wm)) * mf.g1_over_cos(xp, wo[2], _qt(pr, wo))
         return (1.0 - fr.dielectric(xp, oh, pr["eta"])) * mf.ggx_d(xp, h, ax, ay) * g * 0.25
-    # Walter et al. 2007 / pbrt-v4 DielectricBxDF in radiance mode (the 1/η'² included).
     etap = _pick(xp, front, pr["eta"], 1.0 / pr["eta"])
-    h = mf.transmission_half(xp, wi, wo, etap)
-    ih, oh = xp.dot(wi, h), xp.dot(wo, h)
-    ok = (ih < 0.0) & (oh > 0.0)
-    denom = ih + oh / etap
-    denom2 = xp.maximum(denom * denom, xp.tiny)
-    if pdf:
-        return xp.select(ok, mf.visible_ggx_pdf(xp, wo, h, ax, ay) * xp.abs(ih) / denom2, 0.0)
-    g = mf.g1_over_cos(xp, -wi[2], _qt(pr, wi)) * mf.g1_over_cos(xp, wo[2], _qt(pr, wo))
-    d = mf.ggx_d(xp, h, ax, ay)
-    f = (1.0 - fr.dielectric(xp, oh, etap)) * d * g * xp.abs(ih * oh) / (denom2 * etap * etap)
-    return xp.select(ok, f, 0.0)
+    return mf.dielectric_btdf(xp, wi, wo, etap, ax, ay, pdf)
 
 
 def _qt(pr: dict[str, Any], w: Any) -> Any:

@@ -37,6 +37,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from . import fresnel as fr
+
 ALPHA_MIN = 1e-3
 CLEARCOAT_G_ALPHA = 0.25  # Burley 2012 §5.6: the clearcoat's fixed GGX G roughness
 _SERIES = 1e-6  # |x| below which exprel and the sampling ratio use their series
@@ -196,6 +198,28 @@ def transmission_half(xp: Any, wi: Any, wo: Any, eta: Any) -> Any:
     h = xp.normalize(wi * eta + wo)
     one = xp.full(h[2], 1.0)  # keeps the dtype of h
     return h * xp.select(h[2] < 0.0, -one, one)
+
+
+def dielectric_btdf(xp: Any, wi: Any, wo: Any, eta: Any, ax: Any, ay: Any, pdf: bool) -> Any:
+    """Rough dielectric transmission (Walter et al. 2007 eq. 21; pbrt-v4 DielectricBxDF).
+
+    f = (1 − F) D G1(wi) G1(wo) |wi·h| |wo·h| / (|cos θi| cos θo (wi·h + wo·h/η)² η²),
+    the last 1/η² for radiance transport. ``wo`` is up (relative IOR 1), ``wi`` below,
+    ``eta`` = η_wi/η_wo. With ``pdf``: the density of refracting ``wo`` about a visible
+    normal, D_wo(h) |wi·h| / (wi·h + wo·h/η)². Zero where no microfacet connects them.
+    """
+    h = transmission_half(xp, wi, wo, eta)
+    ih, oh = xp.dot(wi, h), xp.dot(wo, h)
+    ok = (ih < 0.0) & (oh > 0.0)
+    denom = ih + oh / eta
+    denom2 = xp.maximum(denom * denom, xp.tiny)
+    if pdf:
+        return xp.select(ok, visible_ggx_pdf(xp, wo, h, ax, ay) * xp.abs(ih) / denom2, 0.0)
+    q_i = (ax * wi[0]) * (ax * wi[0]) + (ay * wi[1]) * (ay * wi[1])
+    q_o = (ax * wo[0]) * (ax * wo[0]) + (ay * wo[1]) * (ay * wo[1])
+    g = g1_over_cos(xp, -wi[2], q_i) * g1_over_cos(xp, wo[2], q_o)
+    f = (1.0 - fr.dielectric(xp, oh, eta)) * ggx_d(xp, h, ax, ay) * g * xp.abs(ih * oh)
+    return xp.select(ok, f / (denom2 * eta * eta), 0.0)
 
 
 def reflect(xp: Any, w: Any, h: Any) -> Any:
