@@ -222,7 +222,8 @@ def _known(alpha: Any, value: float) -> bool:
 
 def _interact(incoming: str, cone_in: Any, lobe: str, cone_lobe: Any) -> tuple[str, Any]:
     """Smits' rule: less blur keeps type and cone, same blur takes the max cone, more
-    blur replaces the type and brings the lobe's cone."""
+    blur replaces the type and "keeps any cone angle the same", read as: the lobe keeps
+    its own cone (a refracted ray meeting a 20° specular lobe leaves in that lobe)."""
     if BLUR[lobe] < BLUR[incoming]:
         return incoming, cone_in
     if BLUR[lobe] == BLUR[incoming]:
