@@ -272,3 +272,19 @@ def test_a_channel_beside_alpha_is_not_premultiplied(tmp_path):
     m = evaluate(TextureMask(path=path, channel="R"), 2)
     assert np.allclose(m, round(0.8 * 255) / 255, atol=1e-6)
     assert np.allclose(evaluate(TextureMask(path=path, channel="A"), 2), 128 / 255, atol=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("fmt", "suffix", "dtype", "step"),
+    [
+        (oiio.UINT8, "png", np.uint8, 1 / 255),
+        (oiio.UINT16, "png", np.uint16, 1 / 65535),
+        (oiio.HALF, "exr", np.float16, 1 / 1024),
+    ],
+)
+def test_decoded_masks_stay_in_the_files_pixel_format(tmp_path, fmt, suffix, dtype, step):
+    values = np.linspace(0, 1, 16, dtype=np.float32).reshape(4, 4)
+    tex = TextureMask(path=write_image(tmp_path / f"m.{suffix}", values, fmt=fmt))
+    sampler = MaskSampler((4, 4))
+    assert sampler.image(tex).dtype == dtype  # 1 or 2 bytes a texel, not 4
+    assert np.allclose(sampler.evaluate(tex)[::-1], values, atol=step)

@@ -37,7 +37,7 @@ from lookdev.materials.layers import (
     TextureMask,
 )
 
-from .resample import read_channels, resample, taps
+from .resample import as_float, read_channels, resample, taps
 
 
 class MaskSampler:
@@ -56,11 +56,12 @@ class MaskSampler:
         self._tap_cache: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
 
     def image(self, tex: TextureMask, count: int = 1, *, where: str | None = None) -> np.ndarray:
-        """The source channels of ``tex`` (cached), float32 (h, w, count) in UV order."""
+        """The source channels of ``tex`` (cached, as stored; see :func:`.read_channels`)."""
         key = (str(tex.path), tex.channel, count)
         if key not in self._images:
             a = read_channels(tex, count, where=where)
-            self._images[key] = (a, (float(a.min()), float(a.max())))
+            lo, hi = as_float(np.array([a.min(), a.max()], dtype=a.dtype))
+            self._images[key] = (a, (float(lo), float(hi)))
         return self._images[key][0]
 
     def lookup(

@@ -37,14 +37,24 @@ _AS_DATA.attribute("oiio:UnassociatedAlpha", 1)
 with unassociated alpha (PNG, TGA, some TIFFs) on read, which would scale a mask channel
 by alpha."""
 
+_STORED = {
+    "uint8": (oiio.UINT8, np.uint8),
+    "uint16": (oiio.UINT16, np.uint16),
+    "half": (oiio.HALF, np.float16),
+}
+"""File pixel formats kept as they are in memory (OpenImageIO type, numpy dtype)."""
+
 _ALIASES = {"r": 0, "g": 1, "b": 2, "a": 3, "x": 0, "y": 1, "z": 2}
 """Channel letters understood when a file does not name its channels that way."""
 
 
 def read_channels(tex: TextureMask, count: int = 1, *, where: str | None = None) -> np.ndarray:
-    """``count`` channels of ``tex.path`` from ``tex.channel`` on, float32 (h, w, count).
+    """``count`` channels of ``tex.path`` from ``tex.channel`` on, (h, w, count), UV order.
 
-    Raises :class:`TextureError` (one line naming ``where`` and the file) when the file is
+    Values are kept as stored, so a decoded mask costs no more memory than the file's
+    pixels: uint8 and uint16 stay integers, half stays float16, anything else becomes
+    float32; :func:`as_float` normalises them (integers to 0..1). Raises
+    :class:`TextureError` (one line naming ``where`` and the file) when the file is
     missing, cannot be decoded, lacks the channel, or holds NaN or infinity.
     """
     path = Path(tex.path)
@@ -63,13 +73,25 @@ def read_channels(tex: TextureMask, count: int = 1, *, where: str | None = None)
         )
     roi = oiio.ROI(spec.x, spec.x + spec.width, spec.y, spec.y + spec.height, 0, 1)
     roi.chbegin, roi.chend = first, first + count
-    pixels = buf.get_pixels(oiio.FLOAT, roi)
+    oiio_type, dtype = _STORED.get(str(spec.format), (oiio.FLOAT, np.float32))
+    pixels = buf.get_pixels(oiio_type, roi)
     if buf.has_error or pixels is None or np.size(pixels) == 0:
         raise TextureError(f"cannot read pixels of {path}: {_oiio_error(buf)}", where=where)
-    pixels = np.asarray(pixels, dtype=np.float32).reshape(spec.height, spec.width, count)
-    if not np.isfinite(pixels).all():
+    pixels = np.asarray(pixels, dtype=dtype).reshape(spec.height, spec.width, count)
+    if pixels.dtype.kind == "f" and not np.isfinite(pixels).all():
         raise TextureError(f"{path} has non-finite pixels (NaN or infinity)", where=where)
     return np.ascontiguousarray(pixels[::-1])
+
+
+def as_float(a: np.ndarray) -> np.ndarray:
+    """Stored texels as float32: integers normalised to 0..1 (v / 255, v / 65535).
+
+    >>> as_float(np.array([0, 51, 255], dtype=np.uint8)).tolist()
+    [0.0, 0.20000000298023224, 1.0]
+    """
+    if a.dtype.kind == "u":
+        return a.astype(np.float32) / np.float32(np.iinfo(a.dtype).max)
+    return a.astype(np.float32, copy=False)
 
 
 def channel_index(channel: int | str, names: list[str]) -> int | None:
@@ -141,7 +163,7 @@ def resample(
     v_idx, v_w = v_taps
     needed, v_local = np.unique(v_idx, return_inverse=True)
     v_local = v_local.reshape(v_idx.shape)
-    rows = _apply_axis(src[needed], *u_taps, axis=1)
+    rows = _apply_axis(as_float(src[needed]), *u_taps, axis=1)
     return _apply_axis(rows, v_local, v_w, axis=0)
 
 
