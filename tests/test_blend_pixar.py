@@ -239,3 +239,19 @@ def test_layer_lobes_match_the_model_weights():
         assert np.array_equal(lobes[lobe].n, w[PREFIX[lobe] + "N"])
     assert lobes["specular"].cone == pytest.approx(30 * 0.1 + 5)
     assert lobes["reflection"].cone == pytest.approx(1.0)
+
+
+def test_tiles_match_one_pass(monkeypatch):
+    from lookdev.pipeline.blend import engine
+
+    stack = layered(
+        layer(pixar("c", CLAY)),
+        layer(pixar("g", GLAZE), NoiseMask(seed=2), presence=0.8),
+        layer(pixar("c2", CLAY.replace(roughness=0.2)), NoiseMask(seed=5)),
+    )
+    whole = blend(stack, (9, 7))
+    monkeypatch.setattr(engine, "TILE_TEXELS", 9 * 3)  # 3 rows a tile, the last one 1 row
+    tiled = blend(stack, (9, 7))
+    assert whole.maps.keys() == tiled.maps.keys() and whole.maps["diffN"].shape == (7, 9, 3)
+    for name in whole.maps:
+        assert np.array_equal(whole.maps[name], tiled.maps[name]), name
