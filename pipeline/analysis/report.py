@@ -243,11 +243,20 @@ def material_plots(
                     environment=environment if view == "sphere" else None,
                     ibl_name=ibl or "",
                 ),
-                out_dir / "plots" / f"{name}_{view}.png",
+                out_dir / "plots" / f"{_slug(name)}_{view}.png",
             )
             for view in PLOT_VIEWS
         }
     return result
+
+
+def _slug(name: str) -> str:
+    """A file-name-safe form of a material name.
+
+    >>> _slug("rusty iron/v2")
+    'rusty_iron_v2'
+    """
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or "unnamed"
 
 
 def _environment(ibl: str | None, load: Any) -> np.ndarray | None:
@@ -268,7 +277,7 @@ th,td{padding:3px 10px;border-bottom:1px solid #333;text-align:right}
 th:first-child,td:first-child,th:nth-child(2),td:nth-child(2){text-align:left}
 .strip{display:flex;flex-wrap:wrap;gap:6px}.strip img{height:128px;background:#000}
 .plots img{height:260px;background:#fff;margin:4px}
-figure{margin:0}figcaption{font-size:12px;color:#999}
+figure{margin:0}figcaption{font-size:12px;color:#999}a{color:#8cf}
 img.sheet{width:100%;max-width:960px}
 """
 
@@ -288,7 +297,12 @@ def render_page(batch_dir: Path, entries: list[Entry], sheets: list[Path], plots
         "<!doctype html><html lang=en><head><meta charset=utf-8>",
         f"<title>lookdev proof: {esc(batch_dir.name)}</title><style>{CSS}</style></head><body>",
         f"<h1>lookdev proof — {esc(batch_dir.name)}</h1>",
-        f"<p>{len({e.material for e in entries})} material(s), {len(entries)} proof(s).</p>",
+        f"<p>{len({e.material for e in entries})} material(s), {len(entries)} proof(s): "
+        + ", ".join(
+            f'<a href="#{esc(_slug(m))}">{esc(m)}</a>'
+            for m in dict.fromkeys(e.material for e in entries)
+        )
+        + ".</p>",
     ]
     if sheets:
         parts.append("<h2>Contact sheets</h2>")
@@ -305,7 +319,7 @@ def render_page(batch_dir: Path, entries: list[Entry], sheets: list[Path], plots
         parts.append("<tr>" + "".join(f"<td>{esc(v)}</td>" for v in row) + "</tr>")
     parts.append("</tbody></table>")
     for material in dict.fromkeys(e.material for e in entries):
-        parts.append(f'<h2 id="{esc(material)}">{esc(material)}</h2>')
+        parts.append(f'<h2 id="{esc(_slug(material))}">{esc(material)}</h2>')
         if material in plots:
             parts.append('<div class="plots">')
             parts += [_img(p, batch_dir, f"{material} {v}") for v, p in plots[material].items()]
