@@ -16,7 +16,9 @@ over :data:`PARAM_SETS` (eight materials that between them switch on every lobe)
 
 Reported: evaluations per second of each and the throughput ratios
 ``ratio_drjit_to_mitsuba`` (target ≥ 0.5) and ``ratio_numpy_to_mitsuba`` (target ≥ 0.1,
-with the faster numpy dtype, named in ``numpy_dtype``).
+with the faster numpy dtype, named in ``numpy_dtype``). What pruning buys is measured
+too: numpy float32 with every lobe kept at weight zero (``ratio_pruned_to_every_lobe``,
+with ``every_lobe_max_abs_diff`` showing that the values are the same).
 
 The helpers :func:`principled_dict` and :func:`mitsuba_eval` are also what the tests
 use to compare the two models where they coincide.
@@ -177,15 +179,24 @@ def _split(n: int) -> list[slice]:
     return [slice(a, b) for a, b in zip(edges[:-1], edges[1:], strict=True)]
 
 
-def _numpy_runner(wi: np.ndarray, wo: np.ndarray, dtype: Any):
+def _every_lobe(xp: Any, params: DisneyParams) -> dict[str, Any]:
+    """``prepare`` with pruning undone: every lobe kept, zero weights and all (the baseline
+    that shows what "a zero lobe costs nothing" saves; the values do not change)."""
+    pr = disney.prepare(xp, params)
+    pr["lobes"] = disney.LOBES
+    pr["odds"], pr["odds_inside"] = disney._lobe_odds(xp, pr)
+    return pr
+
+
+def _numpy_runner(wi: np.ndarray, wo: np.ndarray, dtype: Any, prune: bool = True):
     xp = NumpyOps(dtype)
     parts = [(xp.asarray(wi[s].T), xp.asarray(wo[s].T)) for s in _split(len(wi))]
+    prepare = disney.prepare if prune else _every_lobe
 
     def run() -> list[Any]:
-        model = disney.MODEL
         with np.errstate(all="ignore"):  # masked branches may overflow, as in bsdf.evaluate
             return [
-                model.eval(xp, model.prepare(xp, p), a, b)
+                disney.MODEL.eval(xp, prepare(xp, p), a, b)
                 for p, (a, b) in zip(PARAM_SETS.values(), parts, strict=True)
             ]
 
@@ -256,6 +267,7 @@ def run(n: int = 1_000_000, *, repeat: int = 5, progress: Any = None) -> dict[st
     runners = {
         "numpy_float32": _numpy_runner(wi, wo, np.float32),
         "numpy_float64": _numpy_runner(wi, wo, np.float64),
+        "numpy_every_lobe": _numpy_runner(wi, wo, np.float32, prune=False),
         "drjit": _drjit_runner(wi, wo),
         "mitsuba": _mitsuba_runner(wi, wo),
     }
@@ -281,9 +293,16 @@ def run(n: int = 1_000_000, *, repeat: int = 5, progress: Any = None) -> dict[st
         "numpy_dtype": numpy_dtype,
         "ratio_drjit_to_mitsuba": rate["drjit"] / rate["mitsuba"],
         "ratio_numpy_to_mitsuba": rate[f"numpy_{numpy_dtype}"] / rate["mitsuba"],
+        "evals_per_s_numpy_every_lobe": rate["numpy_every_lobe"],
+        "ratio_pruned_to_every_lobe": rate["numpy_float32"] / rate["numpy_every_lobe"],
+        "every_lobe_max_abs_diff": _max_diff(runners["numpy_float32"], runners["numpy_every_lobe"]),
         "target_drjit": 0.5,
         "target_numpy": 0.1,
     }
+
+
+def _max_diff(a: Any, b: Any) -> float:
+    return float(max(np.max(np.abs(x - y)) for x, y in zip(a(), b(), strict=True)))
 
 
 def command(
@@ -318,6 +337,7 @@ def command(
     rows = [
         ["numpy float32", result["evals_per_s_numpy_float32"], "", ""],
         ["numpy float64", result["evals_per_s_numpy_float64"], "", ""],
+        ["numpy float32, no lobe pruned", result["evals_per_s_numpy_every_lobe"], "", ""],
         ["Dr.Jit (ours)", result["evals_per_s_drjit"], result["drjit_first_call_s"], ""],
         ["Mitsuba principled", result["evals_per_s_mitsuba"], result["mitsuba_first_call_s"], ""],
         ["ratio Dr.Jit / Mitsuba", result["ratio_drjit_to_mitsuba"], "", "≥ 0.5"],
@@ -327,6 +347,7 @@ def command(
             "",
             "≥ 0.1",
         ],
+        ["ratio pruned / no lobe pruned (numpy)", result["ratio_pruned_to_every_lobe"], "", ""],
     ]
     console.print(
         table(
