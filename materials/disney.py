@@ -508,6 +508,16 @@ def sample_core(xp: Any, pr: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any,
 MODEL = Model("disney", DisneyParams, prepare, eval_core, pdf_core, sample_core)
 
 
+def keep_every_lobe(xp: Any, prepared: dict[str, Any]) -> dict[str, Any]:
+    """A prepared material with pruning undone: every lobe evaluated, zero weights and all.
+
+    The same values at a higher cost; the baseline that measures what pruning saves.
+    """
+    pr = {**prepared, "lobes": LOBES}
+    pr["odds"], pr["odds_inside"] = _lobe_odds(xp, pr)
+    return pr
+
+
 def lobe_model(*names: str) -> Model:
     """The Disney model restricted to some lobes (their odds renormalised), for tests and
     per-lobe analysis. ``lobe_model("clearcoat")`` evaluates and samples only the clearcoat.

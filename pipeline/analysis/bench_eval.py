@@ -180,12 +180,7 @@ def _split(n: int) -> list[slice]:
 
 
 def _every_lobe(xp: Any, params: DisneyParams) -> dict[str, Any]:
-    """``prepare`` with pruning undone: every lobe kept, zero weights and all (the baseline
-    that shows what "a zero lobe costs nothing" saves; the values do not change)."""
-    pr = disney.prepare(xp, params)
-    pr["lobes"] = disney.LOBES
-    pr["odds"], pr["odds_inside"] = disney._lobe_odds(xp, pr)
-    return pr
+    return disney.keep_every_lobe(xp, disney.prepare(xp, params))
 
 
 def _numpy_runner(wi: np.ndarray, wo: np.ndarray, dtype: Any, prune: bool = True):
