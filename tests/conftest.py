@@ -2,7 +2,12 @@
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
+
+# Rich sizes its consoles when lookdev.pipeline.cli.common is first imported; a wide one
+# keeps long temporary paths on one line so tests can find them in the output.
+os.environ["COLUMNS"] = "240"
 
 import pytest
 

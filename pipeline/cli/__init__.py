@@ -23,7 +23,6 @@ app = typer.Typer(
     no_args_is_help=True,
     pretty_exceptions_enable=False,
     add_completion=False,
-    rich_markup_mode="rich",
 )
 
 
@@ -56,6 +55,15 @@ def _register() -> None:
     app.add_typer(presets.app, name="presets")
     app.command("plot")(plot.plot)
     app.command("proof")(proof.proof)
+    _reflow_help(app)
+
+
+def _reflow_help(typer_app: typer.Typer) -> None:
+    # Rich mode keeps every docstring line break, so help wraps raggedly in narrow
+    # terminals; markdown mode reflows paragraphs and keeps blank-line breaks.
+    typer_app.rich_markup_mode = "markdown"
+    for group in typer_app.registered_groups:
+        _reflow_help(group.typer_instance)
 
 
 _register()

@@ -78,9 +78,9 @@ def export_usd(
 ) -> None:
     """Write presets as UsdShade materials that DCCs and their renderers read.
 
-    Each preset becomes /Materials/NAME with up to three render contexts: [bold]universal[/]
+    Each preset becomes /Materials/NAME with up to three render contexts: **universal**
     (UsdPreviewSurface, read everywhere; what it cannot express is named in the surface's
-    customData), [bold]mtlx[/] (MaterialX ND_disney_principled) and [bold]ri[/] (RenderMan
+    customData), **mtlx** (MaterialX ND_disney_principled) and **ri** (RenderMan
     PxrDisneyBsdf). Only what a material needs is written: inputs at the target's
     default and lobes without weight are left out. Layered presets are blended and their
     varying parameters baked to EXR maps beside the file (UsdPreviewSurface has no mix
