@@ -115,3 +115,26 @@ def test_two_processes_saving_into_one_library_lose_nothing(tmp_path):
     verdicts = sorted(out.strip().split(":")[0] for out, _ in outs)
     assert verdicts == ["refused dup", "saved dup"], outs
     assert not list(tmp_path.glob(".*.tmp"))
+
+
+FLIPPER = textwrap.dedent(
+    """
+    import sys
+    from lookdev.library import Library
+
+    lib = Library([sys.argv[1]], use_env=False)
+    for i in range(40):
+        lib.update("mine", {"roughness": (0.1, 0.9)[i % 2], "description": "x" * (i * 50)})
+    """
+)
+
+
+def test_readers_never_see_a_half_written_preset(tmp_path):
+    lib = Library([tmp_path], use_env=False)
+    lib.save(PresetFile(name="mine", extends="gold", params={"roughness": 0.5}))
+    proc = start(FLIPPER, str(tmp_path))
+    seen = set()
+    while proc.poll() is None:
+        seen.add(lib.load("mine").params.roughness)  # raises on a torn file
+    assert proc.returncode == 0, proc.communicate()
+    assert seen <= {0.1, 0.5, 0.9} and len(seen) >= 2
