@@ -172,3 +172,20 @@ def test_bench_blend_smoke(cli):
         doc["pruning"]["rusty_car_paint"]["maps"]
         < doc["pruning"]["rusty_car_paint"]["maps_without"]
     )
+
+
+def test_cli_texture_paths_are_relative_to_the_preset(cli, tmp_path, monkeypatch):
+    looks = tmp_path / "looks"
+    looks.mkdir()
+    write_image(looks / "grime.png", np.tile([[0.0, 1.0]], (4, 2)), fmt=oiio.UINT8)
+    (looks / "grimy_gold.toml").write_text(
+        'name = "grimy_gold"\nmodel = "layered"\n'
+        '[[layers]]\npreset = "gold"\n'
+        '[[layers]]\nname = "grime"\npreset = "rust"\n'
+        'mask = { kind = "texture", path = "grime.png", wrap = "clamp" }\n'
+    )
+    monkeypatch.chdir(tmp_path)  # not the preset's folder
+    r = cli("blend", "grimy_gold", "-L", "looks", "-o", "out", "-r", "4", "--json")
+    assert r.code == 0, r.err
+    doc = json.loads(r.out)
+    assert doc["maps"]["roughness"]["min"] < doc["maps"]["roughness"]["max"]
