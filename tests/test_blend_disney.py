@@ -351,3 +351,12 @@ def test_pruning_never_changes_a_texel(spec):
     for name, full in naive.maps.items():
         mine = pruned.maps.get(name, pruned.constants.get(name))
         assert np.allclose(full, np.asarray(mine, dtype=np.float32), atol=1e-6), name
+
+
+def test_a_flat_twin_over_a_normal_map_is_kept(tmp_path):
+    tilt = _normal_file(tmp_path, "tilt.exr", (1.0, 0.0, 1.0))
+    twin = GOLD.model_copy(update={"name": "twin"})
+    out = blend(layered(layer(GOLD, normal_map=tilt), layer(twin, 0.5)), 4)
+    assert out.decisions[-1].kept  # same parameters, but it flattens the normals below
+    expected = np.array([0.5 / np.sqrt(2), 0.0, 0.5 / np.sqrt(2) + 0.5])
+    assert np.allclose(out.normal_map, expected / np.linalg.norm(expected), atol=1e-6)

@@ -187,8 +187,10 @@ def _plan(values: list[dict[str, Any]], kept: list[Entry]):
     constants: dict[str, Any] = dict(values[0])
     varying: set[str] = set()
     inert = []
+    bumpy = False  # a normal map so far: any layer over it flattens it where it shows
     for i, (entry, layer) in enumerate(zip(kept[1:], values[1:], strict=True), start=1):
-        changes = entry.normal_map is not None or entry.specular_normal_map is not None
+        bumpy = bumpy or _has_normals(kept[i - 1])
+        changes = bumpy or _has_normals(entry)
         for key, p in layer.items():
             if key in varying:
                 changes = True
@@ -202,6 +204,10 @@ def _plan(values: list[dict[str, Any]], kept: list[Entry]):
         if not changes:
             inert.append(i)
     return constants, varying, set(inert)
+
+
+def _has_normals(entry: Entry) -> bool:
+    return entry.normal_map is not None or entry.specular_normal_map is not None
 
 
 def _lerp(a: Any, b: Any, m: float) -> Any:
