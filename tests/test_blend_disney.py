@@ -334,23 +334,44 @@ _coverage = st.one_of(
 )
 
 
+@pytest.fixture(scope="module")
+def bumps(tmp_path_factory):
+    """A varying tangent-space normal map (encoded), 4×4."""
+    rng = np.random.default_rng(9)
+    n = np.concatenate([rng.uniform(-0.5, 0.5, (4, 4, 2)), np.ones((4, 4, 1))], axis=-1)
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    path = tmp_path_factory.mktemp("bumps") / "bumps.exr"
+    return TextureMask(path=write_image(path, 0.5 * n + 0.5))
+
+
 @settings(max_examples=30, deadline=None)
 @given(
     st.lists(
-        st.tuples(st.sampled_from([0.1, 0.5, 0.9]), st.sampled_from([0.0, 1.0]), _coverage),
+        st.tuples(
+            st.sampled_from([0.1, 0.5, 0.9]),
+            st.sampled_from([0.0, 1.0]),
+            _coverage,
+            st.booleans(),
+        ),
         min_size=1,
         max_size=5,
     )
 )
-def test_pruning_never_changes_a_texel(spec):
+def test_pruning_never_changes_a_texel(bumps, spec):
     layers = [
-        layer(disney(f"l{i}", roughness=r, metallic=m), cov) for i, (r, m, cov) in enumerate(spec)
+        layer(disney(f"l{i}", roughness=r, metallic=m), cov, normal_map=bumps if bumpy else None)
+        for i, (r, m, cov, bumpy) in enumerate(spec)
     ]
     stack = layered(*layers)
     pruned, naive = blend(stack, 4), blend(stack, 4, prune=False)
     for name, full in naive.maps.items():
         mine = pruned.maps.get(name, pruned.constants.get(name))
         assert np.allclose(full, np.asarray(mine, dtype=np.float32), atol=1e-6), name
+    if naive.normal_map is None:
+        assert pruned.normal_map is None
+    else:
+        mine = pruned.normal_map if pruned.normal_map is not None else np.array([0.0, 0.0, 1.0])
+        assert np.allclose(naive.normal_map, mine, atol=1e-5)
 
 
 def test_a_flat_twin_over_a_normal_map_is_kept(tmp_path):
