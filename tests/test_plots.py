@@ -45,6 +45,14 @@ def test_glossy_slice_peaks_at_theta_h_zero():
     assert np.all(np.argmax(f[:48, :, 0], axis=1) == 0)  # rows up to θd ≈ 67°
 
 
+def test_slice_isolines_are_the_incidence_angle_of_both_directions():
+    th = np.radians(np.linspace(0.5, 89.5, 7))
+    wi, wo = P.slice_directions(th, th)
+    expected = np.degrees(np.arccos(wi[..., 2]))
+    np.testing.assert_allclose(P.incidence_on_slice(*np.meshgrid(th, th)), expected, atol=1e-9)
+    np.testing.assert_allclose(wo[..., 2], wi[..., 2], atol=1e-12)  # φd = 90°: θl = θv
+
+
 def test_exposure_and_srgb_curve():
     np.testing.assert_allclose(P.to_display(np.array([0.25]), exposure=2), [1.0])
     assert P.to_display(np.array([0.5]), exposure=0)[0] == pytest.approx(0.735357, abs=1e-6)

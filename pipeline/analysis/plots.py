@@ -146,9 +146,32 @@ def to_display(radiance: np.ndarray, exposure: float = 0.0) -> np.ndarray:
     return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
 
 
+def incidence_on_slice(theta_h: np.ndarray, theta_d: np.ndarray) -> np.ndarray:
+    """θl (= θv) in degrees over the φd = 90° slice: cos θl = cos θh cos θd.
+
+    Burley Fig. 3 draws these isolines; diffuse effects tend to follow them.
+
+    >>> float(incidence_on_slice(np.radians(60.0), np.radians(60.0)).round(4))
+    75.5225
+    """
+    return np.degrees(np.arccos(np.cos(theta_h) * np.cos(theta_d)))
+
+
 def draw_slice(ax: Any, subject: Subject, *, exposure: float = 0.0, n: int = 128) -> None:
-    _, _, f = brdf_slice(subject.model, subject.params, n)
+    th, td, f = brdf_slice(subject.model, subject.params, n)
     ax.imshow(to_display(f, exposure), origin="lower", extent=(0, 90, 0, 90))
+    deg_h, deg_d = np.meshgrid(np.degrees(th), np.degrees(td))
+    lines = ax.contour(
+        deg_h,
+        deg_d,
+        incidence_on_slice(*np.meshgrid(th, td)),
+        [30, 60, 80],
+        colors="w",
+        linewidths=0.6,
+        linestyles=":",
+        alpha=0.7,
+    )
+    ax.clabel(lines, fmt="θl %g°", fontsize="xx-small")
     ax.set_xlabel("θh (°)")
     ax.set_ylabel("θd (°)")
     ax.set_xticks([0, 30, 60, 90])
