@@ -255,3 +255,18 @@ def test_tiles_match_one_pass(monkeypatch):
     assert whole.maps.keys() == tiled.maps.keys() and whole.maps["diffN"].shape == (16, 20, 3)
     for name in whole.maps:
         assert np.array_equal(whole.maps[name], tiled.maps[name]), name
+
+
+@pytest.mark.parametrize("mode", ["full", "simple"])
+def test_pruning_changes_nothing(mode):
+    stack = layered(
+        layer(pixar("g0", GLAZE)),
+        layer(pixar("c", CLAY), 1.0),  # opaque, full coverage: hides g0
+        layer(pixar("g", GLAZE), NoiseMask(scale=2, seed=4), presence=0.7),
+        layer(pixar("none", CLAY.replace(roughness=0.1)), 0.0),
+    )
+    pruned, naive = blend(stack, 8, layering=mode), blend(stack, 8, layering=mode, prune=False)
+    assert [d.kept for d in pruned.decisions] == [False, True, True, False]
+    for name, full in naive.maps.items():
+        mine = pruned.maps.get(name, pruned.constants.get(name))
+        assert np.allclose(full, np.asarray(mine, dtype=np.float32), atol=1e-6), name
