@@ -154,8 +154,9 @@ def composite(
 ) -> tuple[Lobes, dict[str, np.ndarray]]:
     """Combine ``(lobes, α)`` pairs, **top first**, into one set of lobes and two normals.
 
-    Returns the composite's lobes (cones energy-weighted) and ``{"diffuse", "highlight"}``
-    unit normals (energy-weighted, the geometric normal where there is no energy).
+    Returns the composite's lobes (cones energy-weighted; their ``normal`` is None) and
+    the ``{"diffuse", "highlight"}`` unit normals that replace per-lobe normals
+    (energy-weighted, the geometric normal where there is no energy).
     """
     if mode not in ("full", "simple"):
         raise BlendError(f"unknown Pixar layering {mode!r}; allowed: full, simple")
@@ -164,8 +165,7 @@ def composite(
         _simple(layers, acc)
     else:
         _full(layers, acc)
-    zero = _zero_like(layers[0][0])
-    lobes = {lobe: acc.total(lobe, zero) for lobe in LOBES}
+    lobes = {lobe: acc.total(lobe, _zero()) for lobe in LOBES}
     normals = {}
     for group in ("diffuse", "highlight"):
         total = sum(lobes[lobe].normal for lobe in LOBES if GROUP[lobe] == group)
@@ -193,9 +193,7 @@ def _full(layers: Sequence[tuple[Lobes, Any]], acc: _Sum) -> None:
     for lobes, alpha in layers:
         onward = _Sum()
         for kind, packet in packets.items():
-            for lobe, part in lobes.items():
-                if _known(alpha, 0.0):
-                    break
+            for lobe, part in () if _known(alpha, 0.0) else lobes.items():
                 out_type, cone = _interact(kind, packet.cone, TYPE_OF[lobe], part.cone)
                 hit = Part(packet.n * part.n, packet.g * part.g, cone, part.normal)
                 hit = _scaled(hit, alpha)
@@ -205,9 +203,8 @@ def _full(layers: Sequence[tuple[Lobes, Any]], acc: _Sum) -> None:
                     acc.add(REFLECTED[out_type], hit)
             if not _known(alpha, 1.0):
                 onward.add(TRANSMITTED[kind], _scaled(packet, 1.0 - alpha))  # through holes
-        zero = _zero_like(lobes)
         packets = {
-            TYPE_OF[lobe]: _normalised(onward.total(lobe, zero))
+            TYPE_OF[lobe]: _normalised(onward.total(lobe, _zero()))
             for lobe in LOBES
             if lobe.endswith("_t")
         }
@@ -248,7 +245,8 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return np.where(length > 1e-12, v / np.where(length > 1e-12, length, 1.0), flat)
 
 
-def _zero_like(lobes: Lobes) -> Part:
+def _zero() -> Part:
+    """No light: what a lobe nothing reached totals to."""
     z = np.zeros(3)
     return Part(z, z, 0.0, np.zeros(3))
 
