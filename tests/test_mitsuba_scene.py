@@ -112,14 +112,30 @@ def test_map_rows_follow_v(mi, m):
 
 
 def test_max_depth_follows_the_material(m):
-    assert m.max_depth_for(TinyParams()) == m.DEPTH_OPAQUE
-    assert m.max_depth_for(TinyParams(translucency=0.5)) == m.DEPTH_THIN_TRANSMISSION
+    from lookdev.pipeline.export.mitsuba import depth
+
+    dark = TinyParams(base_color=(0.1, 0.1, 0.1))
+    assert depth.max_depth_for(dark) == depth.DEPTH_DARK
+    assert depth.max_depth_for(TinyParams()) == depth.DEPTH_BRIGHT  # ρ = 0.8
+    assert depth.max_depth_for(TinyParams(translucency=0.5)) == depth.DEPTH_THIN_DIFFUSE
     zero = _blended(translucency=np.zeros((4, 4), np.float32))
-    assert m.max_depth_for(zero) == m.DEPTH_OPAQUE
+    zero.constants = {"base_color": (0.1, 0.1, 0.1)}
+    assert depth.max_depth_for(zero) == depth.DEPTH_DARK
     some = np.zeros((4, 4), np.float32)
-    some[3, 3] = 0.01
-    assert m.max_depth_for(_blended(translucency=some)) == m.DEPTH_THIN_TRANSMISSION
-    assert m.DEPTH_OPAQUE < m.DEPTH_THIN_TRANSMISSION < m.DEPTH_SOLID_TRANSMISSION
+    some[3, 3] = 0.01  # one texel transmits: the whole material needs the longer paths
+    assert depth.max_depth_for(_blended(translucency=some)) == depth.DEPTH_THIN_DIFFUSE
+
+
+def test_albedo_for_is_the_normal_incidence_albedo_anywhere(m):
+    """Tiny model at normal view: albedo ρ(1 + cos 0)/2 = ρ, the largest channel and texel."""
+    from lookdev.pipeline.export.mitsuba import depth
+
+    assert depth.albedo_for(m.flatten(TinyParams(base_color=(0.3, 0.7, 0.2)))) == pytest.approx(
+        0.7, rel=1e-6
+    )
+    color = np.full((8, 8, 3), 0.2, np.float32)
+    color[5, 6] = (0.1, 0.9, 0.3)  # one bright texel among 64: sampled, so it counts
+    assert depth.albedo_for(m.flatten(_blended(base_color=color))) == pytest.approx(0.9, rel=1e-6)
 
 
 def test_force_all_lobes_is_passed_to_the_plugin(mi, m):
@@ -243,10 +259,14 @@ def test_fast_path_only_where_measured(m, disney):
 
 def test_depth_for_disney(m, disney):
     from lookdev.materials.params import DisneyParams
+    from lookdev.pipeline.export.mitsuba import depth
 
-    assert m.max_depth_for(DisneyParams()) == m.DEPTH_OPAQUE
-    assert m.max_depth_for(DisneyParams(spec_trans=1.0, thin=True)) == m.DEPTH_THIN_TRANSMISSION
-    assert m.max_depth_for(DisneyParams(spec_trans=1.0, ior=1.5)) == m.DEPTH_SOLID_TRANSMISSION
+    assert depth.max_depth_for(DisneyParams(base_color=(0.05, 0.05, 0.05))) == depth.DEPTH_DARK
+    assert depth.max_depth_for(DisneyParams(metallic=1.0)) == depth.DEPTH_BRIGHT
+    thin_glass = DisneyParams(spec_trans=1.0, thin=True)
+    assert depth.max_depth_for(thin_glass) == depth.DEPTH_THIN_GLOSSY
+    solid_glass = DisneyParams(spec_trans=1.0, ior=1.5)
+    assert depth.max_depth_for(solid_glass) == depth.DEPTH_SOLID_GLOSSY
 
 
 def test_cli_export_mitsuba(mi, cli, disney, tmp_path):
@@ -268,7 +288,7 @@ def test_cli_export_mitsuba(mi, cli, disney, tmp_path):
     )
     assert result.code == 0, result.err
     summary = json.loads(result.out)
-    assert summary["scene"] == str(out) and summary["max_depth"] == 4
+    assert summary["scene"] == str(out) and summary["max_depth"] == 6  # a bright metal
     assert summary["bsdf"] == "principled" and not summary["plugins"]  # untextured metal
     assert np.all(np.isfinite(np.array(mi.render(mi.load_file(str(out))))))
 
@@ -303,6 +323,7 @@ def test_forcing_all_lobes_traces_more_and_renders_the_same(mi, m, disney):
 def test_every_builtin_preset_becomes_a_bsdf(mi, m, disney):
     """Each built-in preset exports (layered ones blended at 32²) and Mitsuba loads it."""
     from lookdev.library import Library
+    from lookdev.pipeline.export.mitsuba import depth
 
     library = Library(use_env=False)
     for name in library.names():
@@ -314,11 +335,7 @@ def test_every_builtin_preset_becomes_a_bsdf(mi, m, disney):
         flat = m.flatten(material, 32)
         bsdf = mi.load_dict(m.bsdf_dict(flat))
         assert bsdf.flags() != 0, name
-        assert m.max_depth_for(flat) in (
-            m.DEPTH_OPAQUE,
-            m.DEPTH_THIN_TRANSMISSION,
-            m.DEPTH_SOLID_TRANSMISSION,
-        )
+        assert depth.max_depth_for(flat) in (4, 6, 10, 16), name
 
 
 def test_cli_exports_a_layered_preset_with_its_maps(mi, cli, disney, tmp_path):

@@ -5,8 +5,9 @@
 ['MitsubaExportError', 'bsdf_dict', 'export_scene']
 """
 
+from .depth import max_depth_for
 from .plugin import MitsubaExportError, register_model
-from .scene import bsdf_dict, max_depth_for, register_plugins, scene_dict
+from .scene import bsdf_dict, register_plugins, scene_dict
 from .xml import export_scene, write_xml
 
 __all__ = [

@@ -4,8 +4,8 @@
 ``mi.load_dict`` takes: our own plugin (:mod:`.plugin`) for the material's model, with
 uniform parameters as constants and varying ones as ``bitmap`` textures. Mitsuba's
 built-in ``principled`` replaces it only where the two were measured equal (see
-:func:`principled_equivalent`). :func:`max_depth_for` sizes the path tracer to what the
-material needs and :func:`scene_dict` is the small export scene (one sphere under an
+:func:`principled_equivalent`). :func:`.depth.max_depth_for` sizes the path tracer to what
+the material needs and :func:`scene_dict` is the small export scene (one sphere under an
 environment) that ``lookdev export mitsuba`` writes.
 
 Texture orientation: Mitsuba's bitmap puts an image's row 0 at v = 0, and a blended map's
@@ -26,7 +26,6 @@ from typing import Any
 
 import numpy as np
 
-from lookdev.materials.arrays import NumpyOps
 from lookdev.materials.bsdf import Model
 from lookdev.materials.params import Params
 
@@ -34,8 +33,6 @@ from .plugin import (
     FORCE_ALL_LOBES,
     MitsubaExportError,
     is_color_field,
-    lobe_kinds,
-    lobes_of,
     register_model,
 )
 
@@ -45,14 +42,6 @@ MODEL_MODULES = {
     "pixar": "lookdev.materials.pixar",
 }
 """Where each model's ``MODEL`` lives; a plugin ``lookdev_<name>`` is registered for each."""
-
-# Path lengths (Mitsuba's max_depth counts segments: 2 = direct lighting only). An opaque
-# ball on a ground plane needs the ground bounce and one more for its own concavities; a
-# thin sheet adds the crossing; a solid dielectric adds the way in, the way out and a few
-# total internal reflections before the light gets out.
-DEPTH_OPAQUE = 4
-DEPTH_THIN_TRANSMISSION = 6
-DEPTH_SOLID_TRANSMISSION = 12
 
 DEFAULT_MAP_RESOLUTION = 512
 
@@ -172,26 +161,6 @@ def _plain(value: Any) -> Any:
     if isinstance(value, np.ndarray | list | tuple):
         return tuple(float(c) for c in np.asarray(value).ravel())
     return value.item() if isinstance(value, np.generic) else value
-
-
-def lobes_for(flat: Flat) -> tuple[str, ...]:
-    """The lobes the model keeps for this material, everywhere on it (numpy backend)."""
-    model = model_for(flat.model)
-    params = model.params_type.parse(flat.constants, where=flat.name)
-    maps = {k: (v.reshape(-1, 3).T if v.ndim == 3 else v.reshape(-1)) for k, v in flat.maps.items()}
-    with np.errstate(all="ignore"):
-        return lobes_of(model.prepare(NumpyOps(np.float32), params, **maps))
-
-
-def max_depth_for(material: Any) -> int:
-    """Path-tracer depth the material needs: opaque < thin transmissive < solid glass."""
-    flat = flatten(material)
-    kinds = lobe_kinds(lobes_for(flat), flat.model)
-    if not any("Transmission" in k for k in kinds):
-        return DEPTH_OPAQUE
-    if flat.constants.get("thin", False) or "GlossyTransmission" not in kinds:
-        return DEPTH_THIN_TRANSMISSION
-    return DEPTH_SOLID_TRANSMISSION
 
 
 def principled_equivalent(flat: Flat) -> dict[str, Any] | None:
@@ -348,6 +317,8 @@ def scene_dict(
     holds RGB only (no alpha, no AOVs).
     """
     import mitsuba as mi
+
+    from .depth import max_depth_for  # depth builds on this module's flatten
 
     flat = flatten(material, map_resolution)
     _ensure_variant()
