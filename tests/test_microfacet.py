@@ -241,8 +241,11 @@ def test_dielectric_fresnel_is_the_same_from_both_sides(cos_i, eta):
     cos_t = math.sqrt(1 - sin_t2)
     a = float(fr.dielectric(XP, np.float64(cos_i), eta))
     b = float(fr.dielectric(XP, np.float64(cos_t), 1 / eta))
-    assert a == pytest.approx(b, abs=1e-6)  # F's slope is infinite at the critical angle
-    assert 0.0 <= a <= 1.0
+    assert 0.0 <= a <= 1.0 and 0.0 <= b <= 1.0
+    # F's slope is infinite at grazing and at the critical angle: a rounding of cos t there
+    # moves F by ~cos-rounding / cos. Both ends have their own exact edge tests.
+    if min(cos_i, cos_t) > 1e-2:
+        assert a == pytest.approx(b, abs=1e-9)
 
 
 def test_schlick_edges():
