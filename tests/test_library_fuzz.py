@@ -7,13 +7,15 @@ never another exception, never a multi-line message.
 
 from __future__ import annotations
 
+import tomllib
+
 import jsonschema
 import tomli_w
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from lookdev.library import Library, Material, PresetFile, dump_preset, read_preset
-from lookdev.library.index import read_header
+from lookdev.library.index import read_header, simple_header
 from lookdev.library.library import apply_changes
 from lookdev.library.preset import build_preset
 from lookdev.library.schema import preset_schema
@@ -179,3 +181,34 @@ def test_any_set_either_applies_or_fails_in_one_line(changes):
     for key, value in changes.items():
         if value is not None and key in PARAM_NAMES:
             assert edited.params[key] == value
+
+
+TOMLISH = st.text(alphabet=list("name=\"'#[],\\ \t\nabxé\x00\r\x7ftagsdcriptoulx"), max_size=60)
+header_values = st.one_of(st.text(max_size=12), st.lists(st.text(max_size=6), max_size=3))
+header_docs = st.dictionaries(st.sampled_from(["name", "model", "tags", "source"]), header_values)
+
+
+@settings(max_examples=400, deadline=None)
+@given(
+    text=st.one_of(
+        TOMLISH,
+        header_docs.map(tomli_w.dumps),
+        st.builds(
+            lambda d, pad, note: "\n".join(
+                f"{pad}{k}{pad}={pad}'{v}'{pad}#{note}"
+                if isinstance(v, str) and "'" not in v
+                else f"{k} = {tomli_w.dumps({'v': v})[4:].strip()}"
+                for k, v in d.items()
+            ),
+            header_docs,
+            st.sampled_from(["", " ", "\t"]),
+            st.text(max_size=5),
+        ),
+    )
+)
+def test_the_fast_header_parse_agrees_with_tomllib(text):
+    fast = simple_header(text)
+    event("plain" if fast is not None else "not plain")
+    if fast is None:
+        return  # not plain: the listing parses it with tomllib instead
+    assert fast == tomllib.loads(text)
