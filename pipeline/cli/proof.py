@@ -163,19 +163,19 @@ def proof(
         [
             e["material"],
             e["ibl"],
-            e["rendered"],
-            e["skipped"],
+            f"{e['rendered']} + {e['skipped']}",
             e["render_seconds"],
             e["mean_noise_relative"],
-            e["contact_sheet"],
         ]
         for e in doc["proofs"]
     ]
-    columns = ["material", "ibl", "rendered", "skipped", "render s", "noise (rel)", "sheet"]
+    columns = ["material", "ibl", "new + kept", "render s", "noise"]
     console.print(table(f"proofs in {output}", columns, rows))
-    console.print(f"{doc['wall_seconds']:.1f} s; manifest: {output / batch.MANIFEST}")
-    if report:
-        console.print(f"review page: {doc['report']}")
+    console.print(
+        f"{doc['wall_seconds']:.1f} s. Contact sheets: {output}/MATERIAL/IBL/contact.png; "
+        f"all proofs: {output / 'overview.png'}; manifest: {output / batch.MANIFEST}",
+        highlight=False,
+    )
 
 
 def _progress() -> Progress:
