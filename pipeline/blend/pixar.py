@@ -45,7 +45,7 @@ every view by interpolating in s, full layering is exact at both ends.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -74,6 +74,8 @@ GROUP = {lobe: "diffuse" if TYPE_OF[lobe] == "diffuse" else "highlight" for lobe
 VIEWS = {"": 1.0, "_grazing": 0.0}
 """Map-name suffix → cos θ of the view the weights are composited for."""
 CONES = ("specular", "reflection", "specular_t", "reflection_t")
+FLAT = np.array([0.0, 0.0, 1.0])
+"""The geometric normal in the shading frame."""
 
 
 @dataclass
@@ -83,7 +85,8 @@ class Part:
     n: Any
     g: Any
     cone: Any = 0.0
-    normal: Any = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+    normal: Any = None
+    """None: the geometric normal (0, 0, 1); no normal arithmetic is done for it."""
 
     @property
     def energy(self) -> Any:
@@ -108,13 +111,12 @@ def layer_lobes(params: PixarParams, cos_view: float, normals: dict | None = Non
     refl = max(10.0 * r * params.reflection_cone_scale, CONE_MIN_DEG)
     cone = {"diffuse": 0.0, "specular": spec, "reflection": refl}
     normals = normals or {}
-    flat = np.array([0.0, 0.0, 1.0])
     return {
         lobe: Part(
             np.asarray(w[PREFIX[lobe] + "N"], dtype=np.float64),
             np.asarray(w[PREFIX[lobe] + "G"], dtype=np.float64),
             cone[TYPE_OF[lobe]],
-            normals.get(GROUP[lobe], flat),
+            normals.get(GROUP[lobe]),
         )
         for lobe in LOBES
     }
@@ -129,13 +131,14 @@ class _Sum:
     def add(self, lobe: str, part: Part) -> None:
         self.parts[lobe].append(part)
 
-    def total(self, lobe: str, zero: Part) -> Part:
+    def total(self, lobe: str) -> Part:
         """The lobe's summed weights, mean cone and energy-weighted normal *sum*.
 
         The mean is taken about the first part's cone, so parts that share a cone (or a
-        lone part) give that cone exactly.
+        lone part) give that cone exactly. The normal stays None when every part has the
+        geometric normal (no normal maps: the common case costs no vector arithmetic).
         """
-        parts = self.parts[lobe] or [zero]
+        parts = self.parts[lobe] or [_zero()]
         energies = [p.energy for p in parts]
         n = sum(p.n for p in parts[1:]) + parts[0].n
         g = sum(p.g for p in parts[1:]) + parts[0].g
@@ -143,9 +146,12 @@ class _Sum:
         e_sum = sum(energies)
         spread = sum(e * (p.cone - ref) for e, p in zip(energies, parts, strict=True))
         cone = ref + spread / np.where(e_sum > 0, e_sum, 1.0)
-        normal = sum(
-            np.asarray(e)[..., None] * p.normal for e, p in zip(energies, parts, strict=True)
-        )
+        normal = None
+        if any(p.normal is not None for p in parts):
+            normal = sum(
+                np.asarray(e)[..., None] * (FLAT if p.normal is None else p.normal)
+                for e, p in zip(energies, parts, strict=True)
+            )
         return Part(n, g, cone, normal)
 
 
@@ -165,11 +171,17 @@ def composite(
         _simple(layers, acc)
     else:
         _full(layers, acc)
-    lobes = {lobe: acc.total(lobe, _zero()) for lobe in LOBES}
+    lobes = {lobe: acc.total(lobe) for lobe in LOBES}
     normals = {}
     for group in ("diffuse", "highlight"):
-        total = sum(lobes[lobe].normal for lobe in LOBES if GROUP[lobe] == group)
-        normals[group] = _unit(total)
+        members = [lobes[lobe] for lobe in LOBES if GROUP[lobe] == group]
+        if all(p.normal is None for p in members):
+            normals[group] = FLAT
+            continue
+        weighted = [
+            p.normal if p.normal is not None else p.energy[..., None] * FLAT for p in members
+        ]
+        normals[group] = _unit(sum(weighted))
     for part in lobes.values():
         part.normal = None
     return lobes, normals
@@ -204,9 +216,7 @@ def _full(layers: Sequence[tuple[Lobes, Any]], acc: _Sum) -> None:
             if not _known(alpha, 1.0):
                 onward.add(TRANSMITTED[kind], _scaled(packet, 1.0 - alpha))  # through holes
         packets = {
-            TYPE_OF[lobe]: _normalised(onward.total(lobe, _zero()))
-            for lobe in LOBES
-            if lobe.endswith("_t")
+            TYPE_OF[lobe]: _normalised(onward.total(lobe)) for lobe in LOBES if lobe.endswith("_t")
         }
     for kind, packet in packets.items():
         acc.add(TRANSMITTED[kind], packet)
@@ -235,20 +245,20 @@ def _scaled(part: Part, c: Any) -> Part:
 
 def _normalised(part: Part) -> Part:
     """A part whose normal sum (energy-weighted, from :class:`_Sum`) is made unit."""
-    return Part(part.n, part.g, part.cone, _unit(part.normal))
+    return Part(part.n, part.g, part.cone, None if part.normal is None else _unit(part.normal))
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
     v = np.asarray(v, dtype=np.float64)
     length = np.linalg.norm(v, axis=-1, keepdims=True)
-    flat = np.broadcast_to(np.array([0.0, 0.0, 1.0]), v.shape)
+    flat = np.broadcast_to(FLAT, v.shape)
     return np.where(length > 1e-12, v / np.where(length > 1e-12, length, 1.0), flat)
 
 
 def _zero() -> Part:
     """No light: what a lobe nothing reached totals to."""
     z = np.zeros(3)
-    return Part(z, z, 0.0, np.zeros(3))
+    return Part(z, z, 0.0)
 
 
 def energy_sum(lobes: Lobes) -> tuple[np.ndarray, np.ndarray]:
