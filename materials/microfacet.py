@@ -140,8 +140,12 @@ def smith_g1(xp: Any, w: Any, ax: Any, ay: Any) -> Any:
     gives 0 instead of ∞/∞, and w = n gives exactly 1.
     """
     z = xp.abs(w[2])
-    q = (ax * w[0]) * (ax * w[0]) + (ay * w[1]) * (ay * w[1])
-    return 2.0 * z / xp.maximum(z + xp.sqrt(z * z + q), xp.tiny)
+    return z * g1_over_cos(xp, z, projected_roughness(w, ax, ay))
+
+
+def projected_roughness(w: Any, ax: Any, ay: Any) -> Any:
+    """q = αx² wx² + αy² wy², the roughness Smith's Λ sees along w (Heitz 2014 eq. 86)."""
+    return (ax * w[0]) * (ax * w[0]) + (ay * w[1]) * (ay * w[1])
 
 
 def g1_over_cos(xp: Any, z: Any, q: Any, z2: Any = None) -> Any:
@@ -215,9 +219,9 @@ def dielectric_btdf(xp: Any, wi: Any, wo: Any, eta: Any, ax: Any, ay: Any, pdf: 
     denom2 = xp.maximum(denom * denom, xp.tiny)
     if pdf:
         return xp.select(ok, visible_ggx_pdf(xp, wo, h, ax, ay) * xp.abs(ih) / denom2, 0.0)
-    q_i = (ax * wi[0]) * (ax * wi[0]) + (ay * wi[1]) * (ay * wi[1])
-    q_o = (ax * wo[0]) * (ax * wo[0]) + (ay * wo[1]) * (ay * wo[1])
-    g = g1_over_cos(xp, -wi[2], q_i) * g1_over_cos(xp, wo[2], q_o)
+    g = g1_over_cos(xp, -wi[2], projected_roughness(wi, ax, ay)) * g1_over_cos(
+        xp, wo[2], projected_roughness(wo, ax, ay)
+    )
     f = (1.0 - fr.dielectric(xp, oh, eta)) * ggx_d(xp, h, ax, ay) * g * xp.abs(ih * oh)
     return xp.select(ok, f / (denom2 * eta * eta), 0.0)
 
