@@ -160,11 +160,6 @@ def g1_over_cos(xp: Any, z: Any, q: Any, z2: Any = None) -> Any:
     return 2.0 / xp.maximum(z + xp.sqrt(z2 + q), 1e-6)
 
 
-def clearcoat_g1(xp: Any, w: Any) -> Any:
-    """Isotropic GGX G1 at the fixed α = 0.25 of the clearcoat (Burley §5.6)."""
-    return smith_g1(xp, w, CLEARCOAT_G_ALPHA, CLEARCOAT_G_ALPHA)
-
-
 # -- visible normals (Heitz 2018) ------------------------------------------------------------
 def sample_visible_ggx(xp: Any, wo: Any, ax: Any, ay: Any, u1: Any, u2: Any) -> Any:
     """A micro-normal h with density D_wo(h) = G1(wo) max(0, wo·h) D(h) / wo.z.
