@@ -87,6 +87,32 @@ def test_point_lit_lambert_sphere_is_n_dot_l_albedo_over_pi():
     assert img[~inside].max() == 0
 
 
+def test_sphere_wraps_parameter_maps_left_to_right_and_bottom_to_top():
+    # A 2×2 colour map: left/right halves in u, bottom/top halves in v.
+    colours = np.array([[[1, 0, 0], [0, 1, 0]], [[0, 0, 1], [1, 1, 1]]], dtype=np.float32)
+    img = S.point_light_sphere(
+        LAMBERT,
+        LambertParams(),
+        resolution=32,
+        light=(0, 0, 1),
+        irradiance=math.pi,
+        maps={"base_color": colours},
+    )
+    n, _ = S.sphere_normals(32)
+    np.testing.assert_allclose(img[24, 12], colours[0, 0] * n[24, 12, 2])  # bottom left
+    np.testing.assert_allclose(img[24, 20], colours[0, 1] * n[24, 20, 2])  # bottom right
+    np.testing.assert_allclose(img[7, 12], colours[1, 0] * n[7, 12, 2])  # top left
+    ibl = S.ibl_sphere(
+        LAMBERT,
+        LambertParams(),
+        np.ones((8, 16, 3)),
+        resolution=16,
+        spp=64,
+        maps={"base_color": colours},
+    )
+    assert ibl[4, 6].argmax() == 2 and ibl[12, 9].argmax() == 1  # blue top left, green bottom right
+
+
 def test_shading_frames_are_orthonormal_including_the_poles():
     n = np.array([[0, 0, 1.0], [0, 0, -1.0], [1.0, 0, 0], [0, 1.0, 0], [0.6, 0, 0.8]])
     t, s = S.shading_frames(n)
@@ -264,8 +290,9 @@ def test_layered_preset_is_plotted_at_its_centre_texel():
     blended = blend(load_material("rusty_iron"), P.LAYERED_RESOLUTION)
     assert blended.maps, "rusty_iron should vary across the surface"
     n = P.LAYERED_RESOLUTION // 2
-    assert subject.label == "rusty_iron (centre texel)"
+    assert subject.label == "rusty_iron"
     assert subject.params == blended.params_at(n, n)
+    assert subject.maps.keys() == blended.maps.keys()
     assert subject.model is P.model_named(blended.model)
 
 

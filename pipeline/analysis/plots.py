@@ -40,11 +40,16 @@ CHANNEL_COLOURS = ("#d62728", "#2ca02c", "#1f77b4")
 
 @dataclass(frozen=True)
 class Subject:
-    """One material to show: its label, model and (uniform) parameters."""
+    """One material to show: its label, model and parameters.
+
+    A layered material that varies across its surface also carries its blend's ``maps``:
+    the sphere wraps them on, the other views show ``params`` (its centre texel).
+    """
 
     label: str
     model: Model
     params: Any
+    maps: dict[str, np.ndarray] | None = None
 
 
 class PlotError(LookdevError):
@@ -67,7 +72,7 @@ def model_named(name: str) -> Model:
     return models[name]
 
 
-LAYERED_RESOLUTION = 64
+LAYERED_RESOLUTION = 256
 
 
 def subject_for(name_or_path: str, library: Any = None) -> Subject:
@@ -89,7 +94,7 @@ def subject_for(name_or_path: str, library: Any = None) -> Subject:
     if not blended.maps:
         return Subject(material.name, model, blended.to_params())
     h, w = next(iter(blended.maps.values())).shape[:2]
-    return Subject(f"{material.name} (centre texel)", model, blended.params_at(h // 2, w // 2))
+    return Subject(material.name, model, blended.params_at(h // 2, w // 2), blended.maps)
 
 
 def load_environment(name_or_path: str, width: int = 256) -> np.ndarray:
@@ -325,12 +330,18 @@ def figure(
     fig = plt.figure(figsize=(3.6 * cols, 3.4 * rows + 0.6), layout="constrained")
     for i, subject in enumerate(subjects):
         if view == "sphere":
-            img = point_light_sphere(subject.model, subject.params, resolution=resolution)
+            img = point_light_sphere(
+                subject.model, subject.params, resolution=resolution, maps=subject.maps
+            )
             ax = fig.add_subplot(rows, cols, i + 1)
             draw_sphere(ax, img, exposure, f"{subject.label}\npoint light")
             if environment is not None:
                 img = ibl_sphere(
-                    subject.model, subject.params, environment, resolution=min(resolution, 96)
+                    subject.model,
+                    subject.params,
+                    environment,
+                    resolution=min(resolution, 96),
+                    maps=subject.maps,
                 )
                 ax = fig.add_subplot(rows, cols, cols + i + 1)
                 draw_sphere(ax, img, exposure, f"{subject.label}\n{ibl_name}")
@@ -342,7 +353,7 @@ def figure(
             draw_albedo(ax, subject)
         else:
             draw_polar(ax, subject)
-        ax.set_title(subject.label)
+        ax.set_title(subject.label + ("\n(centre texel)" if subject.maps else ""))
     suffix = f", exposure {exposure:+g}" if view in ("slice", "sphere") else ""
     fig.suptitle(f"{view}{suffix}", fontsize="medium")
     return fig

@@ -60,6 +60,40 @@ def to_local(d: np.ndarray, t: np.ndarray, s: np.ndarray, n: np.ndarray) -> np.n
     return np.stack([(d * t).sum(-1), (d * s).sum(-1), (d * n).sum(-1)], axis=-1)
 
 
+def sphere_uv(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Texture coordinates of world normals (..., 3): a lat-long wrap, seam at the back.
+
+    u = ½ + atan2(x, z)/2π runs left to right across the visible half (0.25..0.75), and
+    v = ½ + asin(y)/π runs bottom to top, so the front shows the texture's middle half.
+
+    >>> [round(float(c), 3) for c in sphere_uv(np.array([0.0, 0.0, 1.0]))]
+    [0.5, 0.5]
+    """
+    u = 0.5 + np.arctan2(n[..., 0], n[..., 2]) / (2.0 * math.pi)
+    v = 0.5 + np.arcsin(np.clip(n[..., 1], -1.0, 1.0)) / math.pi
+    return u, v
+
+
+def maps_at(maps: dict[str, np.ndarray], n: np.ndarray) -> dict[str, np.ndarray]:
+    """Each parameter map's nearest texel under normals (..., 3): (...) or (..., 3).
+
+    Maps are in the blend's UV order: ``map[r, c]`` is centred on ((c + ½)/W, (r + ½)/H).
+    """
+    u, v = sphere_uv(n)
+    out = {}
+    for name, a in maps.items():
+        h, w = a.shape[:2]
+        col = np.clip((u * w).astype(int), 0, w - 1)
+        row = np.clip((v * h).astype(int), 0, h - 1)
+        out[name] = np.asarray(a[row, col], dtype=np.float64)
+    return out
+
+
+def _per_sample(pixel_maps: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Per-pixel maps (m,) / (m, 3) shaped to broadcast over (m, spp) samples."""
+    return {k: a[:, None] if a.ndim == 1 else a[:, None, :] for k, a in pixel_maps.items()}
+
+
 def point_light_sphere(
     model: Model,
     params: Any,
@@ -67,8 +101,12 @@ def point_light_sphere(
     resolution: int = 128,
     light: tuple[float, float, float] = (-1.0, 1.0, 1.0),
     irradiance: float = math.pi,
+    maps: dict[str, np.ndarray] | None = None,
 ) -> np.ndarray:
-    """Radiance image (H, W, 3) of the sphere under one distant light; black outside."""
+    """Radiance image (H, W, 3) of the sphere under one distant light; black outside.
+
+    ``maps`` (a blend's parameter maps) are wrapped onto the sphere (:func:`sphere_uv`).
+    """
     n, inside = sphere_normals(resolution)
     l_world = np.asarray(light, dtype=np.float64)
     l_world = l_world / np.linalg.norm(l_world)
@@ -76,7 +114,7 @@ def point_light_sphere(
     nn = n[inside]
     wi = to_local(l_world[None, :], t, s, nn)
     wo = to_local(np.array([[0.0, 0.0, 1.0]]), t, s, nn)
-    f = evaluate(model, params, wi, wo)
+    f = evaluate(model, params, wi, wo, **maps_at(maps or {}, nn))
     image = np.zeros((resolution, resolution, 3))
     image[inside] = np.nan_to_num(f) * np.clip(wi[:, 2:3], 0.0, None) * irradiance
     return image
@@ -148,11 +186,13 @@ def ibl_sphere(
     resolution: int = 96,
     spp: int = 64,
     seed: int = 0,
+    maps: dict[str, np.ndarray] | None = None,
 ) -> np.ndarray:
     """Radiance image (H, W, 3) of the sphere lit by a lat-long environment (H', W', 3).
 
     Each pixel takes ``spp`` BSDF samples and ``spp`` environment samples, combined with
-    the balance heuristic; the estimate is unbiased for any roughness.
+    the balance heuristic; the estimate is unbiased for any roughness. ``maps`` as in
+    :func:`point_light_sphere`.
     """
     env = LatLong(environment)
     n, inside = sphere_normals(resolution)
@@ -162,10 +202,11 @@ def ibl_sphere(
     rng = np.random.default_rng(seed)
     m = len(nn)
     frame = [a[:, None, :] for a in (t, s, nn)]
+    per = _per_sample(maps_at(maps or {}, nn))
 
     # Strategy 1: the BSDF's own sampler.
     wi, weight, p_bsdf = draw(
-        model, params, np.broadcast_to(wo, (m, spp, 3)), rng.random((m, spp, 3))
+        model, params, np.broadcast_to(wo, (m, spp, 3)), rng.random((m, spp, 3)), **per
     )
     world = sum(wi[..., k : k + 1] * frame[k] for k in range(3))
     p_env = env.pdf(world)
@@ -175,8 +216,8 @@ def ibl_sphere(
     # Strategy 2: the environment's luminance.
     world = env.sample(rng.random((m, spp, 3)))
     wi = to_local(world, *frame)
-    f = evaluate(model, params, wi, np.broadcast_to(wo, (m, spp, 3)))
-    p_bsdf = density(model, params, wi, np.broadcast_to(wo, (m, spp, 3)))
+    f = evaluate(model, params, wi, np.broadcast_to(wo, (m, spp, 3)), **per)
+    p_bsdf = density(model, params, wi, np.broadcast_to(wo, (m, spp, 3)), **per)
     p_env = env.pdf(world)
     contrib = f * np.abs(wi[..., 2:3]) * env.lookup(world) / (p_env + p_bsdf)[..., None]
     est += np.nan_to_num(contrib).sum(axis=1)
