@@ -74,32 +74,34 @@ def scan_folder(folder: Path, *, cache: bool = True, skip: tuple[str, ...] = ())
                 raise LookupError("changed")
             header = Header(e[4], f"{root}{sep}{rel}", root, e[5], e[6], tuple(e[7]), e[8], e[9])
         except (LookupError, TypeError):  # not indexed, changed, or a malformed entry
-            header, misses = read_header(Path(root, rel), library=root), misses + 1
+            header, misses = read_header(f"{root}{sep}{rel}", library=root), misses + 1
         headers.append(header)
     if cache and (misses or len(cached) != len(found)):
         _write_index(folder, found, headers)
     return headers
 
 
-def read_header(path: Path, *, library: str | None = None) -> Header:
+def read_header(path: str | Path, *, library: str | None = None) -> Header:
     """The header of one preset file; a file that is not a preset gets ``error`` set."""
-    name, file = path.name[: -len(SUFFIX)], os.fspath(path)
-    library = os.fspath(path.parent) if library is None else library
+    file = os.fspath(path)  # plain strings: a first listing reads thousands
+    name = os.path.basename(file)[: -len(SUFFIX)]
+    library = os.path.dirname(file) if library is None else library
     try:
-        doc = _header_doc(path)
+        doc = _header_doc(file)
         return Header(name, file, library, *_header_fields(doc, name, file))
     except (LookdevError, OSError) as exc:
         return Header(name, file, library, error=str(exc))
 
 
-def _header_doc(path: Path) -> dict[str, Any]:
+def _header_doc(file: str) -> dict[str, Any]:
     """The top-level key/values of a preset, parsed from what precedes its first table.
 
     Plain header lines take a fast path (:func:`simple_header`). If the cut lands inside
     a multi-line string or array the prefix is not valid TOML, and the whole file is
     parsed instead (so its errors are the file's own).
     """
-    data, where = path.read_bytes(), str(path)
+    with open(file, "rb") as f:
+        data = f.read()
     cut = data.find(b"\n[")
     head = data if cut < 0 else data[: cut + 1]
     try:
@@ -110,10 +112,10 @@ def _header_doc(path: Path) -> dict[str, Any]:
         return doc
     if cut >= 0:
         try:
-            return parse_toml(head, where=where)
+            return parse_toml(head, where=file)
         except PresetError:
             pass
-    return parse_toml(data, where=where)
+    return parse_toml(data, where=file)
 
 
 _TEXT = r"[^\x00-\x08\x0a-\x1f\x7f{q}]*"  # TOML forbids control characters but tab
