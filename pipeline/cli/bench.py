@@ -35,6 +35,7 @@ def best_time(fn: Callable[[], Any], *, repeat: int = 3, min_time: float = 0.0) 
 def _register() -> None:
     from lookdev.pipeline.analysis import (
         bench_blend,
+        bench_depth,
         bench_eval,
         bench_library,
         bench_proof,
@@ -43,6 +44,7 @@ def _register() -> None:
     )
 
     app.command("blend")(bench_blend.command)
+    app.command("depth")(bench_depth.command)
     app.command("error")(error_bench.command)
     app.command("eval")(bench_eval.command)
     app.command("library")(bench_library.command)
