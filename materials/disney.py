@@ -47,170 +47,15 @@ from . import fresnel as fr
 from . import microfacet as mf
 from .arrays import NumpyOps
 from .bsdf import Model, density, draw, evaluate
-from .params import SPECULAR_F0_SCALE, DisneyParams
-
-INV_PI = 1.0 / math.pi
-LUMINANCE = (0.3, 0.6, 0.1)  # Burley's tint weights (Schutte's (0.3, 0.6, 1.0) is a typo)
-CLEARCOAT_F0 = 0.04  # IOR 1.5 polyurethane (Burley §5.4)
-SCHLICK_MEAN = 1.0 / 21.0  # ∫ (1 − μ)⁵ 2μ dμ: hemispherical mean of the Schlick weight
-SHEEN_ALBEDO_GUESS = 0.1  # rough albedo of sheen 1, only used to weight sampling
-ETA_MIN = 1.001  # as Mitsuba: at η = 1 the rough BTDF becomes a delta
-LOBES = ("diffuse", "diff_trans", "sheen", "specular", "clearcoat", "spec_trans")
-
-
-# -- parameters --------------------------------------------------------------------------
-def luminance(c: Any) -> Any:
-    return LUMINANCE[0] * c[0] + LUMINANCE[1] * c[1] + LUMINANCE[2] * c[2]
-
-
-def tint_color(xp: Any, base: Any) -> Any:
-    """Base colour over its luminance (hue and saturation only); white for black."""
-    lum = luminance(base)
-    if isinstance(lum, float):
-        return base / lum if lum > 0 else xp.color((1.0, 1.0, 1.0))
-    return xp.select(lum > 0.0, base / xp.select(lum > 0.0, lum, 1.0), 1.0)
-
-
-def _mix(a: Any, b: Any, t: Any) -> Any:
-    return a + (b - a) * t
-
-
-def _eta(xp: Any, params: DisneyParams, maps: dict[str, Any]) -> Any:
-    """Relative IOR: ``ior`` or the IOR whose F0 is 0.08·specular (Burley §5.4)."""
-    if "ior" in maps:
-        return xp.scalar(maps["ior"])
-    if "specular" in maps and not params.uses_ior:
-        r = xp.sqrt(xp.minimum(SPECULAR_F0_SCALE * xp.scalar(maps["specular"]), 0.999999))
-        return (1.0 + r) / (1.0 - r)
-    return params.effective_ior
-
-
-def _fresnel_terms(xp, p, base, tint, w_d, w_g, eta) -> tuple[Any, Any, Any]:
-    """(A, B, c) with F_front(θd) = A + (B − A)(1 − cos θd)⁵ + c · F_dielectric(θd, η).
-
-    Schlick is linear in F0, so the metal, the tinted dielectric and the glass reflection
-    collapse into one colour A, one scalar B and one exact-Fresnel weight c:
-
-    * ``specular`` given: the BRDF Explorer's Schlick with F0 = mix(0.08·specular·
-      mix(1, tint, specular_tint), base, metallic) on the BRDF part (weight 1 − w_g);
-    * ``ior`` given: the 2015 dielectric Fresnel, tinted like Mitsuba's ``principled``
-      (Schutte's DisneyFresnel drops specular_tint unless metallic > 0);
-    * the glass part w_g always reflects the exact dielectric Fresnel.
-    """
-    metallic, spec_tint = p["metallic"], p["specular_tint"]
-    tinted = _mix(1.0, tint, spec_tint)
-    if p["uses_ior"]:
-        a = metallic * base + w_d * spec_tint * fr.schlick_f0(eta) * tint
-        b = metallic + w_d * spec_tint
-        return a, b, w_d * (1.0 - spec_tint) + w_g
-    a = metallic * base + w_d * (SPECULAR_F0_SCALE * p["specular"]) * tinted
-    return a, metallic + w_d, w_g
-
-
-def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
-    """Derived colours, α, lobe weights, which lobes exist, and their sampling odds."""
-    names = (
-        "subsurface metallic specular specular_tint roughness anisotropic sheen sheen_tint "
-        "sheen_roughness clearcoat clearcoat_gloss spec_trans diff_trans flatness"
-    ).split()
-    p = {n: xp.scalar(maps.get(n, getattr(params, n))) for n in names}
-    p["uses_ior"] = params.uses_ior
-    thin = params.thin
-    base = xp.color(maps.get("base_color", params.base_color))
-    tint = tint_color(xp, base)
-    eta = _eta(xp, params, maps)
-    eta = max(eta, ETA_MIN) if isinstance(eta, float) else xp.maximum(eta, ETA_MIN)
-    w_d = (1.0 - p["metallic"]) * (1.0 - p["spec_trans"])
-    w_g = (1.0 - p["metallic"]) * p["spec_trans"]
-    a, b, c = _fresnel_terms(xp, p, base, tint, w_d, w_g, eta)
-    trans_color = xp.sqrt(base) if thin else base
-    ax, ay = mf.anisotropic_alphas(xp, p["roughness"], p["anisotropic"])
-    pr = {
-        "thin": thin,
-        "base": base,
-        "roughness": p["roughness"],
-        "ax": ax,
-        "ay": ay,
-        "eta": eta,
-        "spec_a": a,
-        "spec_b": b,
-        "spec_c": c,
-        "glass": w_g,
-        "diffuse": w_d * (1.0 - p["diff_trans"]),
-        "diff_trans": w_d * p["diff_trans"],
-        "trans_color": trans_color,
-        "sheen": w_d * p["sheen"],
-        "sheen_color": _mix(1.0, tint, p["sheen_tint"]),
-        "sheen_model": params.sheen_model,
-        "sheen_r": p["sheen_roughness"],
-        "clearcoat": 0.25 * p["clearcoat"],
-        "clearcoat_a2": _sq(_mix(0.1, 0.001, p["clearcoat_gloss"])),  # Burley §5.4 / App. B
-        "subsurface": p["subsurface"],
-        "flatness": p["flatness"] if thin else 0.0,
-    }
-    pr["ax2"], pr["ay2"] = ax * ax, ay * ay
-    if thin:
-        # Burley 2015 Fig. 15 via Schutte: a thin sheet's transmission looks rougher.
-        r_t = (0.65 * eta - 0.35) * p["roughness"]
-        r_t = min(r_t, 1.0) if isinstance(r_t, float) else xp.minimum(r_t, 1.0)
-        pr["tax"], pr["tay"] = mf.anisotropic_alphas(xp, r_t, p["anisotropic"])
-    else:
-        pr["tax"], pr["tay"] = ax, ay
-    pr["tax2"], pr["tay2"] = pr["tax"] * pr["tax"], pr["tay"] * pr["tay"]
-    weights = {
-        "diffuse": pr["diffuse"],
-        "diff_trans": pr["diff_trans"],
-        "sheen": pr["sheen"],
-        "specular": 1.0,
-        "clearcoat": pr["clearcoat"],
-        "spec_trans": w_g,
-    }
-    pr["lobes"] = tuple(k for k in LOBES if not xp.known_zero(weights[k]))
-    pr["odds"], pr["odds_inside"] = _lobe_odds(xp, pr)
-    return pr
-
-
-def _sq(x: Any) -> Any:
-    return x * x
-
-
-def _lobe_odds(xp: Any, pr: dict[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
-    """Selection probabilities ∝ estimated albedo, for a viewer outside and (solid) inside.
-
-    Estimates: diffuse ρ·lum(base), Schlick lobes F0 + (1 − F0)/21, glass 1 − F0 split
-    by 1/η² inside. Sheen is sampled like the diffuse, by the cosine.
-    """
-    f0 = fr.schlick_f0(pr["eta"])
-    lum_a = luminance(pr["spec_a"])
-    lum_t = luminance(pr["trans_color"])
-    est = {
-        "diffuse": pr["diffuse"] * luminance(pr["base"]),
-        "sheen": pr["sheen"] * luminance(pr["sheen_color"]) * SHEEN_ALBEDO_GUESS,
-        "diff_trans": pr["diff_trans"] * lum_t,
-        "specular": lum_a
-        + (pr["spec_b"] - lum_a) * SCHLICK_MEAN
-        + pr["spec_c"] * (f0 + (1.0 - f0) * SCHLICK_MEAN),
-        "clearcoat": pr["clearcoat"] * (CLEARCOAT_F0 + (1.0 - CLEARCOAT_F0) * SCHLICK_MEAN),
-        "spec_trans": pr["glass"] * lum_t * (1.0 - f0),
-    }
-    inside = {k: 0.0 for k in est}
-    if not pr["thin"]:
-        escape = (1.0 - f0) / (pr["eta"] * pr["eta"])
-        inside.update(
-            diff_trans=est["diff_trans"],
-            specular=pr["glass"] * (1.0 - escape),
-            spec_trans=pr["glass"] * lum_t * escape,
-        )
-    return _normalise(xp, est, pr["lobes"]), _normalise(xp, inside, pr["lobes"])
-
-
-def _normalise(xp: Any, est: dict[str, Any], lobes: tuple[str, ...]) -> dict[str, Any]:
-    keep = [k for k in lobes if k in est]
-    total = sum(est[k] for k in keep)
-    if isinstance(total, float):
-        return {k: (est[k] / total if total > 0 else 0.0) for k in keep}
-    safe = xp.select(total > 0.0, total, 1.0)
-    return {k: est[k] / safe for k in keep}
+from .disney_prepare import (
+    CLEARCOAT_F0,
+    INV_PI,
+    LOBES,
+    lobe_odds,
+    mix,
+    prepare,
+)
+from .params import DisneyParams
 
 
 # -- the frame: thin sheets are two-sided, a solid is seen from inside only through glass --
@@ -242,11 +87,11 @@ def _diffuse_shape(xp: Any, pr: dict[str, Any], ci: Any, co: Any, cos2_d: Any) -
         return retro + lambert
     # Hanrahan-Krueger; F_ss90 = cos²θd·roughness as the BRDF Explorer (Schutte: roughness²).
     fss90 = cos2_d * pr["roughness"]
-    fss = _mix(1.0, fss90, fl) * _mix(1.0, fss90, fv)
+    fss = mix(1.0, fss90, fl) * mix(1.0, fss90, fv)
     # 1e-20 keeps HK's integrable 1/(cos θl + cos θv) finite at ci = co = 0 (float32 too).
     hk = 1.25 * (fss * (1.0 / xp.maximum(ci + co, 1e-20) - 0.5) + 0.5)
-    shape = retro + lambert * _mix(1.0, hk, flat)  # 2015 flatness (Schutte)
-    return _mix(shape, hk, sss)  # 2012 subsurface (BRDF Explorer)
+    shape = retro + lambert * mix(1.0, hk, flat)  # 2015 flatness (Schutte)
+    return mix(shape, hk, sss)  # 2012 subsurface (BRDF Explorer)
 
 
 def _conty_kulla() -> Any:
@@ -514,7 +359,7 @@ def keep_every_lobe(xp: Any, prepared: dict[str, Any]) -> dict[str, Any]:
     The same values at a higher cost; the baseline that measures what pruning saves.
     """
     pr = {**prepared, "lobes": LOBES}
-    pr["odds"], pr["odds_inside"] = _lobe_odds(xp, pr)
+    pr["odds"], pr["odds_inside"] = lobe_odds(xp, pr)
     return pr
 
 
@@ -529,7 +374,7 @@ def lobe_model(*names: str) -> Model:
     def prepare_only(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
         pr = prepare(xp, params, **maps)
         pr["lobes"] = tuple(k for k in pr["lobes"] if k in names)
-        pr["odds"], pr["odds_inside"] = _lobe_odds(xp, pr)
+        pr["odds"], pr["odds_inside"] = lobe_odds(xp, pr)
         return pr
 
     return Model(
