@@ -213,3 +213,11 @@ def test_sampled_eta_follows_refraction(mi):
         assert np.any(ok & (z * side < 0)) and np.any(ok & (z * side > 0))
         np.testing.assert_allclose(eta[ok & (z * side < 0)], want, rtol=1e-6)
         np.testing.assert_allclose(eta[ok & (z * side > 0)], 1.0)
+
+
+def test_traverse_exposes_numbers_and_colours_not_switches(mi):
+    _, params = _case_params(
+        "disney", {"spec_trans": 1.0, "thin": True, "ior": 1.4, "sheen_model": "conty_kulla"}
+    )
+    bsdf = mi.load_dict(_plugin(mi, params))
+    assert set(mi.traverse(bsdf).keys()) == {"spec_trans", "ior"}

@@ -198,3 +198,15 @@ def test_chi2_rejects_a_pdf_that_does_not_match_sampling(mi):
         res=61,
     )
     assert not test.run()
+
+
+def test_traverse_updates_colours(mi, tiny):
+    bsdf = tiny(base_color=[0.9, 0.9, 0.9])
+    params = mi.traverse(bsdf)
+    params["base_color"] = mi.Color3f(0.1, 0.2, 0.3)
+    params.update()
+    value = bsdf.eval(mi.BSDFContext(), _interaction(mi, [(0, 0, 1)]), mi.Vector3f(0, 0, 1))
+    # Normal view and light: f·cos = ρ · (0.5 + 0.5) / π.
+    np.testing.assert_allclose(
+        np.array(value).ravel(), np.array([0.1, 0.2, 0.3]) / math.pi, rtol=1e-6
+    )

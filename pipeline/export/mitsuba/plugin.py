@@ -148,7 +148,13 @@ def _plugin_class(variant: str) -> type:
                     self.textures[key] = value
                 else:
                     self.constants[key] = _python_value(value)
-            self.traversed = {k: _drjit_value(v) for k, v in self.constants.items()}
+            # Numbers and colours can change after load; switches (``thin``, a model name)
+            # shape the traced kernel, so a new BSDF is the way to change them.
+            self.traversed = {
+                k: _drjit_value(v)
+                for k, v in self.constants.items()
+                if isinstance(v, float | tuple)
+            }
             self._configure()
 
         # -- parameters ----------------------------------------------------------------
@@ -325,21 +331,15 @@ def _python_value(value: Any) -> Any:
         return value
 
 
-def _drjit_value(value: Any) -> Any:
-    """A constant as the Dr.Jit value ``mi.traverse`` exposes (str/bool stay as they are)."""
+def _drjit_value(value: float | tuple[float, ...]) -> Any:
+    """A numeric constant as the Dr.Jit value ``mi.traverse`` exposes."""
     import mitsuba as mi
 
-    if isinstance(value, tuple):
-        return mi.Color3f(*value)
-    if isinstance(value, float):
-        return mi.Float(value)
-    return value
+    return mi.Color3f(*value) if isinstance(value, tuple) else mi.Float(value)
 
 
-def _from_drjit(value: Any, old: Any) -> Any:
+def _from_drjit(value: Any, old: float | tuple[float, ...]) -> float | tuple[float, ...]:
     """The updated traversed value back as the constant's Python type."""
     if isinstance(old, tuple):
         return tuple(float(value[i][0]) for i in range(3))
-    if isinstance(old, float):
-        return float(value[0])
-    return value
+    return float(value[0])
