@@ -288,3 +288,32 @@ def test_decoded_masks_stay_in_the_files_pixel_format(tmp_path, fmt, suffix, dty
     sampler = MaskSampler((4, 4))
     assert sampler.image(tex).dtype == dtype  # 1 or 2 bytes a texel, not 4
     assert np.allclose(sampler.evaluate(tex)[::-1], values, atol=step)
+
+
+def test_many_repeats_are_box_reduced_first_and_stay_filtered(tmp_path):
+    rng = np.random.default_rng(1)
+    src = rng.random((512, 512)).astype(np.float32)
+    tex = TextureMask(path=write_image(tmp_path / "grain.exr", src), uv_scale=(64, 64))
+    sampler = MaskSampler((128, 128))
+    m = sampler.evaluate(tex)  # footprint 256 texels: reduced by 128, then a tent
+    assert sampler._mips and next(iter(sampler._mips.values())).shape == (4, 4, 1)
+    assert abs(float(m.mean()) - float(src.mean())) < 0.01 and m.std() < 0.05
+
+
+def test_box_reduction_agrees_with_the_full_tent(tmp_path):
+    y, x = np.mgrid[0:256, 0:256] / 256.0
+    smooth = (0.5 + 0.4 * np.sin(2 * np.pi * x) * np.cos(2 * np.pi * y)).astype(np.float32)
+    tex = TextureMask(path=write_image(tmp_path / "smooth.exr", smooth))
+    reduced = MaskSampler((16, 16)).evaluate(tex)  # footprint 16: reduced by 8
+    assert np.allclose(reduced, _full_tent(tex, 16), atol=0.01)
+
+
+def _full_tent(tex, n):
+    """The tent filter on the full-resolution source (no box reduction)."""
+    from lookdev.pipeline.blend.resample import resample, taps
+
+    sampler = MaskSampler((n, n))
+    src = sampler.image(tex)
+    h, w = src.shape[:2]
+    out = resample(src, taps(n, h, 1.0, 0.0, "periodic"), taps(n, w, 1.0, 0.0, "periodic"))
+    return np.clip(out[..., 0], 0.0, 1.0)

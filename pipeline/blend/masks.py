@@ -54,6 +54,7 @@ class MaskSampler:
             {} if images is None else images
         )
         self._tap_cache: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
+        self._mips: dict[tuple, np.ndarray] = {}
 
     def image(self, tex: TextureMask, count: int = 1, *, where: str | None = None) -> np.ndarray:
         """The source channels of ``tex`` (cached, as stored; see :func:`.read_channels`)."""
@@ -67,14 +68,34 @@ class MaskSampler:
     def lookup(
         self, tex: TextureMask, count: int = 1, rows: slice | None = None, *, where=None
     ) -> np.ndarray:
-        """Filtered texture values at the output texels of ``rows``: (n, W, count)."""
+        """Filtered texture values at the output texels of ``rows``: (n, W, count).
+
+        Where an output texel covers more than 4 source texels along an axis (strong
+        minification, or many repeats), the source is first box-reduced along it by a
+        power of two (a mip level) that leaves a footprint of 2 to 4 texels, so the cost
+        does not grow with the footprint.
+        """
         src = self.image(tex, count, where=where)
-        h, w = src.shape[:2]
         (su, sv), (ou, ov) = tex.uv_scale, tex.uv_offset
+        kv = _mip_factor(src.shape[0], sv, self.height)
+        ku = _mip_factor(src.shape[1], su, self.width)
+        if kv > 1 or ku > 1:
+            src = self._reduced(tex, count, kv, ku)
+        h, w = src.shape[:2]
         v_idx, v_w = self._taps(self.height, h, sv, ov, tex.wrap)
         rows = rows or slice(0, self.height)
         u_taps = self._taps(self.width, w, su, ou, tex.wrap)
         return resample(src, (v_idx[rows], v_w[rows]), u_taps)
+
+    def _reduced(self, tex: TextureMask, count: int, kv: int, ku: int) -> np.ndarray:
+        """The source averaged over kv × ku blocks (float32, cached)."""
+        key = (str(tex.path), tex.channel, count, kv, ku)
+        if key not in self._mips:
+            a = as_float(self.image(tex, count))
+            h, w = a.shape[:2]
+            blocks = a.reshape(h // kv, kv, w // ku, ku, count)
+            self._mips[key] = blocks.mean(axis=(1, 3), dtype=np.float64).astype(np.float32)
+        return self._mips[key]
 
     def _taps(self, *key) -> tuple[np.ndarray, np.ndarray]:
         """Taps of a whole axis (:func:`.resample.taps`), computed once per sampler."""
@@ -155,6 +176,19 @@ class MaskSampler:
         v_w = taps(self.height, h, sv, ov, "black")[1].sum(axis=1)
         u_w = taps(self.width, w, su, ou, "black")[1].sum(axis=1)
         return bool((v_w < 1 - 1e-6).any() or (u_w < 1 - 1e-6).any())
+
+
+def _mip_factor(n_src: int, scale: float, n_out: int) -> int:
+    """Largest power of two dividing ``n_src`` that keeps the footprint ≥ 2 texels.
+
+    >>> _mip_factor(1024, 32.0, 256), _mip_factor(1024, 1.0, 512), _mip_factor(1000, 1.0, 10)
+    (64, 1, 8)
+    """
+    footprint = abs(scale) * n_src / n_out
+    k = 1
+    while footprint / (2 * k) >= 2.0 and n_src % (2 * k) == 0:
+        k *= 2
+    return k
 
 
 def combine(kind: str, values: list):
