@@ -132,7 +132,7 @@ def report(n: int, times: dict[str, float]) -> dict[str, Any]:
 
 def command(
     n: Annotated[int, typer.Option("--n", min=1, help="Presets in the generated library.")] = 10000,
-    repeat: Annotated[int, typer.Option("--repeat", min=1, help="Runs per timing (best).")] = 3,
+    repeat: Annotated[int, typer.Option("--repeat", min=1, help="Runs per timing (best).")] = 5,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
     """Time `presets list` over N generated presets against reading their bytes (target ≤ 2x).
