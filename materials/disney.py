@@ -98,11 +98,21 @@ def _conty_kulla() -> Any:
     return importlib.import_module(".sheen", __package__)
 
 
+def _conty_kulla_color(xp: Any, pr: dict[str, Any]) -> Any:
+    """The microfacet sheen's reflectance F, per channel at most 1.
+
+    Burley's tint (base over its luminance) exceeds 1 in saturated channels; a lobe
+    reflecting more than all of the light would make the albedo scaling 1 − F·E negative
+    and the material gain energy, so the Conty-Kulla colour is clamped to 1.
+    """
+    return xp.minimum(pr["sheen"] * pr["sheen_color"], 1.0)
+
+
 def _base_scale(xp: Any, pr: dict[str, Any], ci: Any, co: Any) -> Any:
     """Conty-Kulla §5 albedo scaling of what lies under their sheen (1 elsewhere)."""
     if "sheen" not in pr["lobes"] or pr["sheen_model"] != "conty_kulla":
         return 1.0
-    color = pr["sheen"] * pr["sheen_color"]
+    color = _conty_kulla_color(xp, pr)
     r = xp.asarray(pr["sheen_r"])  # an array of the model's dtype: float32 stays float32
     return xp.maximum(_conty_kulla().base_scale(xp, ci, co, r, color), 0.0)
 
@@ -143,11 +153,13 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
     up = (wi[2] > 0.0) & (wo[2] > 0.0)
     # Clamped cosines keep every term finite where ``up`` is false, so masking is a product.
     ci, co = xp.maximum(wi[2], 0.0), xp.maximum(wo[2], 0.0)
-    cos2_d = xp.maximum(0.5 + 0.5 * xp.dot(wi, wo), 0.0)  # cos²θd = (1 + wi·wo)/2
+    h = wi + wo
+    # |wi + wo|² = 4 cos²θd, taken from h itself: (1 + wi·wo)/2 cancels to 0 in float32
+    # for a grazing mirror pair (cos θ = 1e-4), losing the whole highlight.
+    h2 = xp.dot(h, h)
+    cos2_d = 0.25 * h2
     cos_d = xp.sqrt(cos2_d)
     w = fr.schlick_weight(xp, cos_d)
-    h = wi + wo
-    h2 = 4.0 * cos2_d
     zi2, zo2 = ci * ci, co * co
     scale = _base_scale(xp, pr, ci, co)
     terms = []
@@ -172,10 +184,11 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
     if "sheen" in lobes:
         if pr["sheen_model"] == "conty_kulla":
             lobe = _conty_kulla().lobe(xp, wi, wo, xp.asarray(pr["sheen_r"]), True)
+            color = _conty_kulla_color(xp, pr)
         else:
-            lobe = w  # 2014 addendum: sheen · (1 − cos θd)⁵, no 1/π (BRDF Explorer)
-        k = _times(lobe * pr["sheen"], front)
-        terms.append((pr["sheen_color"], _masked(xp, up, k)))
+            lobe = w * pr["sheen"]  # 2014 addendum: sheen · (1 − cos θd)⁵, no 1/π (Explorer)
+            color = pr["sheen_color"]
+        terms.append((color, _masked(xp, up, _times(lobe, front))))
     if "clearcoat" in lobes:
         inv_h2 = 1.0 / xp.maximum(h2, xp.tiny)
         sin2_h = (h[0] * h[0] + h[1] * h[1]) * inv_h2  # not 1 − cos²: the α = 10⁻³ peak
@@ -243,7 +256,7 @@ def _pdf_oriented(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> 
     ci, co = wi[2], wo[2]
     up = (ci > 0.0) & (co > 0.0)
     h = wi + wo
-    h2 = xp.maximum(2.0 + 2.0 * xp.dot(wi, wo), xp.tiny)  # |wi + wo|² = 4 cos²θd
+    h2 = xp.maximum(xp.dot(h, h), xp.tiny)  # 4 cos²θd, from h for float32 (see above)
     p_up = 0.0
     if "specular" in odds:
         # Visible normals: D_wo(h)/(4 wo·h) = G1(wo) D(h) / (4 cos θo).

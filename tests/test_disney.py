@@ -573,3 +573,36 @@ def test_bench_eval_prints_one_json_object_with_the_ratios(cli, mitsuba):
 def test_bench_eval_rejects_a_bad_size_in_one_line(cli):
     r = cli("bench", "eval", "--n", "10")
     assert r.code == 2 and "Traceback" not in r.err
+
+
+@pytest.mark.parametrize("cos_theta", [1e-3, 1e-4])
+@pytest.mark.parametrize(
+    "kw", [{}, {"metallic": 1.0, "roughness": 0.2}, {"spec_trans": 1.0}], ids=str
+)
+def test_float32_keeps_the_grazing_mirror_highlight(cos_theta, kw):
+    # (1 + wi·wo)/2 cancels to 0 in float32 here; |wi + wo|² does not.
+    s = np.sqrt(1.0 - cos_theta**2)
+    wi, wo = np.array([-s, 0.0, cos_theta]), np.array([s, 0.0, cos_theta])
+    p = DisneyParams(**kw)
+    f64 = disney.eval(p, wi, wo)
+    f32 = disney.eval(p, wi.astype(np.float32), wo.astype(np.float32), dtype=np.float32)
+    assert np.allclose(f32, f64, rtol=1e-4)
+    p64 = disney.pdf(p, wi, wo)
+    p32 = disney.pdf(p, wi.astype(np.float32), wo.astype(np.float32), dtype=np.float32)
+    assert np.allclose(p32, p64, rtol=1e-4)
+
+
+def test_saturated_conty_kulla_sheen_gains_no_energy():
+    # Burley's tint exceeds 1 in a saturated channel; the microfacet sheen's F is clamped.
+    p = DisneyParams(
+        base_color=(0.1, 0.003, 0.01),
+        sheen=1.0,
+        sheen_tint=1.0,
+        sheen_model="conty_kulla",
+        roughness=1.0,
+    )
+    rng = np.random.default_rng(7)
+    for mu in (1.0, 0.3, 0.05):
+        wo = np.broadcast_to([np.sqrt(1 - mu * mu), 0.0, mu], (100_000, 3))
+        _, weight, _ = disney.sample(p, wo, rng.random((100_000, 3)))
+        assert np.all(weight.mean(axis=0) < 1.0)
