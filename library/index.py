@@ -160,14 +160,14 @@ def simple_header(text: str) -> dict[str, Any] | None:
 def _header_fields(doc: dict[str, Any], name: str, where: str) -> tuple:
     """(model, description, tags, extends) of a parsed preset, checked just enough to list."""
     got = {k: doc.get(k) for k in ("name", "model", "description", "tags", "extends")}
-    if got["name"] != name or not NAME_RE.match(name):
+    if got["name"] != name or not NAME_RE.fullmatch(name):
         raise PresetError(f"name {got['name']!r} differs from the file name", where=where)
     if got["model"] is not None and got["model"] not in (*MODELS, "layered"):
         raise PresetError(f"unknown model {got['model']!r}", where=where, field="model")
     if got["model"] is None and not isinstance(got["extends"], str):
         raise PresetError("'model' is required unless 'extends' is given", where=where)
     if got["extends"] is not None and not (
-        isinstance(got["extends"], str) and NAME_RE.match(got["extends"])
+        isinstance(got["extends"], str) and NAME_RE.fullmatch(got["extends"])
     ):
         raise PresetError("'extends' is not a preset name", where=where, field="extends")
     tags = got["tags"] or []

@@ -37,12 +37,12 @@ MODELS: dict[str, type[Params]] = {"disney": DisneyParams, "pixar": PixarParams}
 """Parameter schema of each reflectance model a preset may name."""
 
 MAX_BYTES = 1 << 20  # presets are hand-written text; anything larger is not one
-NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_-]{0,99}$")
+NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]{0,99}")  # whole names: fullmatch
 METADATA = ("description", "tags", "source", "extends")
 """Top-level fields that ``--set`` may change (everything else it sets is a parameter)."""
 
 
-def check_name(name: str, *, where: str | None = None, field: str | None = "name") -> str:
+def check_name(name: str, *, field: str | None = "name") -> str:
     """``name`` if it is a safe preset name: a file name in its library and nothing more.
 
     Letters, digits, ``_`` and ``-``; no path separators, no ``..``, not absolute.
@@ -50,11 +50,10 @@ def check_name(name: str, *, where: str | None = None, field: str | None = "name
     >>> check_name("gold_leaf")
     'gold_leaf'
     """
-    if not isinstance(name, str) or not NAME_RE.match(name):
+    if not isinstance(name, str) or not NAME_RE.fullmatch(name):
         raise PresetError(
             f"preset name {_short(name)} is not allowed; use 1-100 letters, digits, '_' or '-' "
             "(no path separators, no '..')",
-            where=where,
             field=field,
         )
     return name
@@ -85,7 +84,7 @@ class PresetFile(BaseModel):
     @field_validator("name", "extends")
     @classmethod
     def _safe_name(cls, value: str | None) -> str | None:
-        if value is not None and not NAME_RE.match(value):
+        if value is not None and not NAME_RE.fullmatch(value):
             raise ValueError(
                 f"{_short(value)} is not a preset name; use 1-100 letters, digits, '_' or '-'"
             )

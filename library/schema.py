@@ -31,7 +31,7 @@ def preset_schema() -> dict[str, Any]:
     for cls in MODELS.values():
         defs[cls.__name__] = params_schema(cls, defs)
     for prop in ("name", "extends"):
-        schema["properties"][prop].setdefault("pattern", NAME_RE.pattern)
+        schema["properties"][prop].setdefault("pattern", f"^{NAME_RE.pattern}$")
     schema["allOf"] = _params_follow_model(MODELS)
     defs[LayerSpec.__name__]["allOf"] = _params_follow_model(MODELS)
     return _bare_numbers_are_masks(schema)

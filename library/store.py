@@ -32,14 +32,14 @@ LOCK_TIMEOUT_S = 60.0
 
 
 @contextlib.contextmanager
-def locked(folder: Path, *, timeout: float = LOCK_TIMEOUT_S) -> Iterator[None]:
+def locked(folder: Path) -> Iterator[None]:
     """Hold the library's lock; an unwritable folder or a stuck lock is a LibraryError."""
-    lock = FileLock(str(folder / LOCK_NAME), timeout=timeout)
+    lock = FileLock(str(folder / LOCK_NAME), timeout=LOCK_TIMEOUT_S)
     try:
         lock.acquire()
     except Timeout:
         raise LibraryError(
-            f"library is locked by another lookdev process for over {timeout:g} s; "
+            f"library is locked by another lookdev process for over {LOCK_TIMEOUT_S:g} s; "
             f"retry, or remove {LOCK_NAME} if no lookdev is running",
             where=str(folder),
         ) from None

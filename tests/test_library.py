@@ -363,7 +363,7 @@ def test_save_refuses_overwrite_without_force_and_bad_names(lib, tmp_path):
         lib.save(p)
     lib.save(p.model_copy(update={"params": {"roughness": 0.4}}), force=True)
     assert lib.load("mine").params.roughness == 0.4
-    for bad in ("../evil", "/abs", "a/b", "a\\b", "..", ""):
+    for bad in ("../evil", "/abs", "a/b", "a\\b", "..", "", "gold\n", "x" * 101):
         with pytest.raises(PresetError, match="not allowed"):
             lib.save(PresetFile.model_construct(name=bad, extends="gold", params={}))
     assert sorted(f.name for f in tmp_path.iterdir() if not f.name.startswith(".")) == ["mine.toml"]
