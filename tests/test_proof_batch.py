@@ -216,3 +216,38 @@ def test_bad_input_is_one_line_exit_2_and_leaves_no_frames(cli, tmp_path, args, 
     assert r.code == 2 and message in r.err
     assert len(r.err.strip().splitlines()) == 1 and "Traceback" not in r.err
     assert not list(tmp_path.rglob("*.png")) and not list(tmp_path.rglob("frame_*"))
+
+
+@pytest.mark.parametrize(("in_flight", "most"), [(1, 1), (2, 2), (None, 4)])
+def test_at_most_in_flight_jobs_are_queued(monkeypatch, in_flight, most):
+    import threading
+    import time
+    from concurrent.futures import ThreadPoolExecutor
+    from types import SimpleNamespace
+
+    class Counting(ThreadPoolExecutor):
+        outstanding = peak = 0
+        lock = threading.Lock()
+
+        def submit(self, fn, *args):
+            with self.lock:
+                Counting.outstanding += 1
+                Counting.peak = max(Counting.peak, Counting.outstanding)
+            fut = super().submit(fn, *args)
+            fut.add_done_callback(lambda _: self._done())
+            return fut
+
+        def _done(self):
+            with self.lock:
+                Counting.outstanding -= 1
+
+    def slow_job(job):
+        time.sleep(0.05)  # long enough for every submission to land first
+        return {"n": job.n}
+
+    monkeypatch.setattr(batch, "run_job", slow_job)
+    jobs = [SimpleNamespace(n=i) for i in range(4)]
+    with Counting(4) as pool:
+        results = batch.run_batch(jobs, pool, in_flight=in_flight)
+    assert [r["n"] for r in results] == [0, 1, 2, 3]
+    assert Counting.peak == most

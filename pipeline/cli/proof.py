@@ -150,7 +150,8 @@ def proof(
                 highlight=False,
             )
 
-        results = batch.run_batch(jobs, executor, on_done=done)
+        in_flight = None if scheduler else workers or batch.default_workers()
+        results = batch.run_batch(jobs, executor, on_done=done, in_flight=in_flight)
     doc = batch.summary(output, jobs, results, time.perf_counter() - start)
     if report:
         from lookdev.pipeline.analysis.report import write_report

@@ -23,12 +23,13 @@ a Dask cluster (the output folder must then be shared by the workers).
 from __future__ import annotations
 
 import hashlib
+import itertools
 import json
 import multiprocessing
 import os
 import traceback
 from collections.abc import Callable, Iterator
-from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, Executor, Future, ProcessPoolExecutor, wait
 from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -272,20 +273,34 @@ def run_batch(
     jobs: list[Job],
     executor: Executor,
     on_done: Callable[[Job, dict[str, Any]], None] | None = None,
+    in_flight: int | None = None,
 ) -> list[dict[str, Any]]:
     """Run ``jobs`` on ``executor``; their manifests in job order.
 
-    The first failing job cancels those not started and its error is raised (a
-    :class:`LookdevError` keeps its one line).
+    At most ``in_flight`` jobs are submitted at a time (all of them when None, as a
+    cluster's scheduler wants), so an interrupted local batch has nothing queued behind
+    the jobs that were running. The first failing job cancels those not started and its
+    error is raised (a :class:`LookdevError` keeps its one line).
     """
-    futures: dict[Future, int] = {executor.submit(run_job, job): i for i, job in enumerate(jobs)}
+    queue = iter(enumerate(jobs))
+    futures: dict[Future, int] = {}
     results: list[dict[str, Any] | None] = [None] * len(jobs)
+
+    def submit_next() -> None:
+        for i, job in itertools.islice(queue, 1):
+            futures[executor.submit(run_job, job)] = i
+
+    for _ in range(in_flight or len(jobs)):
+        submit_next()
     try:
-        for fut in as_completed(futures):
-            i = futures[fut]
-            results[i] = _result(fut, jobs[i])
-            if on_done is not None:
-                on_done(jobs[i], results[i])
+        while futures:
+            finished, _ = wait(futures, return_when=FIRST_COMPLETED)
+            for fut in finished:
+                i = futures.pop(fut)
+                results[i] = _result(fut, jobs[i])
+                if on_done is not None:
+                    on_done(jobs[i], results[i])
+                submit_next()
     except BaseException:
         for fut in futures:
             fut.cancel()
