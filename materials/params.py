@@ -106,29 +106,40 @@ def parameter_error(exc: ValidationError, *, where: str | None = None) -> Parame
 
 
 def _range_text(exc: ValidationError, err: dict[str, Any]) -> str:
+    """``[lo, hi]`` of the offending field, or the violated bound alone when the field's
+    schema is not known here (a nested model that did not call :func:`register_schema`)."""
     ctx = err.get("ctx") or {}
-    field = next((p for p in err["loc"] if isinstance(p, str)), None)
-    if any(isinstance(p, int) for p in err["loc"]):
+    loc = err["loc"]
+    if loc and isinstance(loc[-1], int):
         lo, hi = 0.0, 1.0  # a colour channel
     else:
+        field = next((p for p in reversed(loc) if isinstance(p, str)), None)
         lo, hi = _bounds(exc.title, field)
-    lo = ctx.get("ge", ctx.get("gt")) if lo is None else lo
-    hi = ctx.get("le", ctx.get("lt")) if hi is None else hi
+    if lo is None and hi is None:
+        bound = next((f"{op} {ctx[k]:g}" for k, op in _OPS if k in ctx), "")
+        return bound or "a smaller or larger value"
     lo_text = "-∞" if lo is None else f"{float(lo):g}"
     hi_text = "∞" if hi is None else f"{float(hi):g}"
     return f"[{lo_text}, {hi_text}]"
 
 
+_OPS = (("ge", "≥"), ("gt", ">"), ("le", "≤"), ("lt", "<"))
+
+
 def _bounds(model_name: str, field: str | None) -> tuple[float | None, float | None]:
-    """The (ge, le) bounds declared on a schema's field, or (None, None)."""
-    cls = _SCHEMAS.get(model_name)
-    if cls is None or field not in cls.model_fields:
-        return None, None
-    lo = hi = None
-    for m in cls.model_fields[field].metadata:
-        lo = getattr(m, "ge", None) if getattr(m, "ge", None) is not None else lo
-        hi = getattr(m, "le", None) if getattr(m, "le", None) is not None else hi
-    return lo, hi
+    """The (ge, le) bounds declared on ``field`` of the schema ``model_name``, else of the
+    first registered schema that declares that field; (None, None) when none does."""
+    named = _SCHEMAS.get(model_name)
+    for cls in [named] * (named is not None) + list(_SCHEMAS.values()):
+        if field not in cls.model_fields:
+            continue
+        lo = hi = None
+        for m in cls.model_fields[field].metadata:
+            lo = getattr(m, "ge", None) if getattr(m, "ge", None) is not None else lo
+            hi = getattr(m, "le", None) if getattr(m, "le", None) is not None else hi
+        if lo is not None or hi is not None:
+            return lo, hi
+    return None, None
 
 
 class DisneyParams(Params):

@@ -114,3 +114,11 @@ def test_drjit_stable_forms_take_python_floats():
     dj = DrJitOps.for_mitsuba()
     for x in (0.0, 1e-12, 0.5):
         assert dj.log1p(x) == math.log1p(x) and dj.expm1(x) == math.expm1(x)
+
+
+def test_nested_range_errors_name_the_fields_own_range():
+    from lookdev.materials.layers import LayerSpec
+
+    with pytest.raises(LookdevError) as info:
+        LayerSpec.parse({"preset": "gold", "mask": {"kind": "constant", "value": -1}})
+    assert "-∞" not in str(info.value) and "\n" not in str(info.value)
