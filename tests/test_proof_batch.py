@@ -127,6 +127,15 @@ def test_a_rerun_skips_verified_frames_and_redoes_damaged_ones(mitsuba, gold, tm
     assert len(repaired["frames"]) == 3
 
 
+def test_progress_counts_frames_from_the_manifest_of_matching_settings(mitsuba, gold, tmp_path):
+    job = _job(gold, tmp_path)
+    assert batch.frames_done(job) == 0
+    batch.run_job(job)
+    assert batch.frames_done(job) == 3
+    other = batch.Settings(element_frames=2, light_frames=1, spp=6, resolution=(32, 16))
+    assert batch.frames_done(_job(gold, tmp_path, other)) == 0
+
+
 def test_changed_settings_render_everything_again_and_drop_stray_frames(mitsuba, gold, tmp_path):
     batch.run_job(_job(gold, tmp_path))
     fewer = batch.Settings(element_frames=1, light_frames=1, spp=6, resolution=(32, 16))
@@ -247,7 +256,9 @@ def test_at_most_in_flight_jobs_are_queued(monkeypatch, in_flight, most):
 
     monkeypatch.setattr(batch, "run_job", slow_job)
     jobs = [SimpleNamespace(n=i) for i in range(4)]
+    ticks = []
     with Counting(4) as pool:
-        results = batch.run_batch(jobs, pool, in_flight=in_flight)
+        results = batch.run_batch(jobs, pool, in_flight=in_flight, on_tick=ticks.append)
     assert [r["n"] for r in results] == [0, 1, 2, 3]
     assert Counting.peak == most
+    assert ticks and all(len(running) <= most for running in ticks)

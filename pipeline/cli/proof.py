@@ -141,17 +141,24 @@ def proof(
     per_job = frames + light_frames
     with _progress() as bar, batch.executor_for(scheduler, workers) as executor:
         task = bar.add_task("proofs", total=len(jobs) * per_job)
+        finished = 0
 
         def done(job: batch.Job, doc: dict[str, Any]) -> None:
-            bar.advance(task, per_job)
+            nonlocal finished
+            finished += 1
             bar.console.print(
                 f"  {job.material.name} × {job.ibl}: {doc['rendered']} rendered, "
                 f"{doc['skipped']} already done",
                 highlight=False,
             )
 
+        def tick(running: list[batch.Job]) -> None:
+            partial = sum(batch.frames_done(job) for job in running)
+            bar.update(task, completed=finished * per_job + partial)
+
         in_flight = None if scheduler else workers or batch.default_workers()
-        results = batch.run_batch(jobs, executor, on_done=done, in_flight=in_flight)
+        results = batch.run_batch(jobs, executor, done, in_flight, tick)
+        bar.update(task, completed=len(jobs) * per_job)
     doc = batch.summary(output, jobs, results, time.perf_counter() - start)
     if report:
         from lookdev.pipeline.analysis.report import write_report

@@ -43,6 +43,7 @@ from . import contact, tonemap
 from .turntable import Frame, frames
 
 MANIFEST = "manifest.json"
+TICK_S = 0.5
 FORMAT_VERSION = 1
 
 
@@ -116,6 +117,19 @@ def read_manifest(folder: Path, key: str) -> dict[int, dict[str, Any]]:
         if all(isinstance(f, dict) and _still_valid(folder, f) for f in files):
             done[int(entry["index"])] = entry
     return done
+
+
+def frames_done(job: Job) -> int:
+    """Frames a running job has finished so far, from its manifest on disk.
+
+    Workers write the manifest after every frame, so this works for local processes and
+    for a cluster sharing the output folder alike, without any channel between them.
+    """
+    try:
+        doc = json.loads((job.folder / MANIFEST).read_text(encoding="utf-8"))
+        return len(doc["frames"]) if doc.get("key") == job.key else 0
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return 0
 
 
 def write_json(doc: dict[str, Any], path: Path) -> None:
@@ -274,13 +288,15 @@ def run_batch(
     executor: Executor,
     on_done: Callable[[Job, dict[str, Any]], None] | None = None,
     in_flight: int | None = None,
+    on_tick: Callable[[list[Job]], None] | None = None,
 ) -> list[dict[str, Any]]:
     """Run ``jobs`` on ``executor``; their manifests in job order.
 
     At most ``in_flight`` jobs are submitted at a time (all of them when None, as a
     cluster's scheduler wants), so an interrupted local batch has nothing queued behind
-    the jobs that were running. The first failing job cancels those not started and its
-    error is raised (a :class:`LookdevError` keeps its one line).
+    the jobs that were running. ``on_tick(running_jobs)`` is called about twice a second
+    (for frame-level progress: see :func:`frames_done`). The first failing job cancels
+    those not started and its error is raised (a :class:`LookdevError` keeps its one line).
     """
     queue = iter(enumerate(jobs))
     futures: dict[Future, int] = {}
@@ -294,7 +310,9 @@ def run_batch(
         submit_next()
     try:
         while futures:
-            finished, _ = wait(futures, return_when=FIRST_COMPLETED)
+            finished, _ = wait(futures, timeout=TICK_S, return_when=FIRST_COMPLETED)
+            if on_tick is not None:
+                on_tick([jobs[i] for i in futures.values()])
             for fut in finished:
                 i = futures.pop(fut)
                 results[i] = _result(fut, jobs[i])
