@@ -236,7 +236,14 @@ class DrJitOps:
         return dr.select(u == 1.0, x, dr.select(u - 1.0 == -1.0, -1.0, (u - 1.0) * x / dr.log(u)))
 
     def known_zero(self, x: Any) -> bool:
-        return isinstance(x, int | float) and x == 0
+        """True for a Python zero and for a Dr.Jit *literal* zero (a constant such as a
+        black colour folded into the kernel); an evaluated or opaque array never counts,
+        since reading it would launch a kernel while the plugin is being traced."""
+        if isinstance(x, int | float):
+            return x == 0
+        parts = [x[i] for i in range(len(x))] if isinstance(x, self.Array3) else [x]
+        literal = self.dr.VarState.Literal
+        return all(getattr(p, "state", None) == literal and p[0] == 0 for p in parts)
 
 
 _DRJIT_SAME_NAME = frozenset(

@@ -122,3 +122,16 @@ def test_nested_range_errors_name_the_fields_own_range():
     with pytest.raises(LookdevError) as info:
         LayerSpec.parse({"preset": "gold", "mask": {"kind": "constant", "value": -1}})
     assert "-∞" not in str(info.value) and "\n" not in str(info.value)
+
+
+def test_drjit_known_zero_sees_literal_constants_only():
+    import drjit as dr
+
+    from lookdev.materials.arrays import DrJitOps
+    from lookdev.pipeline.variant import use_mitsuba
+
+    use_mitsuba()
+    dj = DrJitOps.for_mitsuba()
+    assert dj.known_zero(0.0) and dj.known_zero(dj.color([0.0, 0.0, 0.0]))
+    assert not dj.known_zero(dj.color([0.0, 0.5, 0.0]))
+    assert not dj.known_zero(dr.opaque(dj.Float, 0.0))  # force_all_lobes keeps such a lobe

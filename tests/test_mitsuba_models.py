@@ -223,11 +223,6 @@ def test_traverse_exposes_numbers_and_colours_not_switches(mi):
     assert set(mi.traverse(bsdf).keys()) == {"spec_trans", "ior"}
 
 
-@pytest.mark.xfail(
-    reason="arrays.DrJitOps.known_zero cannot see a constant black colour after xp.color "
-    "turned it into an Array3, so Dr.Jit traces a lobe numpy prunes",
-    strict=True,
-)
 def test_a_black_colour_prunes_its_lobe_on_both_backends(mi):
     from lookdev.pipeline.export.mitsuba.depth import lobes_for
     from lookdev.pipeline.export.mitsuba.scene import flatten
