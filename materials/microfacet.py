@@ -86,10 +86,28 @@ def gtr_sample_cos2(xp: Any, gamma: float, a2: Any, xi: Any) -> Any:
     return xp.clip(r * exprel(xp, log_a2 * r) / exprel(xp, log_a2), 0.0, 1.0)
 
 
+def gtr_sample_sin2(xp: Any, gamma: float, a2: Any, xi: Any) -> Any:
+    """sin²θh = 1 − cos²θh of :func:`gtr_sample_cos2`, without the cancellation.
+
+    cos²θh = expm1(L r)/expm1(L) (L = log α²), so sin²θh = e^{L r}·expm1(L s)/expm1(L)
+    with s = 1 − r = −log1p(ξ·expm1(−t))/t (series ξ(1 − u t/2)). Near the peak of a
+    sharp lobe (α = 10⁻³, ξ → 0) 1 − cos² loses every digit in float32; this keeps them.
+    """
+    log_a2 = xp.log(a2)
+    t = (1.0 - gamma) * log_a2
+    u = 1.0 - xi
+    small = xp.abs(t) < _SERIES
+    safe = xp.select(small, 1.0, t)
+    s = xp.select(small, xi * (1.0 - 0.5 * u * t), -xp.log1p(xi * xp.expm1(-safe)) / safe)
+    s = xp.clip(s, 0.0, 1.0)  # float32 at γ > 1, α → 0: log1p(−1) = −∞ where s → 1
+    sin2 = xp.exp(log_a2 * (1.0 - s)) * s * exprel(xp, log_a2 * s) / exprel(xp, log_a2)
+    return xp.clip(sin2, 0.0, 1.0)
+
+
 def sample_gtr(xp: Any, gamma: float, a2: Any, u1: Any, u2: Any) -> Any:
     """A micro-normal with density D_GTR(h) cos θh (eqs. 2–3)."""
     cos2 = gtr_sample_cos2(xp, gamma, a2, u2)
-    sin_t = xp.safe_sqrt(1.0 - cos2)
+    sin_t = xp.sqrt(gtr_sample_sin2(xp, gamma, a2, u2))
     phi = 2.0 * math.pi * u1
     return xp.vec3(sin_t * xp.cos(phi), sin_t * xp.sin(phi), xp.sqrt(cos2))
 

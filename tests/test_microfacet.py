@@ -262,3 +262,16 @@ def test_doctests(name):
     module = importlib.import_module(f"lookdev.materials.{name}")
     result = doctest.testmod(module)
     assert result.failed == 0 and result.attempted > 0
+
+
+@pytest.mark.parametrize("gamma", [0.5, 1.0, 1.5, 3.0])
+@pytest.mark.parametrize("a2", [1e-6, 0.01, 0.25, 1.0])
+def test_sampled_sin2_keeps_float32_digits_at_the_peak(gamma, a2):
+    # 1 − cos²θh would lose all of them near ξ = 0 for a sharp lobe (clearcoat at α = 1e-3).
+    xi = np.array([0.0, 1e-7, 1e-4, 1e-3, 0.3, 0.9, 1.0])
+    s64 = mf.gtr_sample_sin2(XP, gamma, a2, xi)
+    np.testing.assert_allclose(s64 + mf.gtr_sample_cos2(XP, gamma, a2, xi), 1.0, atol=1e-12)
+    with np.errstate(all="ignore"):
+        s32 = mf.gtr_sample_sin2(NumpyOps(np.float32), gamma, np.float32(a2), xi.astype(np.float32))
+    assert s32.dtype == np.float32
+    np.testing.assert_allclose(s32, s64, rtol=2e-6, atol=1e-30)
