@@ -94,6 +94,12 @@ def test_half_sample_noise_estimate_matches_the_true_error(mitsuba):
     assert r.seconds > 0 and r.noise_relative > 0
 
 
+def test_a_black_frame_has_no_relative_noise(mitsuba):
+    table = turntable.Turntable(DIFFUSE, np.zeros((16, 32, 3), np.float32), (16, 8), 3)
+    r = turntable.render_frame(table, turntable.Frame(0, "element", 0.0), 2)
+    assert r.noise_rmse == 0.0 and r.noise_relative is None
+
+
 # -- jobs and resumption -------------------------------------------------------------------
 def _job(material, out, settings=TINY, name="studio"):
     env = ibl.load(name, 64)

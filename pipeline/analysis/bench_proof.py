@@ -92,7 +92,7 @@ def time_pipeline(bsdf: dict, depth: int, env: Any, s: Settings) -> Timing:
     with Clock() as clock:
         table = Turntable(bsdf, env.pixels, s.resolution, depth)
         noise = [render_frame(table, f, s.spp, seed=f.index) for f in _frames(s.frames)]
-    mean_noise = float(np.mean([r.noise_relative for r in noise]))
+    mean_noise = float(np.mean([r.noise_relative or 0.0 for r in noise]))
     return Timing(clock.timing.wall, clock.timing.cpu, mean_noise)
 
 

@@ -348,7 +348,7 @@ def summary(out: Path, jobs: list[Job], results: list[dict[str, Any]], seconds: 
     entries = []
     for job, doc in zip(jobs, results, strict=True):
         times = [f["seconds"] for f in doc["frames"]]
-        noise = [f["noise_relative"] for f in doc["frames"]]
+        noise = [f["noise_relative"] for f in doc["frames"] if f["noise_relative"] is not None]
         entries.append(
             {
                 "material": doc["material"],

@@ -110,14 +110,15 @@ class RenderedFrame:
     image: np.ndarray
     seconds: float
     noise_rmse: float
-    noise_relative: float
+    noise_relative: float | None  # None for a black frame
 
 
 def render_frame(table: Turntable, frame: Frame, spp: int, seed: int = 0) -> RenderedFrame:
     """Render ``frame`` as two half-sample images; their mean and a noise estimate.
 
     ``noise_rmse`` is the estimated RMS error of the mean image, √(mean((A − B)²)/4),
-    taken on luminance; ``noise_relative`` divides it by the mean luminance.
+    taken on luminance; ``noise_relative`` divides it by the mean luminance (None when
+    the frame is black: JSON has no infinity).
     """
     half = max(1, spp // 2)
     t0 = time.perf_counter()
@@ -129,7 +130,7 @@ def render_frame(table: Turntable, frame: Frame, spp: int, seed: int = 0) -> Ren
     diff = (a - b) @ REC709_Y
     rmse = math.sqrt(float(np.mean(diff.astype(np.float64) ** 2)) / 4.0)
     mean = float(np.mean(image @ REC709_Y))
-    return RenderedFrame(frame, image, seconds, rmse, rmse / mean if mean > 0 else math.inf)
+    return RenderedFrame(frame, image, seconds, rmse, rmse / mean if mean > 0 else None)
 
 
 def render_turntable(table: Turntable, todo: list[Frame], spp: int) -> Iterator[RenderedFrame]:
