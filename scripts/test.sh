@@ -7,3 +7,4 @@ export PATH="$PWD/.venv/bin:$PATH"
 ruff check .
 ruff format --check .
 python -m pytest -n 2 -q "$@"
+lookdev check
