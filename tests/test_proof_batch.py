@@ -268,3 +268,16 @@ def test_at_most_in_flight_jobs_are_queued(monkeypatch, in_flight, most):
     assert [r["n"] for r in results] == [0, 1, 2, 3]
     assert Counting.peak == most
     assert ticks and all(len(running) <= most for running in ticks)
+
+
+def test_representative_set_takes_what_the_library_has():
+    from types import SimpleNamespace
+
+    from lookdev.pipeline.cli.proof import REPRESENTATIVE, representative_presets
+
+    full = SimpleNamespace(names=lambda: sorted([*REPRESENTATIVE, "zinc"]))
+    assert representative_presets(full) == list(REPRESENTATIVE)
+    partial = SimpleNamespace(names=lambda: ["gold", "zinc"])
+    assert representative_presets(partial) == ["gold"]
+    other = SimpleNamespace(names=lambda: ["a", "b", "c", "d", "e"])
+    assert representative_presets(other) == ["a", "b", "c", "d"]
