@@ -10,7 +10,7 @@ export PATH="$PWD/.venv/bin:$PATH"
 lookdev --version
 
 OUT="${LOOKDEV_PROOFS:-proofs}"
-lookdev proof -o "$OUT" "$@"
+lookdev proof -o "$OUT" --report "$@"
 
 # The presets the batch proofed, from its manifest, exported as one USD library.
 mapfile -t PRESETS < <(python - "$OUT/manifest.json" <<'PY'
@@ -19,4 +19,4 @@ print("\n".join(sorted({p["material"] for p in json.load(open(sys.argv[1]))["pro
 PY
 )
 lookdev export usd "${PRESETS[@]}" -o "$OUT/proofed.usda"
-echo "proofs: $OUT/*/*/contact.png, manifest: $OUT/manifest.json, USD: $OUT/proofed.usda"
+echo "review page: $OUT/index.html; proofs: $OUT/*/*/contact.png; USD: $OUT/proofed.usda"

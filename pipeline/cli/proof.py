@@ -181,7 +181,8 @@ def proof(
     console.print(table(f"proofs in {output}", columns, rows))
     console.print(
         f"{doc['wall_seconds']:.1f} s. Contact sheets: {output}/MATERIAL/IBL/contact.png; "
-        f"all proofs: {output / 'overview.png'}; manifest: {output / batch.MANIFEST}",
+        f"all proofs: {output / 'overview.png'}; manifest: {output / batch.MANIFEST}"
+        + (f"; review page: {doc['report']}" if report else ""),
         highlight=False,
     )
 
