@@ -28,15 +28,16 @@ The surface is two-sided: seen from below, the roles of the sides swap.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Annotated, Any
 
 import numpy as np
-from pydantic import Field
+from pydantic import BeforeValidator, Field, create_model
 
 from . import pixar_lobes as lobes
 from .arrays import NumpyOps
 from .bsdf import Model, density, draw, evaluate
-from .params import Color, Params, register_schema
+from .params import Color, Params, parse_color, register_schema
+from .pixar_lobes import LN_10
 
 DIELECTRIC_REFL = 0.05  # Smits' default normal reflectance of a dielectric
 
@@ -96,6 +97,54 @@ class PixarParams(Params):
         return (1.0 + f0) / (1.0 - f0)
 
 
+GRAZING = "_grazing"
+"""Suffix of a weight's value for the view at grazing incidence (s = 1)."""
+CONE_LOBES = ("specular", "reflection", "specular_t", "reflection_t")
+FALLOFF_LOBES = ("specular", "specular_t")
+_Weight = Annotated[float, Field(ge=0.0)]
+Weight = Annotated[tuple[_Weight, _Weight, _Weight], BeforeValidator(parse_color)]
+"""A lobe weight per channel: ≥ 0, above 1 only where a lobe scale pushed it."""
+
+
+def _weight_fields() -> dict[str, Any]:
+    out = {}
+    for name in WEIGHT_NAMES:
+        side = "normal" if name.endswith("N") else "grazing"
+        for suffix, view in (("", "normal"), (GRAZING, "grazing")):
+            out[name + suffix] = (
+                Weight,
+                Field((0.0, 0.0, 0.0), description=f"{name}: {side}-light weight, {view} view."),
+            )
+    for lobe in CONE_LOBES:
+        out[f"{lobe}_cone"] = (
+            float,
+            Field(20.0, ge=0.0, le=90.0, description=f"Cone of the {lobe} lobe (degrees)."),
+        )
+    for lobe in FALLOFF_LOBES:
+        out[f"{lobe}_falloff"] = (
+            float,
+            Field(
+                LN_10 / 2,
+                ge=0.0,
+                description=f"−ln of the {lobe} lobe's value at its cone, relative to its "
+                "peak (Smits' powerS: r ln 10).",
+            ),
+        )
+    out["ior"] = (float, Field(PixarParams().eta, ge=1.0, le=10.0, description="Refraction."))
+    return out
+
+
+PixarLobeWeights = register_schema(
+    create_model(
+        "PixarLobeWeights",
+        __base__=Params,
+        __doc__="Smits' lobe weights as a material's inputs: what compositing a layered "
+        "stack produces (lookdev.pipeline.blend.pixar), and what any Pixar material is.",
+        **_weight_fields(),
+    )
+)
+
+
 _COLORS = ("surface_color", "specular_tint", "transmission_tint")
 
 
@@ -145,51 +194,94 @@ def view_independent(xp: Any, v: dict[str, Any]) -> dict[str, Any]:
     }
 
 
-def weights(xp: Any, w: dict[str, Any], cos_view: Any) -> dict[str, Any]:
-    """Smits' twelve weights for a view at ``cos_view`` (only the diffuse ones vary).
+def ends(xp: Any, w: dict[str, Any]) -> dict[str, tuple[Any, Any]]:
+    """Smits' twelve weights at the view's two ends, ``{name: (at s = 0, at s = 1)}``.
 
-    dN = Mix[(1 − clear)(1 − nRefl) FrnlBlend[1 − nRefl, 1 − gRefl, V·n], 1, rough]
-    (the seed's ``1 rough`` lost its comma, DESIGN.md), dG likewise with (1 − gRefl);
-    diffN/diffG take (1 − back), diffTN/diffTG take back.
+    Only the diffuse weights depend on the view, through FrnlBlend[…, V·n], which is
+    affine in s = (1 − V·n)⁵: dN = Mix[(1 − clear)(1 − nRefl) FrnlBlend[1 − nRefl,
+    1 − gRefl, V·n], 1, rough] (the seed's ``1 rough`` lost its comma, DESIGN.md), dG
+    likewise with (1 − gRefl); diffN/diffG take (1 − back), diffTN/diffTG take back.
+    So each is affine in s too and its two ends give it exactly at every view
+    (:func:`weights`). The highlight weights have one value: ``(w, None)``.
     """
-    f_view = lobes.frn_blend(xp, 1.0 - w["n_refl_d"], 1.0 - w["g_refl"], cos_view)
-    d_n = xp.lerp(w["diff_n"] * f_view, 1.0, w["rough"])
-    d_g = xp.lerp(w["diff_g"] * f_view, 1.0, w["rough"])
-    out = {name: w[name] for name in WEIGHT_NAMES if name in w}
+    d_n, d_g = (
+        tuple(
+            xp.lerp(w[key] * f_view, 1.0, w["rough"])
+            for f_view in (1.0 - w["n_refl_d"], 1.0 - w["g_refl"])
+        )
+        for key in ("diff_n", "diff_g")
+    )
+    out = {name: (w[name], None) for name in WEIGHT_NAMES if name in w}
     out.update(
-        diffN=w["front"] * d_n,
-        diffG=w["front"] * d_g,
-        diffTN=w["behind"] * d_n,
-        diffTG=w["behind"] * d_g,
+        diffN=(w["front"] * d_n[0], w["front"] * d_n[1]),
+        diffG=(w["front"] * d_g[0], w["front"] * d_g[1]),
+        diffTN=(w["behind"] * d_n[0], w["behind"] * d_n[1]),
+        diffTG=(w["behind"] * d_g[0], w["behind"] * d_g[1]),
     )
     return out
 
 
-def _kept_lobes(xp: Any, w: dict[str, Any]) -> tuple[str, ...]:
+def weights(xp: Any, pairs: dict[str, tuple[Any, Any]], cos_view: Any) -> dict[str, Any]:
+    """The twelve weights for a view at ``cos_view`` from their two ends (:func:`ends`):
+    (1 − s) W(s=0) + s W(s=1) with s = (1 − V·n)⁵, exact at both ends."""
+    s = lobes.schlick_weight(xp, cos_view)
+    return {k: n if g is None else n * (1.0 - s) + g * s for k, (n, g) in pairs.items()}
+
+
+def _kept_lobes(xp: Any, pairs: dict[str, tuple[Any, Any]]) -> tuple[str, ...]:
     """Lobes whose weights are not known to be zero (DESIGN.md: nothing unneeded)."""
-    diffuse_amp = xp.lerp(xp.maximum(w["diff_n"], w["diff_g"]), 1.0, w["rough"])
-    amplitude = {
-        "diffuse": w["front"] * diffuse_amp,
-        "diffuse_t": w["behind"] * diffuse_amp,
-    }
-    for lobe in LOBES[1:3] + LOBES[4:]:
-        p = _PREFIX[lobe]
-        amplitude[lobe] = xp.maximum(w[p + "N"], w[p + "G"])
-    return tuple(lobe for lobe in LOBES if not xp.known_zero(amplitude[lobe]))
+    kept = []
+    for lobe in LOBES:
+        values = [v for end in "NG" for v in pairs[_PREFIX[lobe] + end] if v is not None]
+        if not all(xp.known_zero(v) for v in values):
+            kept.append(lobe)
+    return tuple(kept)
 
 
 # -- the Model -----------------------------------------------------------------------------
+def _prepared(xp: Any, pairs: dict, powers: dict[str, Any], eta: Any) -> dict[str, Any]:
+    """What eval/pdf/sample consume, from the weights' two ends, each highlight lobe's
+    exponent and the IOR: the one path for plain and composited materials."""
+    return {"ends": pairs, "power": powers, "eta": eta, "lobes": _kept_lobes(xp, pairs)}
+
+
 def _prepare(xp: Any, params: PixarParams, **maps: Any) -> dict[str, Any]:
+    """Parameters → Smits' weights and exponents → :func:`_prepared`."""
     v = _values(xp, params, maps)
-    w = view_independent(xp, v)
     r = v["roughness"]
-    return {
-        "w": w,
-        "power_s": lobes.power_specular(xp, r, v["specular_cone_scale"]),
-        "power_r": lobes.power_reflection(xp, r, v["reflection_cone_scale"]),
-        "eta": xp.scalar(maps.get("ior", params.eta)),
-        "lobes": _kept_lobes(xp, w),
-    }
+    p_s = lobes.power_specular(xp, r, v["specular_cone_scale"])
+    p_r = lobes.power_reflection(xp, r, v["reflection_cone_scale"])
+    powers = {"specular": p_s, "specular_t": p_s, "reflection": p_r, "reflection_t": p_r}
+    eta = xp.scalar(maps.get("ior", params.eta))
+    return _prepared(xp, ends(xp, view_independent(xp, v)), powers, eta)
+
+
+def _prepare_weights(xp: Any, params: Any, **maps: Any) -> dict[str, Any]:
+    """Composited weights (:data:`PixarLobeWeights`) → :func:`_prepared`.
+
+    Each weight is taken at the two view ends and interpolated in s = (1 − V·n)⁵
+    (:func:`weights`): exact at every view for a plain material and for simple layering
+    (both affine in s), exact at both ends for full layering, whose interactions
+    multiply view-dependent weights (lookdev.pipeline.blend.pixar). A weight whose
+    ends are the same constant is view-independent and costs no interpolation.
+    """
+
+    pairs = {}
+    for name in WEIGHT_NAMES:
+        n, g = maps.get(name, getattr(params, name)), maps.get(name + GRAZING)
+        if g is None:
+            g = getattr(params, name + GRAZING)
+            g = None if name not in maps and g == n else xp.color(g)
+        pairs[name] = (xp.color(n), g)
+    powers = {}
+    for lobe in CONE_LOBES:
+        falloff = _scalar(xp, params, maps, f"{lobe}_falloff") if lobe in FALLOFF_LOBES else LN_10
+        powers[lobe] = lobes.cone_power(xp, falloff, _scalar(xp, params, maps, f"{lobe}_cone"))
+    return _prepared(xp, pairs, powers, _scalar(xp, params, maps, "ior"))
+
+
+def _scalar(xp: Any, params: Any, maps: dict[str, Any], name: str) -> Any:
+    return xp.scalar(maps.get(name, getattr(params, name)))
 
 
 def _upper(xp: Any, wi: Any, wo: Any) -> tuple[Any, Any]:
@@ -199,7 +291,7 @@ def _upper(xp: Any, wi: Any, wo: Any) -> tuple[Any, Any]:
 
 
 def _power(prep: dict[str, Any], lobe: str) -> Any:
-    return prep["power_r"] if lobe.startswith("reflection") else prep["power_s"]
+    return prep["power"][lobe]
 
 
 def _lobe_value(xp: Any, prep: dict[str, Any], w: dict, lobe: str, wi: Any, wo: Any) -> Any:
@@ -226,7 +318,7 @@ def _lobe_value(xp: Any, prep: dict[str, Any], w: dict, lobe: str, wi: Any, wo: 
 
 def _eval(xp: Any, prep: dict[str, Any], wi: Any, wo: Any) -> Any:
     wi, wo = _upper(xp, wi, wo)
-    w = weights(xp, prep["w"], wo[2])
+    w = weights(xp, prep["ends"], wo[2])
     f = xp.zeros(wi[2]) * w["specN"]
     for lobe in prep["lobes"]:
         f = f + _lobe_value(xp, prep, w, lobe, wi, wo)
@@ -239,7 +331,7 @@ def _mean(c: Any) -> Any:
 
 def _selection(xp: Any, prep: dict[str, Any], wo: Any) -> dict[str, Any]:
     """Probability of sampling each kept lobe: its estimated albedo at this view."""
-    w = weights(xp, prep["w"], wo[2])
+    w = weights(xp, prep["ends"], wo[2])
     est = {}
     for lobe in prep["lobes"]:
         n, g = w[_PREFIX[lobe] + "N"], w[_PREFIX[lobe] + "G"]
@@ -312,6 +404,8 @@ def _sample(xp: Any, prep: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any, A
 
 
 MODEL = Model("pixar", PixarParams, _prepare, _eval, _pdf, _sample)
+LAYERED_MODEL = Model("pixar_layered", PixarLobeWeights, _prepare_weights, _eval, _pdf, _sample)
+"""The same lobes driven by composited weights: a layered Pixar material's BSDF."""
 
 
 # -- public numpy API ----------------------------------------------------------------------
@@ -319,9 +413,30 @@ def lobe_weights(params: PixarParams, cos_view: Any = 1.0) -> dict[str, np.ndarr
     """Smits' twelve weights by his names, each an RGB colour (shape (3,) or (..., 3))."""
     xp = NumpyOps()
     c = np.asarray(cos_view, dtype=np.float64)
-    w = weights(xp, view_independent(xp, _values(xp, params, {})), c.reshape(-1))
+    w = weights(xp, ends(xp, view_independent(xp, _values(xp, params, {}))), c.reshape(-1))
     shape = (*c.shape, 3)
     return {k: np.broadcast_to(np.asarray(w[k]).T, (c.size, 3)).reshape(shape) for k in w}
+
+
+def as_lobe_weights(params: PixarParams) -> Any:
+    """A plain material as :data:`PixarLobeWeights` (what a one-layer stack composites to).
+
+    >>> w = as_lobe_weights(PixarParams(surface_color=1.0, roughness=0.0))
+    >>> round(w.diffN[0], 6), w.diffN_grazing[0], w.reflection_cone
+    (0.9025, 0.0, 0.0)
+    """
+    xp = NumpyOps()
+    v = _values(xp, params, {})
+    data: dict[str, Any] = {}
+    for name, (n, g) in ends(xp, view_independent(xp, v)).items():
+        data[name] = tuple(np.asarray(n, dtype=float).ravel())
+        data[name + GRAZING] = tuple(np.asarray(n if g is None else g, dtype=float).ravel())
+    r = params.roughness
+    data["specular_cone"] = data["specular_t_cone"] = (30.0 * r + 5.0) * params.specular_cone_scale
+    data["reflection_cone"] = data["reflection_t_cone"] = 10.0 * r * params.reflection_cone_scale
+    data["specular_falloff"] = data["specular_t_falloff"] = r * LN_10
+    data["ior"] = params.eta
+    return PixarLobeWeights.parse(data, where="as_lobe_weights")
 
 
 def eval(params: PixarParams, wi: Any, wo: Any, **kw: Any) -> np.ndarray:  # noqa: A001

@@ -29,11 +29,16 @@ takes "0 (or epsilon in practice)". 0.5° is about the sun's disc: a mirror for 
 resolution, and its power (3.0e4) keeps exp(−p sin²θ) and p itself well inside float32."""
 
 
-def frn_blend(xp: Any, normal: Any, grazing: Any, cos_theta: Any) -> Any:
-    """Smits' generalised Schlick: Mix[normal, grazing, (1 − cos θ)⁵]."""
+def schlick_weight(xp: Any, cos_theta: Any) -> Any:
+    """s = (1 − cos θ)⁵, with cos θ clipped to 0..1: 0 at normal incidence, 1 at grazing."""
     c = xp.clip(cos_theta, 0.0, 1.0)
     t = (1.0 - c) * (1.0 - c)
-    return xp.lerp(normal, grazing, t * t * (1.0 - c))
+    return t * t * (1.0 - c)
+
+
+def frn_blend(xp: Any, normal: Any, grazing: Any, cos_theta: Any) -> Any:
+    """Smits' generalised Schlick: Mix[normal, grazing, (1 − cos θ)⁵]."""
+    return xp.lerp(normal, grazing, schlick_weight(xp, cos_theta))
 
 
 def p_diffuse(xp: Any, cos_u: Any, cos_v: Any, norm_refl: Any, grazing_refl: Any) -> Any:

@@ -51,7 +51,7 @@ from typing import Any
 import numpy as np
 
 from lookdev.materials.pixar import LOBES, WEIGHT_NAMES, PixarParams, lobe_weights
-from lookdev.materials.pixar_lobes import CONE_MIN_DEG
+from lookdev.materials.pixar_lobes import CONE_MIN_DEG, LN_10
 
 from .errors import BlendError
 from .masks import MaskSampler
@@ -74,6 +74,7 @@ GROUP = {lobe: "diffuse" if TYPE_OF[lobe] == "diffuse" else "highlight" for lobe
 VIEWS = {"": 1.0, "_grazing": 0.0}
 """Map-name suffix → cos θ of the view the weights are composited for."""
 CONES = ("specular", "reflection", "specular_t", "reflection_t")
+FALLOFFS = ("specular", "specular_t")
 FLAT = np.array([0.0, 0.0, 1.0])
 """The geometric normal in the shading frame."""
 
@@ -87,6 +88,10 @@ class Part:
     cone: Any = 0.0
     normal: Any = None
     """None: the geometric normal (0, 0, 1); no normal arithmetic is done for it."""
+    falloff: Any = LN_10
+    """−ln of the lobe's value at its cone relative to its peak: Smits' powerS falls to
+    0.1^r there (r ln 10), powerR to 0.1 (ln 10). It travels with the cone, so the
+    composite's exponent is falloff / sin²(cone) and a lone layer keeps its own."""
 
     @property
     def energy(self) -> Any:
@@ -110,6 +115,7 @@ def layer_lobes(params: PixarParams, cos_view: float, normals: dict | None = Non
     spec = (30.0 * r + 5.0) * params.specular_cone_scale
     refl = max(10.0 * r * params.reflection_cone_scale, CONE_MIN_DEG)
     cone = {"diffuse": 0.0, "specular": spec, "reflection": refl}
+    falloff = {"diffuse": LN_10, "specular": r * LN_10, "reflection": LN_10}
     normals = normals or {}
     return {
         lobe: Part(
@@ -117,6 +123,7 @@ def layer_lobes(params: PixarParams, cos_view: float, normals: dict | None = Non
             np.asarray(w[PREFIX[lobe] + "G"], dtype=np.float64),
             cone[TYPE_OF[lobe]],
             normals.get(GROUP[lobe]),
+            falloff[TYPE_OF[lobe]],
         )
         for lobe in LOBES
     }
@@ -132,9 +139,9 @@ class _Sum:
         self.parts[lobe].append(part)
 
     def total(self, lobe: str) -> Part:
-        """The lobe's summed weights, mean cone and energy-weighted normal *sum*.
+        """The lobe's summed weights, mean cone and falloff, energy-weighted normal *sum*.
 
-        The mean is taken about the first part's cone, so parts that share a cone (or a
+        Means are taken about the first part's value, so parts that share a cone (or a
         lone part) give that cone exactly. The normal stays None when every part has the
         geometric normal (no normal maps: the common case costs no vector arithmetic).
         """
@@ -142,17 +149,22 @@ class _Sum:
         energies = [p.energy for p in parts]
         n = sum(p.n for p in parts[1:]) + parts[0].n
         g = sum(p.g for p in parts[1:]) + parts[0].g
-        ref = parts[0].cone
         e_sum = sum(energies)
-        spread = sum(e * (p.cone - ref) for e, p in zip(energies, parts, strict=True))
-        cone = ref + spread / np.where(e_sum > 0, e_sum, 1.0)
+        e_sum = np.where(e_sum > 0, e_sum, 1.0)
+
+        def mean(attr: str) -> Any:
+            ref = getattr(parts[0], attr)
+            spread = sum(e * (getattr(p, attr) - ref) for e, p in zip(energies, parts, strict=True))
+            return ref + spread / e_sum
+
+        cone, falloff = mean("cone"), mean("falloff")
         normal = None
         if any(p.normal is not None for p in parts):
             normal = sum(
                 np.asarray(e)[..., None] * (FLAT if p.normal is None else p.normal)
                 for e, p in zip(energies, parts, strict=True)
             )
-        return Part(n, g, cone, normal)
+        return Part(n, g, cone, normal, falloff)
 
 
 def composite(
@@ -206,8 +218,8 @@ def _full(layers: Sequence[tuple[Lobes, Any]], acc: _Sum) -> None:
         onward = _Sum()
         for kind, packet in packets.items():
             for lobe, part in () if _known(alpha, 0.0) else lobes.items():
-                out_type, cone = _interact(kind, packet.cone, TYPE_OF[lobe], part.cone)
-                hit = Part(packet.n * part.n, packet.g * part.g, cone, part.normal)
+                out_type, cone, falloff = _interact(kind, packet, TYPE_OF[lobe], part)
+                hit = Part(packet.n * part.n, packet.g * part.g, cone, part.normal, falloff)
                 hit = _scaled(hit, alpha)
                 if lobe.endswith("_t"):
                     onward.add(TRANSMITTED[out_type], hit)
@@ -227,25 +239,34 @@ def _known(alpha: Any, value: float) -> bool:
     return bool(np.all(np.asarray(alpha) == value))
 
 
-def _interact(incoming: str, cone_in: Any, lobe: str, cone_lobe: Any) -> tuple[str, Any]:
+def _interact(incoming: str, packet: Part, lobe: str, part: Part) -> tuple[str, Any, Any]:
     """Smits' rule: less blur keeps type and cone, same blur takes the max cone, more
     blur replaces the type and "keeps any cone angle the same", read as: the lobe keeps
-    its own cone (a refracted ray meeting a 20° specular lobe leaves in that lobe)."""
+    its own cone (a refracted ray meeting a 20° specular lobe leaves in that lobe).
+    The falloff goes with the cone it belongs to (the blurrier one on a tie)."""
     if BLUR[lobe] < BLUR[incoming]:
-        return incoming, cone_in
+        return incoming, packet.cone, packet.falloff
     if BLUR[lobe] == BLUR[incoming]:
-        return incoming, np.maximum(cone_in, cone_lobe)
-    return lobe, cone_lobe
+        wider = packet.cone > part.cone
+        tie = packet.cone == part.cone
+        falloff = np.where(
+            tie,
+            np.minimum(packet.falloff, part.falloff),
+            np.where(wider, packet.falloff, part.falloff),
+        )
+        return incoming, np.maximum(packet.cone, part.cone), falloff
+    return lobe, part.cone, part.falloff
 
 
 def _scaled(part: Part, c: Any) -> Part:
     c = np.asarray(c)
-    return Part(part.n * c[..., None], part.g * c[..., None], part.cone, part.normal)
+    return Part(part.n * c[..., None], part.g * c[..., None], part.cone, part.normal, part.falloff)
 
 
 def _normalised(part: Part) -> Part:
     """A part whose normal sum (energy-weighted, from :class:`_Sum`) is made unit."""
-    return Part(part.n, part.g, part.cone, None if part.normal is None else _unit(part.normal))
+    normal = None if part.normal is None else _unit(part.normal)
+    return Part(part.n, part.g, part.cone, normal, part.falloff)
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -291,8 +312,11 @@ def blend_stack(
     A plain (not layered) Pixar material stays its parameters. A layered one becomes
     lobe weights (``representation = "lobe_weights"``): Smits' twelve weight names for
     the view at normal incidence and the same with ``_grazing`` for the view at grazing
-    incidence (RGB), ``<lobe>_cone`` in degrees for the four highlight lobes, and the
-    diffuse and highlight normals as ``normal_map`` and ``specular_normal_map``.
+    incidence (RGB), ``<lobe>_cone`` in degrees for the four highlight lobes,
+    ``specular_falloff`` and ``specular_t_falloff`` (:attr:`Part.falloff`), the ``ior``
+    the view refracts by (:func:`_ior`), and the diffuse and highlight normals as
+    ``normal_map`` and ``specular_normal_map``: the inputs of
+    :data:`lookdev.materials.pixar.LAYERED_MODEL`.
     """
     from .engine import BlendedMaterial
 
@@ -356,7 +380,10 @@ def _outputs(top_first: list[Entry], sampler: MaskSampler, progress, mode: str):
                 _store(out, f"{PREFIX[lobe]}G{suffix}", part.g, rows, n, width, height)
                 if suffix == "" and lobe in CONES:
                     _store(out, f"{lobe}_cone", part.cone, rows, n, width, height)
+                if suffix == "" and lobe in FALLOFFS:
+                    _store(out, f"{lobe}_falloff", part.falloff, rows, n, width, height)
             if suffix == "":
+                _store(out, "ior", _ior(top_first, alphas), rows, n, width, height)
                 _store(out, "normal_map", group_normals["diffuse"], rows, n, width, height)
                 _store(
                     out, "specular_normal_map", group_normals["highlight"], rows, n, width, height
@@ -366,12 +393,23 @@ def _outputs(top_first: list[Entry], sampler: MaskSampler, progress, mode: str):
     return out
 
 
+def _ior(top_first: list[Entry], alphas: list[Any]) -> Any:
+    """The IOR the view refracts by: the uppermost layer present at the texel, i.e. the
+    A-over-B mean Σ cₖ ηₖ (cₖ = αₖ Π(1 − αⱼ above)), the bottom layer's where none is."""
+    eta: Any = 0.0
+    remaining: Any = 1.0
+    for entry, alpha in zip(top_first, alphas, strict=True):
+        eta = eta + alpha * remaining * entry.params.eta
+        remaining = remaining * (1.0 - alpha)
+    return eta + remaining * top_first[-1].params.eta
+
+
 def _with_normals(lobes: Lobes, normals: dict[str, Any]) -> Lobes:
     """``lobes`` with the diffuse and highlight normals of this tile where a map gives one."""
     if not normals:
         return lobes
     return {
-        lobe: Part(p.n, p.g, p.cone, normals.get(GROUP[lobe], p.normal))
+        lobe: Part(p.n, p.g, p.cone, normals.get(GROUP[lobe], p.normal), p.falloff)
         for lobe, p in lobes.items()
     }
 
@@ -387,8 +425,9 @@ def _entry_normals(entry: Entry, sampler: MaskSampler, rows: slice) -> dict[str,
 
 
 def _store(out, key, value, rows, n, width, height) -> None:
-    """Write one tile of output ``key`` (cones are scalars, the rest RGB or xyz)."""
-    channels = () if key.endswith("_cone") else (3,)
+    """Write one tile of output ``key`` (cones, falloffs and the IOR are scalars, the
+    rest RGB or xyz)."""
+    channels = () if key.endswith(("_cone", "_falloff", "ior")) else (3,)
     if key not in out:
         out[key] = np.empty((height, width, *channels), dtype=np.float32)
     out[key][rows] = np.broadcast_to(value, (n, width, *channels))
