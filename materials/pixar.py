@@ -110,11 +110,16 @@ def _weight_fields() -> dict[str, Any]:
     out = {}
     for name in WEIGHT_NAMES:
         side = "normal" if name.endswith("N") else "grazing"
-        for suffix, view in (("", "normal"), (GRAZING, "grazing")):
-            out[name + suffix] = (
-                Weight,
-                Field((0.0, 0.0, 0.0), description=f"{name}: {side}-light weight, {view} view."),
-            )
+        out[name] = (
+            Weight,
+            Field((0.0, 0.0, 0.0), description=f"{name}: {side}-light weight, normal view."),
+        )
+        out[name + GRAZING] = (
+            Weight | None,
+            Field(
+                None, description=f"{name} for the grazing view; unset: {name} (no view change)."
+            ),
+        )
     for lobe in CONE_LOBES:
         out[f"{lobe}_cone"] = (
             float,
@@ -271,7 +276,7 @@ def _prepare_weights(xp: Any, params: Any, **maps: Any) -> dict[str, Any]:
         n, g = maps.get(name, getattr(params, name)), maps.get(name + GRAZING)
         if g is None:
             g = getattr(params, name + GRAZING)
-            g = None if name not in maps and g == n else xp.color(g)
+            g = None if g is None or (name not in maps and g == n) else xp.color(g)
         pairs[name] = (xp.color(n), g)
     powers = {}
     for lobe in CONE_LOBES:
@@ -430,7 +435,8 @@ def as_lobe_weights(params: PixarParams) -> Any:
     data: dict[str, Any] = {}
     for name, (n, g) in ends(xp, view_independent(xp, v)).items():
         data[name] = tuple(np.asarray(n, dtype=float).ravel())
-        data[name + GRAZING] = tuple(np.asarray(n if g is None else g, dtype=float).ravel())
+        if g is not None:
+            data[name + GRAZING] = tuple(np.asarray(g, dtype=float).ravel())
     r = params.roughness
     data["specular_cone"] = data["specular_t_cone"] = (30.0 * r + 5.0) * params.specular_cone_scale
     data["reflection_cone"] = data["reflection_t_cone"] = 10.0 * r * params.reflection_cone_scale

@@ -25,6 +25,7 @@ baseline).
 from __future__ import annotations
 
 import functools
+import types
 import typing
 from collections.abc import Iterable
 from typing import Any
@@ -89,8 +90,8 @@ def lobe_kinds(lobes: Iterable[str], model_name: str) -> set[str]:
 def is_color_field(params_type: type, field: str) -> bool:
     """True when a schema field holds an RGB triple (its texture is evaluated as colour)."""
     annotation = params_type.model_fields[field].annotation
-    while typing.get_origin(annotation) is typing.Annotated:
-        annotation = typing.get_args(annotation)[0]
+    while typing.get_origin(annotation) in (typing.Annotated, typing.Union, types.UnionType):
+        annotation = typing.get_args(annotation)[0]  # Colour | None: the colour
     return typing.get_origin(annotation) is tuple
 
 

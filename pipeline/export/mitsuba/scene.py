@@ -28,6 +28,7 @@ import numpy as np
 
 from lookdev.materials.bsdf import Model
 from lookdev.materials.params import Params
+from lookdev.materials.pixar import GRAZING
 
 from .plugin import (
     FORCE_ALL_LOBES,
@@ -40,8 +41,10 @@ MODEL_MODULES = {
     "disney": "lookdev.materials.disney",
     "sheen": "lookdev.materials.sheen",
     "pixar": "lookdev.materials.pixar",
+    "pixar_layered": "lookdev.materials.pixar:LAYERED_MODEL",
 }
-"""Where each model's ``MODEL`` lives; a plugin ``lookdev_<name>`` is registered for each."""
+"""Where each model lives (``module`` for its ``MODEL``, or ``module:NAME``); a plugin
+``lookdev_<name>`` is registered for each."""
 
 DEFAULT_MAP_RESOLUTION = 512
 
@@ -53,8 +56,9 @@ def model_for(name: str) -> Model:
         raise MitsubaExportError(
             f"no Mitsuba plugin for model {name!r}; known: {', '.join(MODEL_MODULES)}"
         )
+    module, _, attr = module.partition(":")
     try:
-        return importlib.import_module(module).MODEL
+        return getattr(importlib.import_module(module), attr or "MODEL")
     except (ImportError, AttributeError) as exc:
         raise MitsubaExportError(
             f"model {name!r} is not available ({module}.MODEL: {exc})"
@@ -133,19 +137,29 @@ def _given(params: Params) -> dict[str, Any]:
     return {k: v for k, v in params.model_dump(exclude_unset=True).items() if v is not None}
 
 
+LAYERED_MODELS = {"pixar": "pixar_layered"}
+"""The model that renders a blend of ``representation = "lobe_weights"`` (Smits' weights)."""
+BLEND_ONLY = frozenset({"layering"})
+"""Constants a blend records for the record, which no BSDF takes."""
+
+
 def _from_blended(blended: Any) -> Flat:
-    fields = model_for(blended.model).params_type.model_fields
-    foreign = sorted(set(blended.constants) - set(fields)) + sorted(set(blended.maps) - set(fields))
+    model = blended.model
+    if getattr(blended, "representation", "params") == "lobe_weights":
+        model = LAYERED_MODELS.get(model, model)
+    fields = model_for(model).params_type.model_fields
+    given = set(blended.constants) - BLEND_ONLY
+    foreign = sorted(given - set(fields)) + sorted(set(blended.maps) - set(fields))
     if foreign:
-        # Pixar stacks composite lobe weights (Smits, "Layering"), which the Pixar Model's
-        # prepare() does not take as inputs: such a material has no BSDF to render yet.
         raise MitsubaExportError(
-            f"blended {blended.model} material carries {', '.join(foreign[:3])}… which are "
-            f"not {blended.model} parameters; layered Pixar materials cannot be rendered yet",
+            f"blended material carries {', '.join(foreign[:3])}, which are not inputs of "
+            f"the {model} model",
             where=blended.name,
         )
-    constants = {k: _plain(v) for k, v in dict(blended.constants).items() if v is not None}
+    constants = {k: _plain(v) for k, v in blended.constants.items() if k in given and v is not None}
     maps = {k: np.asarray(v, dtype=np.float32) for k, v in dict(blended.maps).items()}
+    if model != blended.model:
+        _drop_view_independent(constants, maps)
     if getattr(blended, "specular_normal_map", None) is not None:
         warnings.warn(
             f"{blended.name}: Mitsuba proofs ignore the specular normal map (a Model "
@@ -154,7 +168,18 @@ def _from_blended(blended: Any) -> Flat:
             stacklevel=3,
         )
     normal = getattr(blended, "normal_map", None)
-    return Flat(blended.name, blended.model, constants, maps, normal)
+    return Flat(blended.name, model, constants, maps, normal)
+
+
+def _drop_view_independent(constants: dict[str, Any], maps: dict[str, np.ndarray]) -> None:
+    """Leave out each ``<weight>_grazing`` equal to its normal-view weight (Smits'
+    highlight weights do not change with the view): the model then reads one value
+    and interpolates nothing (:data:`lookdev.materials.pixar.PixarLobeWeights`)."""
+    for key in [k for k in (*constants, *maps) if k.endswith(GRAZING)]:
+        base = key.removesuffix(GRAZING)
+        for store in (constants, maps):
+            if key in store and base in store and np.array_equal(store[key], store[base]):
+                del store[key]
 
 
 def _plain(value: Any) -> Any:
