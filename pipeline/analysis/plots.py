@@ -90,11 +90,24 @@ def subject_for(name_or_path: str, library: Any = None) -> Subject:
     from lookdev.pipeline.blend import blend
 
     blended = blend(material, LAYERED_RESOLUTION)
+    if blended.representation == "lobe_weights":
+        return _weights_subject(material.name, blended)
     model = model_named(blended.model)
     if not blended.maps:
         return Subject(material.name, model, blended.to_params())
     h, w = next(iter(blended.maps.values())).shape[:2]
     return Subject(material.name, model, blended.params_at(h // 2, w // 2), blended.maps)
+
+
+def _weights_subject(name: str, blended: Any) -> Subject:
+    """A layered Pixar blend (Smits' composited lobe weights) on the model that takes them."""
+    from lookdev.materials.pixar import LAYERED_MODEL
+
+    fields = LAYERED_MODEL.params_type.model_fields
+    h, w = blended.resolution[1], blended.resolution[0]
+    values = {k: v for k, v in blended.params_at(h // 2, w // 2).items() if k in fields}
+    params = LAYERED_MODEL.params_type.parse(values, where=f"{name} centre texel")
+    return Subject(name, LAYERED_MODEL, params, blended.maps or None)
 
 
 def load_environment(name_or_path: str, width: int = 256) -> np.ndarray:
