@@ -135,7 +135,10 @@ def _weight_fields() -> dict[str, Any]:
                 "peak (Smits' powerS: r ln 10).",
             ),
         )
-    out["ior"] = (float, Field(PixarParams().eta, ge=1.0, le=10.0, description="Refraction."))
+    out["ior"] = (
+        float,
+        Field(PixarParams().eta, ge=1.0, description="IOR of the transmitted lobes' view."),
+    )  # unbounded above: PixarParams.eta derives it from nRefl, which may reach 1
     return out
 
 
