@@ -169,8 +169,11 @@ def table_nodes(n_mu: int, n_r: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _gather(xp: Any, flat: np.ndarray, index: Any) -> Any:
+    """``flat[index]`` for an index of any backend (integral values held as floats)."""
     if xp.name == "numpy":
         return flat[np.asarray(index, dtype=np.int64)]
+    if isinstance(index, int | float):  # Mitsuba's scalar_rgb: its Float is Python's float
+        return float(flat[int(index)])
     dr = xp.dr
     return dr.gather(xp.Float, xp.Float(flat), dr.uint32_array_t(xp.Float)(index))
 
