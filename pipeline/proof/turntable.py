@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -118,7 +117,8 @@ def render_frame(table: Turntable, frame: Frame, spp: int, seed: int = 0) -> Ren
 
     ``noise_rmse`` is the estimated RMS error of the mean image, √(mean((A − B)²)/4),
     taken on luminance; ``noise_relative`` divides it by the mean luminance (None when
-    the frame is black: JSON has no infinity).
+    the frame is black: JSON has no infinity). An odd ``spp`` is rounded down to even.
+    Seeds 2·seed and 2·seed + 1 keep every frame's samples distinct and reruns equal.
     """
     half = max(1, spp // 2)
     t0 = time.perf_counter()
@@ -131,9 +131,3 @@ def render_frame(table: Turntable, frame: Frame, spp: int, seed: int = 0) -> Ren
     rmse = math.sqrt(float(np.mean(diff.astype(np.float64) ** 2)) / 4.0)
     mean = float(np.mean(image @ REC709_Y))
     return RenderedFrame(frame, image, seconds, rmse, rmse / mean if mean > 0 else None)
-
-
-def render_turntable(table: Turntable, todo: list[Frame], spp: int) -> Iterator[RenderedFrame]:
-    """Render ``todo`` in order; each frame's seed is its index, so reruns match."""
-    for frame in todo:
-        yield render_frame(table, frame, spp, seed=frame.index)
