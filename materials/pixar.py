@@ -210,7 +210,7 @@ def ends(xp: Any, w: dict[str, Any]) -> dict[str, tuple[Any, Any]]:
     1 − gRefl, V·n], 1, rough] (the seed's ``1 rough`` lost its comma, DESIGN.md), dG
     likewise with (1 − gRefl); diffN/diffG take (1 − back), diffTN/diffTG take back.
     So each is affine in s too and its two ends give it exactly at every view
-    (:func:`weights`). The highlight weights have one value: ``(w, None)``.
+    (:func:`at_view`). The highlight weights have one value: ``(w, None)``.
     """
     d_n, d_g = (
         tuple(
@@ -229,11 +229,16 @@ def ends(xp: Any, w: dict[str, Any]) -> dict[str, tuple[Any, Any]]:
     return out
 
 
-def weights(xp: Any, pairs: dict[str, tuple[Any, Any]], cos_view: Any) -> dict[str, Any]:
+def at_view(xp: Any, pairs: dict[str, tuple[Any, Any]], cos_view: Any) -> dict[str, Any]:
     """The twelve weights for a view at ``cos_view`` from their two ends (:func:`ends`):
     (1 − s) W(s=0) + s W(s=1) with s = (1 − V·n)⁵, exact at both ends."""
     s = lobes.schlick_weight(xp, cos_view)
     return {k: n if g is None else n * (1.0 - s) + g * s for k, (n, g) in pairs.items()}
+
+
+def weights(xp: Any, w: dict[str, Any], cos_view: Any) -> dict[str, Any]:
+    """Smits' twelve weights for a view at ``cos_view`` from :func:`view_independent`."""
+    return at_view(xp, ends(xp, w), cos_view)
 
 
 def _kept_lobes(xp: Any, pairs: dict[str, tuple[Any, Any]]) -> tuple[str, ...]:
@@ -268,7 +273,7 @@ def _prepare_weights(xp: Any, params: Any, **maps: Any) -> dict[str, Any]:
     """Composited weights (:data:`PixarLobeWeights`) → :func:`_prepared`.
 
     Each weight is taken at the two view ends and interpolated in s = (1 − V·n)⁵
-    (:func:`weights`): exact at every view for a plain material and for simple layering
+    (:func:`at_view`): exact at every view for a plain material and for simple layering
     (both affine in s), exact at both ends for full layering, whose interactions
     multiply view-dependent weights (lookdev.pipeline.blend.pixar). A weight whose
     ends are the same constant is view-independent and costs no interpolation.
@@ -326,7 +331,7 @@ def _lobe_value(xp: Any, prep: dict[str, Any], w: dict, lobe: str, wi: Any, wo: 
 
 def _eval(xp: Any, prep: dict[str, Any], wi: Any, wo: Any) -> Any:
     wi, wo = _upper(xp, wi, wo)
-    w = weights(xp, prep["ends"], wo[2])
+    w = at_view(xp, prep["ends"], wo[2])
     f = xp.zeros(wi[2]) * w["specN"]
     for lobe in prep["lobes"]:
         f = f + _lobe_value(xp, prep, w, lobe, wi, wo)
@@ -339,7 +344,7 @@ def _mean(c: Any) -> Any:
 
 def _selection(xp: Any, prep: dict[str, Any], wo: Any) -> dict[str, Any]:
     """Probability of sampling each kept lobe: its estimated albedo at this view."""
-    w = weights(xp, prep["ends"], wo[2])
+    w = at_view(xp, prep["ends"], wo[2])
     est = {}
     for lobe in prep["lobes"]:
         n, g = w[_PREFIX[lobe] + "N"], w[_PREFIX[lobe] + "G"]
@@ -421,7 +426,7 @@ def lobe_weights(params: PixarParams, cos_view: Any = 1.0) -> dict[str, np.ndarr
     """Smits' twelve weights by his names, each an RGB colour (shape (3,) or (..., 3))."""
     xp = NumpyOps()
     c = np.asarray(cos_view, dtype=np.float64)
-    w = weights(xp, ends(xp, view_independent(xp, _values(xp, params, {}))), c.reshape(-1))
+    w = weights(xp, view_independent(xp, _values(xp, params, {})), c.reshape(-1))
     shape = (*c.shape, 3)
     return {k: np.broadcast_to(np.asarray(w[k]).T, (c.size, 3)).reshape(shape) for k in w}
 
