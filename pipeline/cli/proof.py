@@ -89,7 +89,12 @@ def proof(
     ] = None,
     workers: Annotated[
         int | None,
-        typer.Option("--workers", "-j", min=1, help="Local worker processes (default: cores/2)."),
+        typer.Option(
+            "--workers",
+            "-j",
+            min=1,
+            help="Local worker processes (default 1: each renders on every core).",
+        ),
     ] = None,
     library: Annotated[
         list[Path] | None,
