@@ -278,7 +278,6 @@ def _prepare_weights(xp: Any, params: Any, **maps: Any) -> dict[str, Any]:
     multiply view-dependent weights (lookdev.pipeline.blend.pixar). A weight whose
     ends are the same constant is view-independent and costs no interpolation.
     """
-
     pairs = {}
     for name in WEIGHT_NAMES:
         n, g = maps.get(name, getattr(params, name)), maps.get(name + GRAZING)
