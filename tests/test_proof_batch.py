@@ -83,6 +83,29 @@ def test_frames_after_the_first_reuse_every_compiled_kernel(mitsuba):
     assert jit and all(k["cache_hit"] for k in jit)
 
 
+def test_another_ibl_of_the_same_size_reuses_the_compiled_kernels(mitsuba):
+    """Why a batch brings IBLs to one size and folds exposure into pixels (DESIGN.md)."""
+    import gc
+
+    import drjit as dr
+
+    frame = turntable.Frame(0, "element", 0.0)
+    first = turntable.Turntable(DIFFUSE, ibl.load("studio", 64).pixels, (32, 16), 3)
+    turntable.render_frame(first, frame, 4)
+    del first  # a job's scene is gone before the next job's (Dr.Jit reuses its slots)
+    gc.collect()
+    dr.set_flag(dr.JitFlag.KernelHistory, True)
+    try:
+        dr.kernel_history()
+        brighter = ibl.load("overcast", 64, exposure=1.5).pixels
+        second = turntable.Turntable(DIFFUSE, brighter, (32, 16), 3)
+        turntable.render_frame(second, frame, 4)
+        jit = [k for k in dr.kernel_history() if str(k["type"]).endswith("JIT")]
+    finally:
+        dr.set_flag(dr.JitFlag.KernelHistory, False)
+    assert jit and all(k["cache_hit"] for k in jit)
+
+
 def test_half_sample_noise_estimate_matches_the_true_error(mitsuba):
     table = _table(mitsuba, resolution=(48, 24))
     frame = turntable.Frame(0, "element", 0.0)
