@@ -121,6 +121,18 @@ def test_an_unset_grazing_weight_does_not_change_with_the_view():
     assert fading[0, 0] == steady[0, 0] and fading[2, 0] < 1e-5 * steady[2, 0]
 
 
+def test_stability_sweep_finds_no_nan_inf_negative_or_crash():
+    """``lookdev check``'s sweep (every field at its extremes, stiff directions, float32
+    and float64, per-element maps) on the composited-weights model. Energy is not judged
+    here: arbitrary weights need not partition energy; composites do (tested below)."""
+    from lookdev.pipeline.analysis.stability import check_model
+
+    report = check_model("pixar_layered", LAYERED_MODEL)
+    assert report.cases > 10_000
+    bad = {k: n for k, n in report.counts.items() if k != "energy_gain" and n}
+    assert not bad, {k: report.failures[k].case for k in bad}
+
+
 # -- view dependence: interpolation in s = (1 − V·n)⁵ ------------------------------------------
 def _weights_at(stack_params, alphas, cos_view, mode):
     stack = [(layer_lobes(p, cos_view), a) for p, a in zip(stack_params, alphas, strict=True)]
