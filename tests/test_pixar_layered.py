@@ -300,6 +300,29 @@ def test_mitsuba_renders_a_one_layer_stack_as_the_preset(mi):
     np.testing.assert_allclose(images[1], images[0], rtol=1e-4, atol=1e-5)
 
 
+def test_white_furnace_sphere_shows_the_composites_albedo(mi):
+    """Glaze over clay (mask 0.6) under a white sky, single scattering: the rendered
+    sphere's centre is the numpy model's reflected albedo at the pixels' view angles."""
+    from _mitsuba_helpers import pixel_view_angles
+
+    from lookdev.pipeline.analysis.albedo import albedo_monte_carlo
+    from lookdev.pipeline.export.mitsuba.scene import scene_dict
+
+    stack = layered(
+        layer(plain("clay", CLAY)), layer(plain("glaze", GLAZE), ConstantMask(value=0.6))
+    )
+    blended = blend(stack, 1)
+    scene = scene_dict(blended, resolution=(32, 32), spp=512, max_depth=2)
+    assert scene["ball"]["bsdf"]["type"] == "lookdev_pixar_layered"
+    image = np.array(mi.render(mi.load_dict(scene), seed=1))
+    rows, cols = np.mgrid[14:18, 14:18]
+    theta, count = np.unique(np.round(pixel_view_angles(scene, rows, cols), 9), return_counts=True)
+    albedo = albedo_monte_carlo(LAYERED_MODEL, as_weights(blended), theta, n_samples=65536).albedo
+    expected = (albedo * count[:, None]).sum(axis=0) / count.sum()
+    got = image[14:18, 14:18].reshape(-1, 3).mean(axis=0)
+    np.testing.assert_allclose(got, expected, rtol=0.02, atol=2e-3)
+
+
 @pytest.mark.parametrize("name", LAYERED_PRESETS)
 def test_builtin_layered_pixar_presets_become_bsdfs(mi, name):
     from lookdev.pipeline.export.mitsuba.depth import max_depth_for
