@@ -21,6 +21,13 @@ Lobes at a view ωo and light ωi (both as BRDFs, i.e. Smits' lobes / π):
 
 The surface is two-sided: seen from below, the roles of the sides swap.
 
+Two models share these lobes. :data:`MODEL` takes Smits' parameters
+(:class:`PixarParams`); :data:`LAYERED_MODEL` takes the twelve weights themselves at the
+two ends of the view, cones, falloffs and IOR (:data:`PixarLobeWeights`), which is what
+compositing a layered stack produces (:mod:`lookdev.pipeline.blend.pixar`). The first
+is the second after one step: parameters → weights → the same prepared dict
+(:func:`_prepared`), so a one-layer stack renders as its preset.
+
 >>> w = lobe_weights(PixarParams(surface_color=1.0, metallic=0.0, roughness=0.0))
 >>> round(float(w["diffN"][0]), 6), float(w["diffG"][0])  # Smits' printed 0.9025 check
 (0.9025, 0.0)
@@ -112,7 +119,9 @@ def _weight_fields() -> dict[str, Any]:
         side = "normal" if name.endswith("N") else "grazing"
         out[name] = (
             Weight,
-            Field((0.0, 0.0, 0.0), description=f"{name}: {side}-light weight, normal view."),
+            Field(
+                (0.0, 0.0, 0.0), description=f"{name}: weight at {side} incidence, view head-on."
+            ),
         )
         out[name + GRAZING] = (
             Weight | None,
