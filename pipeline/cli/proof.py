@@ -24,8 +24,10 @@ REPRESENTATIVE = (
     "velvet",
     "glass_clear",
     "rusty_car_paint",
+    "pixar_paint_red",
 )
-"""The default subjects: a metal, a glossy plastic, cloth, glass and a layered material."""
+"""The default subjects: a metal, a glossy plastic, cloth, glass, a layered material and a
+Pixar lobe-weight material."""
 
 
 def representative_presets(library: Any) -> list[str]:
