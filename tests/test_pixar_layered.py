@@ -13,6 +13,8 @@ import numpy as np
 import pytest
 from _blend_helpers import layer, layered
 from chi2_harness import chi2_test
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from lookdev.library import Library, Material
 from lookdev.materials import pixar
@@ -103,6 +105,33 @@ def test_one_layer_stack_with_presence_1_is_the_preset(params):
         np.testing.assert_allclose(f_layered, f_plain, rtol=2e-5, atol=1e-9 * f_plain.max())
         p_plain, p_layered = pixar.pdf(params, wi, wo), density(LAYERED_MODEL, w, wi, wo)
         np.testing.assert_allclose(p_layered, p_plain, rtol=2e-5, atol=1e-9 * p_plain.max())
+
+
+unit = st.floats(0.0, 1.0)
+RANDOM_PARAMS = st.builds(
+    P,
+    surface_color=st.tuples(unit, unit, unit),
+    metallic=unit,
+    roughness=unit,
+    clear=unit,
+    back=unit,
+    normal_fresnel=st.floats(0.0, 20.0),
+    grazing_fresnel=unit,
+    specular_cone_scale=st.floats(0.0, 2.5),
+    reflection_cone_scale=st.floats(0.0, 2.5),
+    specular_t_scale=unit,
+    diffuse_t_scale=unit,
+)
+
+
+@settings(max_examples=30, deadline=None)
+@given(params=RANDOM_PARAMS, mode=st.sampled_from(["full", "simple"]))
+def test_any_one_layer_stack_is_its_preset(params, mode):
+    """Property: over random parameters, the blended lone layer evaluates as the preset."""
+    w = as_weights(blend(layered(layer(plain("only", params))), 1, layering=mode))
+    wi, wo = pairs(640)
+    f_plain, f_layered = pixar.eval(params, wi, wo), evaluate(LAYERED_MODEL, w, wi, wo)
+    np.testing.assert_allclose(f_layered, f_plain, rtol=2e-5, atol=1e-9 * max(f_plain.max(), 1.0))
 
 
 def test_an_unset_grazing_weight_does_not_change_with_the_view():
