@@ -53,8 +53,11 @@ MODEL_MODULES = {
     "disney": "lookdev.materials.disney",
     "sheen": "lookdev.materials.sheen",
     "pixar": "lookdev.materials.pixar",
+    "pixar_layered": "lookdev.materials.pixar",
 }
-ALLOWANCE = {"disney": 0.77, "sheen": 0.002, "pixar": 0.0}
+MODEL_ATTRS = {"pixar_layered": "LAYERED_MODEL"}
+"""The attribute holding the Model, where it is not ``MODEL``."""
+ALLOWANCE = {"disney": 0.77, "sheen": 0.002, "pixar": 0.0, "pixar_layered": 0.0}
 DTYPES = (np.float32, np.float64)
 FURNACE_THETA_DEG = (0.0, 45.0, 60.0, 75.0, 89.0, 89.99)
 FURNACE_SAMPLES = 2048
@@ -100,7 +103,8 @@ def available_models(names: list[str] | None = None) -> tuple[dict[str, Model], 
     models, missing = {}, {}
     for name in wanted:
         try:
-            models[name] = importlib.import_module(MODEL_MODULES[name]).MODEL
+            module = importlib.import_module(MODEL_MODULES[name])
+            models[name] = getattr(module, MODEL_ATTRS.get(name, "MODEL"))
         except (ImportError, AttributeError) as exc:
             missing[name] = f"not available ({exc})"
     return models, missing
@@ -349,11 +353,18 @@ def _white(params: Any) -> Any:
     return params.replace(**colours) if colours else params
 
 
-def _sweep_energy(report: ModelReport, model: Model, label: str, params: Any, dtype: Any) -> None:
+def _sweep_energy(
+    report: ModelReport, model: Model, label: str, params: Any, dtype: Any, whiten: bool = True
+) -> None:
     name = np.dtype(dtype).name
     theta = np.radians(FURNACE_THETA_DEG)
     curve = albedo_monte_carlo(
-        model, _white(params), theta, n_samples=FURNACE_SAMPLES, hemisphere="both", dtype=dtype
+        model,
+        _white(params) if whiten else params,
+        theta,
+        n_samples=FURNACE_SAMPLES,
+        hemisphere="both",
+        dtype=dtype,
     )
     mean, err = curve.albedo, curve.stderr
     report.cases += len(theta)
@@ -393,7 +404,30 @@ def check_model(
                 name_ = np.dtype(dtype).name
                 case = f"{label}; {name_}: {type(exc).__name__}: {exc}"
                 report._count(name_, "exception", 1, Finding("exception", case))
+    for label, params in furnace_cases(name):
+        for dtype in DTYPES:
+            with np.errstate(all="ignore"):
+                _sweep_energy(report, model, label, params, dtype, whiten=False)
     return report
+
+
+def furnace_cases(name: str) -> list[tuple[str, Any]]:
+    """Extra furnace inputs (already white) for a model whose own inputs need not
+    conserve energy.
+
+    Composited Pixar lobe weights partition energy only as compositing produces them, so
+    ``pixar_layered`` is put in the furnace with the weights of every plausible Pixar
+    parameter case made white (what a one-layer stack composites to), not with arbitrary
+    weights (twelve white weights would reflect several times the light).
+    """
+    if name != "pixar_layered":
+        return []
+    from lookdev.materials.pixar import PixarParams, as_lobe_weights
+
+    cases = parameter_cases(PixarParams)
+    return [
+        (f"weights of {label}", as_lobe_weights(_white(p))) for label, p in cases if _plausible(p)
+    ]
 
 
 def run(
