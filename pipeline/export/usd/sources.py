@@ -109,12 +109,15 @@ def weights_source(material: Any, blended, texture_dir: Path) -> Source:
 
     Derived quantities (:func:`.pixar.from_weights`) are computed on the blend's arrays
     and written by the exporter beside the file; a quantity varies if any weight behind
-    it does. The refraction IOR is not blended (weights carry none): the default is used.
+    it does. The refraction IOR is the blend's (the uppermost present layer's per texel),
+    averaged over the material: the networks carry one IOR.
     """
     from .pixar import from_weights
 
     arrays = {k: np.asarray(v) for k, v in {**blended.constants, **blended.maps}.items()}
-    values: dict[str, Any] = {"eta": DEFAULTS["pixar_weights"]["eta"]}
+    ior = arrays.pop("ior", None)
+    eta = DEFAULTS["pixar_weights"]["eta"] if ior is None else float(np.mean(ior))
+    values: dict[str, Any] = {"eta": eta}
     maps: dict[str, Image] = {}
     for name, value in from_weights(arrays).items():
         if np.ndim(value) >= 2:
