@@ -70,42 +70,38 @@ def _directions(*vs: Any, dtype: Any) -> tuple[list[np.ndarray], tuple[int, ...]
     return out, lead
 
 
+def _call(core: Callable[..., Any], model: Model, params: Any, a: Any, b: Any, dtype, maps):
+    """Run one core function on user arrays: (its result, element count N, leading shape)."""
+    xp = NumpyOps(dtype)
+    (a_, b_), lead = _directions(a, b, dtype=dtype)
+    with np.errstate(all="ignore"):
+        prepared = model.prepare(xp, params, **_flatten_maps(maps, lead, dtype))
+        return core(xp, prepared, a_, b_), a_.shape[1], lead
+
+
+def _out(x: Any, n: int, lead: tuple[int, ...], colour: bool) -> np.ndarray:
+    return from_channel_first(np.broadcast_to(x, (3, n) if colour else (n,)), lead)
+
+
 def evaluate(
     model: Model, params: Any, wi: Any, wo: Any, *, dtype: Any = np.float64, **maps: Any
 ) -> np.ndarray:
     """f(wi, wo) without the cosine, shape (..., 3)."""
-    xp = NumpyOps(dtype)
-    (wi_, wo_), lead = _directions(wi, wo, dtype=dtype)
-    with np.errstate(all="ignore"):
-        prepared = model.prepare(xp, params, **_flatten_maps(maps, lead, dtype))
-        f = model.eval(xp, prepared, wi_, wo_)
-    return from_channel_first(np.broadcast_to(f, (3, wi_.shape[1])), lead)
+    f, n, lead = _call(model.eval, model, params, wi, wo, dtype, maps)
+    return _out(f, n, lead, colour=True)
 
 
 def density(
     model: Model, params: Any, wi: Any, wo: Any, *, dtype: Any = np.float64, **maps: Any
 ) -> np.ndarray:
     """pdf of sampling wi given wo (solid angle), shape (...)."""
-    xp = NumpyOps(dtype)
-    (wi_, wo_), lead = _directions(wi, wo, dtype=dtype)
-    with np.errstate(all="ignore"):
-        prepared = model.prepare(xp, params, **_flatten_maps(maps, lead, dtype))
-        p = model.pdf(xp, prepared, wi_, wo_)
-    return from_channel_first(np.broadcast_to(p, (wi_.shape[1],)), lead)
+    p, n, lead = _call(model.pdf, model, params, wi, wo, dtype, maps)
+    return _out(p, n, lead, colour=False)
 
 
 def draw(
     model: Model, params: Any, wo: Any, u: Any, *, dtype: Any = np.float64, **maps: Any
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Sample wi given wo and uniforms u of shape (..., 3): (wi, weight, pdf)."""
-    xp = NumpyOps(dtype)
-    (wo_, u_), lead = _directions(wo, u, dtype=dtype)
-    n = wo_.shape[1]
-    with np.errstate(all="ignore"):
-        prepared = model.prepare(xp, params, **_flatten_maps(maps, lead, dtype))
-        wi, weight, pdf = model.sample(xp, prepared, wo_, u_)
-    return (
-        from_channel_first(np.broadcast_to(wi, (3, n)), lead),
-        from_channel_first(np.broadcast_to(weight, (3, n)), lead),
-        from_channel_first(np.broadcast_to(pdf, (n,)), lead),
-    )
+    (wi, weight, pdf), n, lead = _call(model.sample, model, params, wo, u, dtype, maps)
+    return _out(wi, n, lead, True), _out(weight, n, lead, True), _out(pdf, n, lead, False)
