@@ -151,8 +151,8 @@ PREVIEW_DISNEY: tuple[Slot, ...] = (
     ),
 )
 
-# MaterialX 1.39 ND_disney_principled (libraries/bxdf/disney_principled.mtlx).
-MTLX_DISNEY: tuple[Slot, ...] = (
+# Burley's parameters under their camelCase names, as both Disney targets spell them.
+_BURLEY_CAMEL: tuple[Slot, ...] = (
     Slot("base_color", "baseColor", "color3f"),
     Slot("metallic", "metallic", "float"),
     Slot("roughness", "roughness", "float"),
@@ -165,44 +165,35 @@ MTLX_DISNEY: tuple[Slot, ...] = (
     Slot("clearcoat_gloss", "clearcoatGloss", "float", lobe="clearcoat"),
     Slot("spec_trans", "specTrans", "float", lobe="spec_trans"),
     Slot("ior", "ior", "float", lobe="spec_trans"),
-    Slot("subsurface", "subsurface", "float", lobe="subsurface"),
-    Slot(
+)
+
+
+def _scatter(target_name: str) -> Slot:
+    return Slot(
         "scatter_distance",
-        "subsurfaceDistance",
+        target_name,
         "color3f",
         lobe="scatter",
         to_target=_grey,
         from_target=_mean,
         texture_linear=None,
-    ),
+    )
+
+
+# MaterialX 1.39 ND_disney_principled (libraries/bxdf/disney_principled.mtlx).
+MTLX_DISNEY: tuple[Slot, ...] = (
+    *_BURLEY_CAMEL,
+    Slot("subsurface", "subsurface", "float", lobe="subsurface"),
+    _scatter("subsurfaceDistance"),
 )
 
 # RenderMan PxrDisneyBsdf: Schutte's 2015 parameter set under camelCase names.
 RI_DISNEY: tuple[Slot, ...] = (
-    Slot("base_color", "baseColor", "color3f"),
-    Slot("metallic", "metallic", "float"),
-    Slot("roughness", "roughness", "float"),
-    Slot("anisotropic", "anisotropic", "float", lobe="specular"),
-    Slot("specular", "specular", "float", lobe="dielectric"),
-    Slot("specular_tint", "specularTint", "float", lobe="dielectric"),
-    Slot("sheen", "sheen", "float", lobe="sheen"),
-    Slot("sheen_tint", "sheenTint", "float", lobe="sheen"),
-    Slot("clearcoat", "clearcoat", "float", lobe="clearcoat"),
-    Slot("clearcoat_gloss", "clearcoatGloss", "float", lobe="clearcoat"),
-    Slot("spec_trans", "specTrans", "float", lobe="spec_trans"),
-    Slot("ior", "ior", "float", lobe="spec_trans"),
+    *_BURLEY_CAMEL,
     Slot("diff_trans", "diffTrans", "float", lobe="diff_trans"),
     Slot("subsurface", "subsurface", "float", lobe="subsurface"),
     Slot("flatness", "flatness", "float", lobe="flatness"),
-    Slot(
-        "scatter_distance",
-        "scatterDistance",
-        "color3f",
-        lobe="scatter",
-        to_target=_grey,
-        from_target=_mean,
-        texture_linear=None,
-    ),
+    _scatter("scatterDistance"),
     Slot("thin", "thin", "int", lobe="thin", to_target=_flag, from_target=bool),
 )
 
