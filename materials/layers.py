@@ -46,7 +46,9 @@ class ConstantMask(Params):
     """The same coverage everywhere."""
 
     kind: Literal["constant"] = "constant"
-    value: float = Field(1.0, ge=0.0, le=1.0, description="Coverage, 0 (absent) .. 1 (full).")
+    value: float = Field(
+        1.0, strict=True, ge=0.0, le=1.0, description="Coverage, 0 (absent) .. 1 (full)."
+    )
 
 
 class TextureMask(Params):
@@ -63,7 +65,7 @@ class TextureMask(Params):
     channel: int | str = Field(
         0, description="Channel index from 0, or its name ('R', 'G', 'B', 'A', 'Y', 'mask.R')."
     )
-    invert: bool = Field(False, description="Use 1 - value.")
+    invert: bool = Field(False, strict=True, description="Use 1 - value.")
     uv_scale: tuple[float, float] = Field((1.0, 1.0), description="Repeats across the UV square.")
     uv_offset: tuple[float, float] = Field((0.0, 0.0), description="Shift in UV, after scaling.")
     wrap: Wrap = Field("periodic", description="Lookup outside 0..1: periodic|clamp|black|mirror.")
@@ -83,11 +85,17 @@ class NoiseMask(Params):
     """
 
     kind: Literal["noise"] = "noise"
-    scale: float = Field(4.0, gt=0.0, le=4096.0, description="Lattice cells of the first octave.")
-    octaves: int = Field(4, ge=1, le=16, description="Number of octaves summed.")
-    seed: int = Field(0, ge=0, description="Any non-negative integer; same seed, same mask.")
-    lacunarity: float = Field(2.0, ge=1.0, le=8.0, description="Frequency ratio of octaves.")
-    gain: float = Field(0.5, ge=0.0, le=1.0, description="Amplitude ratio of octaves.")
+    scale: float = Field(
+        4.0, strict=True, gt=0.0, le=4096.0, description="Lattice cells of the first octave."
+    )
+    octaves: int = Field(4, strict=True, ge=1, le=16, description="Number of octaves summed.")
+    seed: int = Field(
+        0, strict=True, ge=0, description="Any non-negative integer; same seed, same mask."
+    )
+    lacunarity: float = Field(
+        2.0, strict=True, ge=1.0, le=8.0, description="Frequency ratio of octaves."
+    )
+    gain: float = Field(0.5, strict=True, ge=0.0, le=1.0, description="Amplitude ratio of octaves.")
 
 
 class RampMask(Params):
@@ -95,8 +103,10 @@ class RampMask(Params):
 
     kind: Literal["ramp"] = "ramp"
     axis: Literal["u", "v", "radial"] = Field("u", description="Direction of the gradient.")
-    start: float = Field(0.0, description="Coordinate where the ramp is 0.")
-    end: float = Field(1.0, description="Coordinate where the ramp is 1 (radial: radius).")
+    start: float = Field(0.0, strict=True, description="Coordinate where the ramp is 0.")
+    end: float = Field(
+        1.0, strict=True, description="Coordinate where the ramp is 1 (radial: radius)."
+    )
     interpolation: Literal["linear", "smooth"] = Field(
         "linear", description="Linear, or smoothstep (C1 at both ends)."
     )
@@ -131,12 +141,16 @@ class LevelsMask(Params):
 
     kind: Literal["levels"] = "levels"
     input: Mask
-    low: float = Field(0.0, ge=0.0, le=1.0, description="Input black point.")
-    high: float = Field(1.0, ge=0.0, le=1.0, description="Input white point.")
-    gamma: float = Field(1.0, gt=0.0, le=10.0, description="Midtone gamma; >1 brightens.")
-    contrast: float = Field(1.0, ge=0.0, le=100.0, description="Slope about 0.5; 1 is neutral.")
-    out_low: float = Field(0.0, ge=0.0, le=1.0, description="Output black point.")
-    out_high: float = Field(1.0, ge=0.0, le=1.0, description="Output white point.")
+    low: float = Field(0.0, strict=True, ge=0.0, le=1.0, description="Input black point.")
+    high: float = Field(1.0, strict=True, ge=0.0, le=1.0, description="Input white point.")
+    gamma: float = Field(
+        1.0, strict=True, gt=0.0, le=10.0, description="Midtone gamma; >1 brightens."
+    )
+    contrast: float = Field(
+        1.0, strict=True, ge=0.0, le=100.0, description="Slope about 0.5; 1 is neutral."
+    )
+    out_low: float = Field(0.0, strict=True, ge=0.0, le=1.0, description="Output black point.")
+    out_high: float = Field(1.0, strict=True, ge=0.0, le=1.0, description="Output white point.")
 
     @model_validator(mode="after")
     def _low_below_high(self) -> LevelsMask:
@@ -168,7 +182,9 @@ class LayerSpec(Params):
     model: Literal["disney", "pixar"] | None = Field(None, description="Model of inline params.")
     params: dict[str, Any] = Field(default_factory=dict, description="Inline params/overrides.")
     mask: Mask = Field(default_factory=ConstantMask, description="Where the layer shows.")
-    presence: float = Field(1.0, ge=0.0, le=1.0, description="Pixar layer presence (opacity).")
+    presence: float = Field(
+        1.0, strict=True, ge=0.0, le=1.0, description="Pixar layer presence (opacity)."
+    )
     normal_map: TextureMask | None = Field(None, description="Tangent-space normal map.")
     specular_normal_map: TextureMask | None = Field(
         None, description="Separate normal for the specular lobes (Burley §6)."

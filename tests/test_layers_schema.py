@@ -145,3 +145,19 @@ def test_every_builtin_layered_preset_validates():
     for path in files:
         for entry in tomllib.loads(path.read_text())["layers"]:
             LayerSpec.parse(entry, where=str(path))
+
+
+@pytest.mark.parametrize(
+    "entry, field",
+    [
+        ({"preset": "gold", "presence": "0.5"}, "presence"),
+        ({"preset": "gold", "mask": {"kind": "constant", "value": True}}, "value"),
+        ({"preset": "gold", "mask": {"kind": "noise", "octaves": 4.5}}, "octaves"),
+        ({"preset": "gold", "mask": {"kind": "texture", "path": "m.png", "invert": 1}}, "invert"),
+    ],
+)
+def test_scalar_fields_take_their_toml_type_only(entry, field):
+    # TOML is typed: a quoted number or a 1 for true is a typo, not a value to coerce.
+    with pytest.raises(ParameterError) as info:
+        LayerSpec.parse(entry)
+    assert field in str(info.value) and "\n" not in str(info.value)
