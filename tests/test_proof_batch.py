@@ -83,27 +83,41 @@ def test_frames_after_the_first_reuse_every_compiled_kernel(mitsuba):
     assert jit and all(k["cache_hit"] for k in jit)
 
 
-def test_another_ibl_of_the_same_size_reuses_the_compiled_kernels(mitsuba):
-    """Why a batch brings IBLs to one size and folds exposure into pixels (DESIGN.md)."""
-    import gc
+_KERNEL_REUSE = """
+import gc, sys
+import drjit as dr
+from lookdev.pipeline.variant import use_mitsuba
+use_mitsuba()
+from lookdev.pipeline.proof import ibl, turntable
+DIFFUSE = {"type": "diffuse", "reflectance": {"type": "rgb", "value": 0.5}}
+frame = turntable.Frame(0, "element", 0.0)
+first = turntable.Turntable(DIFFUSE, ibl.load("studio", 64).pixels, (32, 16), 3)
+turntable.render_frame(first, frame, 4)
+del first  # a job's scene is gone before the next job's (Dr.Jit reuses its slots)
+gc.collect()
+dr.set_flag(dr.JitFlag.KernelHistory, True)
+dr.kernel_history()
+brighter = ibl.load("overcast", 64, exposure=1.5).pixels
+second = turntable.Turntable(DIFFUSE, brighter, (32, 16), 3)
+turntable.render_frame(second, frame, 4)
+jit = [k for k in dr.kernel_history() if str(k["type"]).endswith("JIT")]
+sys.exit(0 if jit and all(k["cache_hit"] for k in jit) else 1)
+"""
 
-    import drjit as dr
 
-    frame = turntable.Frame(0, "element", 0.0)
-    first = turntable.Turntable(DIFFUSE, ibl.load("studio", 64).pixels, (32, 16), 3)
-    turntable.render_frame(first, frame, 4)
-    del first  # a job's scene is gone before the next job's (Dr.Jit reuses its slots)
-    gc.collect()
-    dr.set_flag(dr.JitFlag.KernelHistory, True)
-    try:
-        dr.kernel_history()
-        brighter = ibl.load("overcast", 64, exposure=1.5).pixels
-        second = turntable.Turntable(DIFFUSE, brighter, (32, 16), 3)
-        turntable.render_frame(second, frame, 4)
-        jit = [k for k in dr.kernel_history() if str(k["type"]).endswith("JIT")]
-    finally:
-        dr.set_flag(dr.JitFlag.KernelHistory, False)
-    assert jit and all(k["cache_hit"] for k in jit)
+def test_another_ibl_of_the_same_size_reuses_the_compiled_kernels(tmp_path):
+    """Why a batch brings IBLs to one size and folds exposure into pixels (DESIGN.md).
+
+    In a fresh process: scenes other tests keep alive in this one would be traced into
+    the render too and change its kernels.
+    """
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "LOOKDEV_CACHE": str(tmp_path)}
+    done = subprocess.run([sys.executable, "-c", _KERNEL_REUSE], env=env, timeout=300)
+    assert done.returncode == 0
 
 
 def test_half_sample_noise_estimate_matches_the_true_error(mitsuba):
