@@ -107,7 +107,7 @@ def time_bare(bsdf: dict, depth: int, env: Any, s: Settings) -> Timing:
     for f in _frames(s.frames):
         table.set_frame(f)
         with Clock() as clock:
-            np.array(mi.render(table.scene, spp=s.spp, seed=f.index))
+            np.array(mi.render(table.scene, sensor=table.camera_index, spp=s.spp, seed=f.index))
         total += clock.timing
     return total
 
