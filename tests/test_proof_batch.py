@@ -83,6 +83,22 @@ def test_frames_after_the_first_reuse_every_compiled_kernel(mitsuba):
     assert jit and all(k["cache_hit"] for k in jit)
 
 
+def test_frozen_frames_equal_plain_renders_and_stop_recording(mitsuba):
+    """The frozen launch (dr.freeze) replays exactly what mi.render computes, and records
+    only while the scene's first poses settle which of its values are literals, never
+    once per frame: each frame's seed is an input of the recording, not part of its key."""
+    table = _table(mitsuba)
+    counts = []
+    for _ in range(2):
+        for frame in turntable.frames(3, 3):
+            table.set_frame(frame)
+            frozen = table.render(4, seed=frame.index)
+            plain = mitsuba.render(table.scene, sensor=table.camera_index, spp=4, seed=frame.index)
+            assert frozen == pytest.approx(np.array(plain)[..., :3], abs=1e-6)
+            counts.append(table.recordings)
+    assert counts[-1] <= 3 and counts[-1] == counts[len(counts) // 2 - 1]
+
+
 _KERNEL_REUSE = """
 import gc, sys
 import drjit as dr

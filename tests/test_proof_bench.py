@@ -25,6 +25,24 @@ def test_bench_proof_quick_json_reports_every_measurement(cli, tmp_path, monkeyp
         assert t[f"{prefix}overhead_vs_bare"] == pytest.approx(overhead)
     assert p["all_lobes"]["cpu_s"] > 0 and p["pruned"]["noise_relative"] > 0
     assert doc["settings"]["frames"] == 4
+    # the floor: kernel run time from Dr.Jit's history bounds every speed-up
+    assert 0 < t["kernels_s"] and t["bound_vs_naive"] == pytest.approx(
+        t["naive_rebuild"]["wall_s"] / t["kernels_s"]
+    )
+    rows = doc["by_frame_size"]
+    assert [r["resolution"] for r in rows] == [[16, 8], [32, 16]]  # the sweep, then the main
+    assert [r["samples_per_frame"] for r in rows] == [16 * 8 * 2, 32 * 16 * 4]
+    assert rows[-1]["speedup_vs_naive"] == t["speedup_vs_naive"]
+    met = [r["samples_per_frame"] for r in rows if r["speedup_vs_naive"] >= 3]
+    assert doc["speedup_target_met_up_to_samples_per_frame"] == max(met, default=None)
+
+
+def test_bench_proof_table_names_the_floor_and_the_frame_sizes(cli, tmp_path, monkeypatch):
+    monkeypatch.setenv("LOOKDEV_CACHE", str(tmp_path))
+    r = cli("bench", "proof", "--quick", "--repeat", "1", "--preset", "gold")
+    assert r.code == 0, r.err
+    assert "render kernels alone" in r.out and "by frame size" in r.out
+    assert "no pipeline can be more than" in r.out and "3× target is met" in r.out
 
 
 def test_interleaved_keeps_each_cases_fastest_round():

@@ -4,6 +4,9 @@ Burley 2012 §6.1: "all turntables include both element and lighting rotations".
 is loaded once; every frame only updates scene parameters through ``mi.traverse`` (the
 ``to_world`` of the ball's and the cup's instances and of the envmap),
 so Mitsuba reuses the kernels it compiled for the first frame (DESIGN.md, Proofing).
+Renders are also frozen (``dr.freeze``): after the first frames are recorded, a frame
+replays the recorded kernel launches instead of tracing the integrator and our Python
+BSDF plugins again, which is most of a small frame's fixed cost.
 
 Each frame is rendered as two independent half-sample images: their mean is the frame
 and their difference estimates its noise (the variance of a mean of two independent
@@ -83,6 +86,7 @@ class Turntable:
         self.camera_index = widths.index(self.width)
         self.params = mi.traverse(self.scene)
         self._pose = (0.0, 0.0)  # (element, light) angles the scene is posed at
+        self._launch = _frozen(_render_call)
 
     def set_frame(self, frame: Frame) -> None:
         """Pose the element and the lighting for ``frame``, pushing only what changed.
@@ -102,21 +106,42 @@ class Turntable:
         self._pose = (element, light)
         self.params.update()
 
+    @property
+    def recordings(self) -> int:
+        """How many times the frozen launch was traced and recorded (0 when not frozen)."""
+        return getattr(self._launch, "n_recordings", 0)
+
     def render(self, spp: int, seed: int) -> np.ndarray:
         """One image (H, W, 3) float32 at the current pose."""
-        import mitsuba as mi
-
-        image = mi.render(self.scene, sensor=self.camera_index, spp=spp, seed=seed)
-        return np.array(image, dtype=np.float32)[..., :3]
+        return self._image(self.camera_index, spp, seed)
 
     def render_halves(self, spp: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
         """Two independent images of ``spp`` samples each at the current pose, rendered
         side by side by one ``mi.render`` call (a second call cost ~10 % per frame)."""
+        pair = self._image(self.pair_index, spp, seed)
+        return pair[:, : self.width], pair[:, self.width :]
+
+    def _image(self, sensor: int, spp: int, seed: int) -> np.ndarray:
         import mitsuba as mi
 
-        image = mi.render(self.scene, sensor=self.pair_index, spp=spp, seed=seed)
-        pair = np.array(image, dtype=np.float32)[..., :3]
-        return pair[:, : self.width], pair[:, self.width :]
+        # The seed goes in as a JIT value: a Python int would be part of the recording's
+        # key and every frame (each its own seed) would record anew.
+        image = self._launch(self.scene, sensor, spp, mi.UInt32(seed))
+        return np.array(image, dtype=np.float32)[..., :3]
+
+
+def _render_call(scene: Any, sensor: int, spp: int, seed: Any) -> Any:
+    import mitsuba as mi
+
+    return mi.render(scene, sensor=sensor, spp=spp, seed=seed)
+
+
+def _frozen(fn: Any) -> Any:
+    """``fn`` frozen with ``dr.freeze`` on a JIT variant; as it is on a scalar one."""
+    import drjit as dr
+    import mitsuba as mi
+
+    return dr.freeze(fn) if dr.is_jit_v(mi.Float) else fn
 
 
 def _sensor_pair(camera: dict[str, Any]) -> dict[str, Any]:
