@@ -112,11 +112,21 @@ def test_plain_diffuse_has_no_clearcoat_sheen_or_transmission(tmp_path):
     assert attrs["/Materials/plaster/ri_surface"] == [
         "info:id",
         "inputs:baseColor",
+        "inputs:ior",
         "inputs:roughness",
-        "inputs:specular",
         "outputs:bxdf_out",
     ]
     assert sum(len(v) for v in attrs.values()) == 3 + 4 + 4 + 5  # material outputs + shaders
+
+
+@pytest.mark.parametrize("specular", [0.0, 0.3, 0.5, 2.0])
+def test_renderman_disney_takes_f0_as_ior(tmp_path, specular):
+    """PxrDisneyBsdf has no ``specular`` (Burley 2015): the same F0 goes in as ``ior``."""
+    stage = _export(tmp_path, {"specular": specular})
+    surface = stage.GetPrimAtPath("/Materials/m/ri_surface")
+    assert not surface.GetAttribute("inputs:specular").IsAuthored()
+    ior = surface.GetAttribute("inputs:ior").Get()
+    assert ((ior - 1) / (ior + 1)) ** 2 == pytest.approx(0.08 * specular, rel=1e-5, abs=1e-9)
 
 
 @pytest.mark.parametrize("clearcoat, written", [(0.0, False), (1e-6, True), (4.0, True)])

@@ -187,9 +187,13 @@ MTLX_DISNEY: tuple[Slot, ...] = (
     _scatter("subsurfaceDistance"),
 )
 
-# RenderMan PxrDisneyBsdf: Schutte's 2015 parameter set under camelCase names.
+# RenderMan PxrDisneyBsdf: Schutte's 2015 parameter set under camelCase names. Like
+# Burley 2015 it has no `specular`: its dielectric F0 follows `ior` for reflection and
+# refraction alike (RenderMan 24 docs, PxrDisneyBsdf, "Specular Reflect Scale"), so
+# Burley 2012's specular reaches it as the IOR of the same F0 (§5.4).
 RI_DISNEY: tuple[Slot, ...] = (
-    *_BURLEY_CAMEL,
+    *(s for s in _BURLEY_CAMEL if s.param not in ("specular", "ior")),
+    Slot("ior", "ior", "float", lobe="dielectric"),
     Slot("diff_trans", "diffTrans", "float", lobe="diff_trans"),
     Slot("subsurface", "subsurface", "float", lobe="subsurface"),
     Slot("flatness", "flatness", "float", lobe="flatness"),
