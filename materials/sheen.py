@@ -175,7 +175,22 @@ def _gather(xp: Any, flat: np.ndarray, index: Any) -> Any:
     if isinstance(index, int | float):  # Mitsuba's scalar_rgb: its Float is Python's float
         return float(flat[int(index)])
     dr = xp.dr
-    return dr.gather(xp.Float, xp.Float(flat), dr.uint32_array_t(xp.Float)(index))
+    return dr.gather(xp.Float, _on_device(xp.Float, flat), dr.uint32_array_t(xp.Float)(index))
+
+
+_DEVICE_TABLES: dict[tuple[type, int], Any] = {}
+
+
+def _on_device(float_type: type, flat: np.ndarray) -> Any:
+    """``flat`` as a Dr.Jit array, copied once per array type and table.
+
+    Copying in the render (4 copies a lookup) cost a host-to-device transfer per call and
+    made renders impossible to freeze (``dr.freeze`` cannot record a host copy).
+    """
+    key = (float_type, hash(flat.tobytes()))
+    if key not in _DEVICE_TABLES:
+        _DEVICE_TABLES[key] = float_type(flat)
+    return _DEVICE_TABLES[key]
 
 
 def interpolate(xp: Any, table: np.ndarray, cos_theta: Any, r: Any) -> Any:
