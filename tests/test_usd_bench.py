@@ -27,3 +27,47 @@ def test_bench_usd_table_for_people(cli):
     result = cli("bench", "usd", "-n", "5", "--repeat", "1")
     assert result.code == 0, result.err
     assert "ratio_fast_to_naive" in result.out and "materials" in result.out
+
+
+def test_the_floor_creates_exactly_the_specs_the_exporter_authors():
+    """The floor is only a bound if it makes the same specs as the fast path, all of them."""
+    from pathlib import Path
+
+    from lookdev.pipeline.analysis.bench_usd import (
+        author_fast,
+        author_floor,
+        bench_specs,
+        spec_paths,
+    )
+
+    specs = bench_specs(12)
+
+    def every_path(layer) -> set[str]:
+        found: set[str] = set()
+
+        def visit(path) -> None:
+            if path.IsPrimPath() or path.IsPrimPropertyPath():  # not connection targets
+                found.add(str(path))
+
+        layer.Traverse(layer.pseudoRoot.path, visit)
+        return found
+
+    fast = author_fast(specs, Path.cwd())
+    floor = author_floor(*spec_paths(specs))
+    assert every_path(floor) == every_path(fast)
+    fast_types = {
+        str(p): str(fast.GetAttributeAtPath(p).typeName) for p, _, _ in spec_paths(specs)[1]
+    }
+    floor_types = {
+        str(p): str(floor.GetAttributeAtPath(p).typeName) for p, _, _ in spec_paths(specs)[1]
+    }
+    assert floor_types == fast_types
+
+
+def test_bench_usd_reports_the_floor_and_its_bound(cli):
+    result = cli("bench", "usd", "--materials", "10", "--repeat", "1", "--json")
+    data = json.loads(result.out)
+    assert data["floor_empty_specs_s"] > 0
+    assert data["ratio_bound"] == pytest.approx(data["naive_s"] / data["floor_empty_specs_s"])
+    people = cli("bench", "usd", "-n", "5", "--repeat", "1")
+    assert "target ≥ 5×" in people.out

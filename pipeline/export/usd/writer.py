@@ -102,31 +102,47 @@ def author(layer, specs: list[MaterialSpec], base: Path) -> list[str]:
         scope.specifier = Sdf.SpecifierDef
         scope.typeName = "Scope"
         for spec in specs:
-            paths.append(str(_author_material(scope, spec, base, types).path))
+            paths.append(str(_author_material(layer, scope, spec, base, types)))
     return paths
 
 
-def _author_material(scope, spec: MaterialSpec, base: Path, types: dict[str, Any]):
+# Attributes are made by Sdf.JustCreatePrimAttributeInLayer and set through the layer,
+# not by constructing Sdf.AttributeSpec objects (≈ 3 µs an attribute instead of ≈ 6),
+# and connections are assigned as a list instead of appended through the list proxy
+# (≈ 2 µs instead of ≈ 4.5): usd-core 0.26, measured in lookdev bench usd.
+
+
+def _author_material(layer, scope, spec: MaterialSpec, base: Path, types: dict[str, Any]):
     prim = Sdf.PrimSpec(scope, prim_name(spec.name), Sdf.SpecifierDef, "Material")
     prim.customData = {"lookdev": dict(spec.custom)}
+    path = prim.path
     for net in spec.networks:
-        out = Sdf.AttributeSpec(prim, f"outputs:{CONTEXT_OUTPUT[net.context]}", types["token"])
-        out.connectionPathList.explicitItems.append(_output_path(prim.path, net.terminal))
+        output = path.AppendProperty(f"outputs:{CONTEXT_OUTPUT[net.context]}")
+        _attribute(layer, output, types["token"]).connectionPathList.explicitItems = [
+            _output_path(path, net.terminal)
+        ]
         for node in net.nodes:
             shader = Sdf.PrimSpec(prim, node.name, Sdf.SpecifierDef, "Shader")
             if any(node.custom.values()):
                 shader.customData = {"lookdev": {k: v for k, v in node.custom.items() if v}}
-            ident = Sdf.AttributeSpec(shader, "info:id", types["token"], Sdf.VariabilityUniform)
-            ident.default = node.id
+            at = shader.path.AppendProperty
+            ident = at("info:id")
+            _attribute(layer, ident, types["token"], Sdf.VariabilityUniform).default = node.id
             for name, (kind, value) in node.inputs.items():
-                attr = Sdf.AttributeSpec(shader, f"inputs:{name}", types[kind])
+                attr = _attribute(layer, at(f"inputs:{name}"), types[kind])
                 if isinstance(value, Connection):
-                    attr.connectionPathList.explicitItems.append(_output_path(prim.path, value))
+                    attr.connectionPathList.explicitItems = [_output_path(path, value)]
                 else:
                     attr.default = usd_value(kind, value, base)
             for name, kind in node.outputs.items():
-                Sdf.AttributeSpec(shader, f"outputs:{name}", types[kind])
-    return prim
+                Sdf.JustCreatePrimAttributeInLayer(layer, at(f"outputs:{name}"), types[kind])
+    return path
+
+
+def _attribute(layer, path, type_name, variability=Sdf.VariabilityVarying):
+    """A new attribute spec at ``path`` (its prim exists), for setting a value on."""
+    Sdf.JustCreatePrimAttributeInLayer(layer, path, type_name, variability)
+    return layer.GetAttributeAtPath(path)
 
 
 def _output_path(material_path, conn: Connection):
