@@ -26,7 +26,7 @@ Two models share these lobes. :data:`MODEL` takes Smits' parameters
 two ends of the view, cones, falloffs and IOR (:data:`PixarLobeWeights`), which is what
 compositing a layered stack produces (:mod:`lookdev.pipeline.blend.pixar`). The first
 is the second after one step: parameters → weights → the same prepared dict
-(:func:`_prepared`), so a one-layer stack renders as its preset.
+(:func:`.pixar_scatter.prepared`), so a one-layer stack renders as its preset.
 
 >>> w = lobe_weights(PixarParams(surface_color=1.0, metallic=0.0, roughness=0.0))
 >>> round(float(w["diffN"][0]), 6), float(w["diffG"][0])  # Smits' printed 0.9025 check
@@ -45,14 +45,13 @@ from .arrays import NumpyOps
 from .bsdf import Model, density, draw, evaluate
 from .params import Color, Params, parse_color, register_schema
 from .pixar_lobes import LN_10
+from .pixar_scatter import at_view, prepared, scatter_eval, scatter_pdf, scatter_sample
 
 DIELECTRIC_REFL = 0.05  # Smits' default normal reflectance of a dielectric
 
 WEIGHT_NAMES = (
     "diffN diffG specN specG reflN reflG diffTN diffTG specTN specTG reflTN reflTG".split()
 )
-LOBES = ("diffuse", "specular", "reflection", "diffuse_t", "specular_t", "reflection_t")
-_PREFIX = dict(zip(LOBES, ("diff", "spec", "refl", "diffT", "specT", "reflT"), strict=True))
 
 
 def _scale(description: str, le: float | None = None) -> Any:
@@ -238,48 +237,24 @@ def ends(xp: Any, w: dict[str, Any]) -> dict[str, tuple[Any, Any]]:
     return out
 
 
-def at_view(xp: Any, pairs: dict[str, tuple[Any, Any]], cos_view: Any) -> dict[str, Any]:
-    """The twelve weights for a view at ``cos_view`` from their two ends (:func:`ends`):
-    (1 − s) W(s=0) + s W(s=1) with s = (1 − V·n)⁵, exact at both ends."""
-    s = lobes.schlick_weight(xp, cos_view)
-    return {k: n if g is None else n * (1.0 - s) + g * s for k, (n, g) in pairs.items()}
-
-
 def weights(xp: Any, w: dict[str, Any], cos_view: Any) -> dict[str, Any]:
     """Smits' twelve weights for a view at ``cos_view`` from :func:`view_independent`."""
     return at_view(xp, ends(xp, w), cos_view)
 
 
-def _kept_lobes(xp: Any, pairs: dict[str, tuple[Any, Any]]) -> tuple[str, ...]:
-    """Lobes whose weights are not known to be zero (DESIGN.md: nothing unneeded)."""
-    kept = []
-    for lobe in LOBES:
-        values = [v for end in "NG" for v in pairs[_PREFIX[lobe] + end] if v is not None]
-        if not all(xp.known_zero(v) for v in values):
-            kept.append(lobe)
-    return tuple(kept)
-
-
-# -- the Model -----------------------------------------------------------------------------
-def _prepared(xp: Any, pairs: dict, powers: dict[str, Any], eta: Any) -> dict[str, Any]:
-    """What eval/pdf/sample consume, from the weights' two ends, each highlight lobe's
-    exponent and the IOR: the one path for plain and composited materials."""
-    return {"ends": pairs, "power": powers, "eta": eta, "lobes": _kept_lobes(xp, pairs)}
-
-
 def _prepare(xp: Any, params: PixarParams, **maps: Any) -> dict[str, Any]:
-    """Parameters → Smits' weights and exponents → :func:`_prepared`."""
+    """Parameters → Smits' weights and exponents → :func:`.pixar_scatter.prepared`."""
     v = _values(xp, params, maps)
     r = v["roughness"]
     p_s = lobes.power_specular(xp, r, v["specular_cone_scale"])
     p_r = lobes.power_reflection(xp, r, v["reflection_cone_scale"])
     powers = {"specular": p_s, "specular_t": p_s, "reflection": p_r, "reflection_t": p_r}
     eta = xp.scalar(maps.get("ior", params.eta))
-    return _prepared(xp, ends(xp, view_independent(xp, v)), powers, eta)
+    return prepared(xp, ends(xp, view_independent(xp, v)), powers, eta)
 
 
 def _prepare_weights(xp: Any, params: Any, **maps: Any) -> dict[str, Any]:
-    """Composited weights (:data:`PixarLobeWeights`) → :func:`_prepared`.
+    """Composited weights (:data:`PixarLobeWeights`) → :func:`.pixar_scatter.prepared`.
 
     Each weight is taken at the two view ends and interpolated in s = (1 − V·n)⁵
     (:func:`at_view`): exact at every view for a plain material and for simple layering
@@ -298,134 +273,18 @@ def _prepare_weights(xp: Any, params: Any, **maps: Any) -> dict[str, Any]:
     for lobe in CONE_LOBES:
         falloff = _scalar(xp, params, maps, f"{lobe}_falloff") if lobe in FALLOFF_LOBES else LN_10
         powers[lobe] = lobes.cone_power(xp, falloff, _scalar(xp, params, maps, f"{lobe}_cone"))
-    return _prepared(xp, pairs, powers, _scalar(xp, params, maps, "ior"))
+    return prepared(xp, pairs, powers, _scalar(xp, params, maps, "ior"))
 
 
 def _scalar(xp: Any, params: Any, maps: dict[str, Any], name: str) -> Any:
     return xp.scalar(maps.get(name, getattr(params, name)))
 
 
-def _upper(xp: Any, wi: Any, wo: Any) -> tuple[Any, Any]:
-    """Both directions with the view's side as +z (the surface is two-sided)."""
-    s = xp.select(wo[2] < 0.0, -1.0, 1.0)
-    return xp.vec3(wi[0], wi[1], wi[2] * s), xp.vec3(wo[0], wo[1], wo[2] * s)
-
-
-def _power(prep: dict[str, Any], lobe: str) -> Any:
-    return prep["power"][lobe]
-
-
-def _lobe_value(xp: Any, prep: dict[str, Any], w: dict, lobe: str, wi: Any, wo: Any) -> Any:
-    """One lobe's f(wi, wo) (colour), zero on the side it does not cover."""
-    p = _PREFIX[lobe]
-    n, g = w[p + "N"], w[p + "G"]
-    if lobe.endswith("_t"):
-        side = wi[2] < 0.0
-        if lobe == "diffuse_t":
-            f = lobes.frn_blend(xp, n, g, -wi[2]) * lobes.INV_PI
-        else:
-            # Blended by the view's incidence on the front, where the light crosses: the
-            # transmitted weights are the share the front Fresnel did not reflect.
-            back_i, back_o = lobes.to_back(xp, wi), lobes.back_view(xp, wo, prep["eta"])
-            f = lobes.p_specular(xp, back_i, back_o, _power(prep, lobe), n, g, wo[2])
-    else:
-        side = wi[2] > 0.0
-        if lobe == "diffuse":
-            f = lobes.frn_blend(xp, n, g, wi[2]) * lobes.INV_PI
-        else:
-            f = lobes.p_specular(xp, wi, wo, _power(prep, lobe), n, g)
-    return xp.select(side & (wo[2] > 0.0), f, 0.0)
-
-
-def _eval(xp: Any, prep: dict[str, Any], wi: Any, wo: Any) -> Any:
-    wi, wo = _upper(xp, wi, wo)
-    w = at_view(xp, prep["ends"], wo[2])
-    f = xp.zeros(wi[2]) * w["specN"]
-    for lobe in prep["lobes"]:
-        f = f + _lobe_value(xp, prep, w, lobe, wi, wo)
-    return f
-
-
-def _mean(c: Any) -> Any:
-    return (c[0] + c[1] + c[2]) * (1.0 / 3.0)
-
-
-def _selection(xp: Any, prep: dict[str, Any], wo: Any) -> dict[str, Any]:
-    """Probability of sampling each kept lobe: its estimated albedo at this view."""
-    w = at_view(xp, prep["ends"], wo[2])
-    est = {}
-    for lobe in prep["lobes"]:
-        n, g = w[_PREFIX[lobe] + "N"], w[_PREFIX[lobe] + "G"]
-        if lobe.startswith("diffuse"):
-            albedo = n + (g - n) / 21.0  # exact: ∫ 2(1 − μ)⁵ μ dμ = 1/21
-        else:
-            albedo = lobes.frn_blend(xp, n, g, wo[2])  # the highlight's weight at its peak
-        est[lobe] = _mean(albedo)
-    total = sum(est.values()) if est else 0.0
-    inv = xp.select(total > 0.0, 1.0 / xp.maximum(total, xp.tiny), 0.0)
-    return {lobe: e * inv for lobe, e in est.items()}
-
-
-def _lobe_pdf(xp: Any, prep: dict[str, Any], lobe: str, wi: Any, wo: Any) -> Any:
-    if lobe == "diffuse":
-        return xp.maximum(wi[2], 0.0) * lobes.INV_PI
-    if lobe == "diffuse_t":
-        return xp.maximum(-wi[2], 0.0) * lobes.INV_PI
-    if lobe.endswith("_t"):
-        back_i, back_o = lobes.to_back(xp, wi), lobes.back_view(xp, wo, prep["eta"])
-        pdf = lobes.half_vector_pdf(xp, back_i, back_o, _power(prep, lobe))
-        return xp.select(wi[2] < 0.0, pdf, 0.0)
-    return xp.select(wi[2] > 0.0, lobes.half_vector_pdf(xp, wi, wo, _power(prep, lobe)), 0.0)
-
-
-def _mixture_pdf(xp: Any, prep: dict[str, Any], wi: Any, wo: Any) -> Any:
-    probs = _selection(xp, prep, wo)
-    pdf = xp.zeros(wi[2])
-    for lobe, prob in probs.items():
-        pdf = pdf + prob * _lobe_pdf(xp, prep, lobe, wi, wo)
-    return xp.select(wo[2] > 0.0, pdf, 0.0)
-
-
-def _pdf(xp: Any, prep: dict[str, Any], wi: Any, wo: Any) -> Any:
-    wi, wo = _upper(xp, wi, wo)
-    return _mixture_pdf(xp, prep, wi, wo)
-
-
-def _candidate(xp: Any, prep: dict[str, Any], lobe: str, wo: Any, u1: Any, u2: Any) -> Any:
-    """The direction lobe ``lobe`` would sample (upper side = the view's side)."""
-    if lobe == "diffuse":
-        return lobes.cosine_hemisphere(xp, u1, u2)
-    if lobe == "diffuse_t":
-        return lobes.to_back(xp, lobes.cosine_hemisphere(xp, u1, u2))
-    h = lobes.sample_half_vector(xp, _power(prep, lobe), u1, u2)
-    if lobe.endswith("_t"):
-        view = lobes.back_view(xp, wo, prep["eta"])
-        return lobes.to_back(xp, lobes.reflect(xp, view, h))
-    return lobes.reflect(xp, wo, h)
-
-
-def _sample(xp: Any, prep: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any, Any]:
-    s = xp.select(wo[2] < 0.0, -1.0, 1.0)
-    wo = xp.vec3(wo[0], wo[1], wo[2] * s)
-    wi = xp.vec3(xp.zeros(u[0]), xp.zeros(u[0]), xp.zeros(u[0]) + 1.0)
-    transmitted = u[0] < 0.0  # all False: the chosen lobe's side, filled in below
-    cumulative = 0.0
-    for lobe, prob in _selection(xp, prep, wo).items():
-        chosen = (u[0] >= cumulative) & (u[0] < cumulative + prob)
-        cumulative = cumulative + prob
-        wi = xp.select(chosen, _candidate(xp, prep, lobe, wo, u[1], u[2]), wi)
-        if lobe.endswith("_t"):
-            transmitted = transmitted | chosen
-    # A highlight sample that leaves its own side failed (pdf 0), as in a renderer.
-    ok = (u[0] < cumulative) & xp.select(transmitted, wi[2] < 0.0, wi[2] > 0.0)
-    pdf = xp.select(ok, _mixture_pdf(xp, prep, wi, wo), 0.0)
-    f = _eval(xp, prep, wi, wo)
-    weight = f * xp.select(pdf > 0.0, xp.abs(wi[2]) / xp.maximum(pdf, xp.tiny), 0.0)
-    return xp.vec3(wi[0], wi[1], wi[2] * s), weight, pdf
-
-
-MODEL = Model("pixar", PixarParams, _prepare, _eval, _pdf, _sample)
-LAYERED_MODEL = Model("pixar_layered", PixarLobeWeights, _prepare_weights, _eval, _pdf, _sample)
+# -- the Model -----------------------------------------------------------------------------
+MODEL = Model("pixar", PixarParams, _prepare, scatter_eval, scatter_pdf, scatter_sample)
+LAYERED_MODEL = Model(
+    "pixar_layered", PixarLobeWeights, _prepare_weights, scatter_eval, scatter_pdf, scatter_sample
+)
 """The same lobes driven by composited weights: a layered Pixar material's BSDF."""
 
 

@@ -10,7 +10,8 @@ from hypothesis import strategies as st
 
 from lookdev.library import Material
 from lookdev.materials.layers import NoiseMask, TextureMask
-from lookdev.materials.pixar import LOBES, PixarParams, lobe_weights
+from lookdev.materials.pixar import PixarParams, lobe_weights
+from lookdev.materials.pixar_scatter import LOBES
 from lookdev.pipeline.blend import BlendError, blend
 from lookdev.pipeline.blend.pixar import PREFIX, Part, composite, energy_sum, layer_lobes
 

@@ -16,6 +16,7 @@ from lookdev.materials import pixar
 from lookdev.materials import pixar_lobes as lobes
 from lookdev.materials.arrays import NumpyOps
 from lookdev.materials.params import ParameterError
+from lookdev.materials.pixar_scatter import LOBES
 
 P = pixar.PixarParams
 XP = NumpyOps()
@@ -195,7 +196,7 @@ def test_weights_partition_energy_property(
         grazing_fresnel=gf,
         **dict(
             zip(
-                [f"{lobe}_scale" for lobe in pixar.LOBES],
+                [f"{lobe}_scale" for lobe in LOBES],
                 scales,
                 strict=True,
             )
@@ -291,7 +292,7 @@ def test_lobes_known_zero_are_dropped():
     assert kept(roughness=1.0) == ("diffuse",)  # the (1 − rough) fade
     assert kept(roughness=0.2) == ("diffuse", "specular", "reflection")
     assert kept(roughness=0.0) == ("diffuse", "reflection")
-    assert kept(roughness=0.2, clear=0.5, back=0.5) == pixar.LOBES
+    assert kept(roughness=0.2, clear=0.5, back=0.5) == LOBES
     # A black metal still has Fresnel's grazing highlight; without it, nothing is left.
     assert kept(roughness=0.2, surface_color=0.0, metallic=1.0) == ("specular", "reflection")
     assert kept(roughness=0.2, surface_color=0.0, metallic=1.0, grazing_fresnel=0.0) == ()

@@ -17,7 +17,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from lookdev.library import Library, Material
-from lookdev.materials import pixar
+from lookdev.materials import pixar, pixar_scatter
 from lookdev.materials.bsdf import density, draw, evaluate
 from lookdev.materials.layers import ConstantMask
 from lookdev.materials.pixar import LAYERED_MODEL, PixarLobeWeights, PixarParams
@@ -184,9 +184,9 @@ def test_interpolation_in_s_is_exact_where_the_blend_says(mode):
     worst = 0.0
     for cos_view in (1.0, 0.9, 0.6, 0.3, 0.05, 0.0):
         direct = _weights_at(top_first, alphas, cos_view, mode)
-        interp = pixar.at_view(xp, prep["ends"], np.array([cos_view]))
+        interp = pixar_scatter.at_view(xp, prep["ends"], np.array([cos_view]))
         for lobe, part in direct.items():
-            name = pixar._PREFIX[lobe]
+            name = pixar_scatter.PREFIX[lobe]
             got = np.stack([np.ravel(interp[name + "N"]), np.ravel(interp[name + "G"])])
             err = np.max(np.abs(got - np.stack([part.n, part.g])))
             if cos_view in VIEWS.values() or mode == "simple":

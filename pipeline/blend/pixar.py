@@ -50,8 +50,9 @@ from typing import Any
 
 import numpy as np
 
-from lookdev.materials.pixar import LOBES, WEIGHT_NAMES, PixarParams, lobe_weights
+from lookdev.materials.pixar import WEIGHT_NAMES, PixarParams, lobe_weights
 from lookdev.materials.pixar_lobes import CONE_MIN_DEG, LN_10
+from lookdev.materials.pixar_scatter import LOBES
 
 from .errors import BlendError
 from .masks import MaskSampler

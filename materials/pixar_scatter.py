@@ -1,0 +1,161 @@
+"""Scattering by Smits' six lobes once their weights are known: f, pdf and sampling.
+
+Both Pixar models (:mod:`.pixar`) reduce a material to one *prepared* dict
+(:func:`prepared`): the twelve weights at the two ends of the view, each highlight lobe's
+exponent, the IOR and the lobes whose weights are not known to be zero. The functions
+here read only that dict, so a plain material and a composited stack scatter by the same
+code. Lobe shapes are in :mod:`.pixar_lobes`; the surface is two-sided (the view's side
+is +z), and a lobe is sampled with the probability of its estimated albedo at the view.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from . import pixar_lobes as lobes
+
+LOBES = ("diffuse", "specular", "reflection", "diffuse_t", "specular_t", "reflection_t")
+PREFIX = dict(zip(LOBES, ("diff", "spec", "refl", "diffT", "specT", "reflT"), strict=True))
+"""lobe → the stem of its weights in Smits' notebook (``diffN``, ``diffG`` …)."""
+
+
+def at_view(xp: Any, pairs: dict[str, tuple[Any, Any]], cos_view: Any) -> dict[str, Any]:
+    """The twelve weights for a view at ``cos_view`` from their two ends (:func:`ends`):
+    (1 − s) W(s=0) + s W(s=1) with s = (1 − V·n)⁵, exact at both ends."""
+    s = lobes.schlick_weight(xp, cos_view)
+    return {k: n if g is None else n * (1.0 - s) + g * s for k, (n, g) in pairs.items()}
+
+
+def kept_lobes(xp: Any, pairs: dict[str, tuple[Any, Any]]) -> tuple[str, ...]:
+    """Lobes whose weights are not known to be zero (DESIGN.md: nothing unneeded)."""
+    kept = []
+    for lobe in LOBES:
+        values = [v for end in "NG" for v in pairs[PREFIX[lobe] + end] if v is not None]
+        if not all(xp.known_zero(v) for v in values):
+            kept.append(lobe)
+    return tuple(kept)
+
+
+def prepared(xp: Any, pairs: dict, powers: dict[str, Any], eta: Any) -> dict[str, Any]:
+    """What eval/pdf/sample consume, from the weights' two ends, each highlight lobe's
+    exponent and the IOR: the one path for plain and composited materials."""
+    return {"ends": pairs, "power": powers, "eta": eta, "lobes": kept_lobes(xp, pairs)}
+
+
+def _upper(xp: Any, wi: Any, wo: Any) -> tuple[Any, Any]:
+    """Both directions with the view's side as +z (the surface is two-sided)."""
+    s = xp.select(wo[2] < 0.0, -1.0, 1.0)
+    return xp.vec3(wi[0], wi[1], wi[2] * s), xp.vec3(wo[0], wo[1], wo[2] * s)
+
+
+def _power(prep: dict[str, Any], lobe: str) -> Any:
+    return prep["power"][lobe]
+
+
+def _lobe_value(xp: Any, prep: dict[str, Any], w: dict, lobe: str, wi: Any, wo: Any) -> Any:
+    """One lobe's f(wi, wo) (colour), zero on the side it does not cover."""
+    p = PREFIX[lobe]
+    n, g = w[p + "N"], w[p + "G"]
+    if lobe.endswith("_t"):
+        side = wi[2] < 0.0
+        if lobe == "diffuse_t":
+            f = lobes.frn_blend(xp, n, g, -wi[2]) * lobes.INV_PI
+        else:
+            # Blended by the view's incidence on the front, where the light crosses: the
+            # transmitted weights are the share the front Fresnel did not reflect.
+            back_i, back_o = lobes.to_back(xp, wi), lobes.back_view(xp, wo, prep["eta"])
+            f = lobes.p_specular(xp, back_i, back_o, _power(prep, lobe), n, g, wo[2])
+    else:
+        side = wi[2] > 0.0
+        if lobe == "diffuse":
+            f = lobes.frn_blend(xp, n, g, wi[2]) * lobes.INV_PI
+        else:
+            f = lobes.p_specular(xp, wi, wo, _power(prep, lobe), n, g)
+    return xp.select(side & (wo[2] > 0.0), f, 0.0)
+
+
+def scatter_eval(xp: Any, prep: dict[str, Any], wi: Any, wo: Any) -> Any:
+    wi, wo = _upper(xp, wi, wo)
+    w = at_view(xp, prep["ends"], wo[2])
+    f = xp.zeros(wi[2]) * w["specN"]
+    for lobe in prep["lobes"]:
+        f = f + _lobe_value(xp, prep, w, lobe, wi, wo)
+    return f
+
+
+def _mean(c: Any) -> Any:
+    return (c[0] + c[1] + c[2]) * (1.0 / 3.0)
+
+
+def _selection(xp: Any, prep: dict[str, Any], wo: Any) -> dict[str, Any]:
+    """Probability of sampling each kept lobe: its estimated albedo at this view."""
+    w = at_view(xp, prep["ends"], wo[2])
+    est = {}
+    for lobe in prep["lobes"]:
+        n, g = w[PREFIX[lobe] + "N"], w[PREFIX[lobe] + "G"]
+        if lobe.startswith("diffuse"):
+            albedo = n + (g - n) / 21.0  # exact: ∫ 2(1 − μ)⁵ μ dμ = 1/21
+        else:
+            albedo = lobes.frn_blend(xp, n, g, wo[2])  # the highlight's weight at its peak
+        est[lobe] = _mean(albedo)
+    total = sum(est.values()) if est else 0.0
+    inv = xp.select(total > 0.0, 1.0 / xp.maximum(total, xp.tiny), 0.0)
+    return {lobe: e * inv for lobe, e in est.items()}
+
+
+def _lobe_pdf(xp: Any, prep: dict[str, Any], lobe: str, wi: Any, wo: Any) -> Any:
+    if lobe == "diffuse":
+        return xp.maximum(wi[2], 0.0) * lobes.INV_PI
+    if lobe == "diffuse_t":
+        return xp.maximum(-wi[2], 0.0) * lobes.INV_PI
+    if lobe.endswith("_t"):
+        back_i, back_o = lobes.to_back(xp, wi), lobes.back_view(xp, wo, prep["eta"])
+        pdf = lobes.half_vector_pdf(xp, back_i, back_o, _power(prep, lobe))
+        return xp.select(wi[2] < 0.0, pdf, 0.0)
+    return xp.select(wi[2] > 0.0, lobes.half_vector_pdf(xp, wi, wo, _power(prep, lobe)), 0.0)
+
+
+def _mixture_pdf(xp: Any, prep: dict[str, Any], wi: Any, wo: Any) -> Any:
+    probs = _selection(xp, prep, wo)
+    pdf = xp.zeros(wi[2])
+    for lobe, prob in probs.items():
+        pdf = pdf + prob * _lobe_pdf(xp, prep, lobe, wi, wo)
+    return xp.select(wo[2] > 0.0, pdf, 0.0)
+
+
+def scatter_pdf(xp: Any, prep: dict[str, Any], wi: Any, wo: Any) -> Any:
+    wi, wo = _upper(xp, wi, wo)
+    return _mixture_pdf(xp, prep, wi, wo)
+
+
+def _candidate(xp: Any, prep: dict[str, Any], lobe: str, wo: Any, u1: Any, u2: Any) -> Any:
+    """The direction lobe ``lobe`` would sample (upper side = the view's side)."""
+    if lobe == "diffuse":
+        return lobes.cosine_hemisphere(xp, u1, u2)
+    if lobe == "diffuse_t":
+        return lobes.to_back(xp, lobes.cosine_hemisphere(xp, u1, u2))
+    h = lobes.sample_half_vector(xp, _power(prep, lobe), u1, u2)
+    if lobe.endswith("_t"):
+        view = lobes.back_view(xp, wo, prep["eta"])
+        return lobes.to_back(xp, lobes.reflect(xp, view, h))
+    return lobes.reflect(xp, wo, h)
+
+
+def scatter_sample(xp: Any, prep: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any, Any]:
+    s = xp.select(wo[2] < 0.0, -1.0, 1.0)
+    wo = xp.vec3(wo[0], wo[1], wo[2] * s)
+    wi = xp.vec3(xp.zeros(u[0]), xp.zeros(u[0]), xp.zeros(u[0]) + 1.0)
+    transmitted = u[0] < 0.0  # all False: the chosen lobe's side, filled in below
+    cumulative = 0.0
+    for lobe, prob in _selection(xp, prep, wo).items():
+        chosen = (u[0] >= cumulative) & (u[0] < cumulative + prob)
+        cumulative = cumulative + prob
+        wi = xp.select(chosen, _candidate(xp, prep, lobe, wo, u[1], u[2]), wi)
+        if lobe.endswith("_t"):
+            transmitted = transmitted | chosen
+    # A highlight sample that leaves its own side failed (pdf 0), as in a renderer.
+    ok = (u[0] < cumulative) & xp.select(transmitted, wi[2] < 0.0, wi[2] > 0.0)
+    pdf = xp.select(ok, _mixture_pdf(xp, prep, wi, wo), 0.0)
+    f = scatter_eval(xp, prep, wi, wo)
+    weight = f * xp.select(pdf > 0.0, xp.abs(wi[2]) / xp.maximum(pdf, xp.tiny), 0.0)
+    return xp.vec3(wi[0], wi[1], wi[2] * s), weight, pdf
