@@ -20,7 +20,7 @@ PREFIX = dict(zip(LOBES, ("diff", "spec", "refl", "diffT", "specT", "reflT"), st
 
 
 def at_view(xp: Any, pairs: dict[str, tuple[Any, Any]], cos_view: Any) -> dict[str, Any]:
-    """The twelve weights for a view at ``cos_view`` from their two ends (:func:`ends`):
+    """The twelve weights for a view at ``cos_view`` from their two ends (:func:`.pixar.ends`):
     (1 − s) W(s=0) + s W(s=1) with s = (1 − V·n)⁵, exact at both ends."""
     s = lobes.schlick_weight(xp, cos_view)
     return {k: n if g is None else n * (1.0 - s) + g * s for k, (n, g) in pairs.items()}
