@@ -10,7 +10,7 @@ import pytest
 from _lambert import LambertParams
 
 from lookdev.materials.bsdf import Model
-from lookdev.pipeline.analysis import stability
+from lookdev.pipeline.analysis import stability, stability_cases
 
 
 # -- a model broken on purpose, three ways ---------------------------------------------------
@@ -45,7 +45,7 @@ MODEL = Model("broken", LambertParams, _prepare, _eval, _pdf, _sample)
 
 @pytest.fixture
 def broken_registered(monkeypatch):
-    monkeypatch.setitem(stability.MODEL_MODULES, "broken", "test_check")
+    monkeypatch.setitem(stability_cases.MODEL_MODULES, "broken", "test_check")
 
 
 # -- the sweep ------------------------------------------------------------------------------
@@ -65,7 +65,7 @@ def test_sweep_finds_nan_inf_and_energy_gain_where_they_are():
 def test_parameter_cases_cover_every_extreme_and_the_named_combinations():
     from lookdev.materials.pixar import PixarParams
 
-    labels = [label for label, _ in stability.parameter_cases(PixarParams)]
+    labels = [label for label, _ in stability_cases.parameter_cases(PixarParams)]
     for expected in ("roughness=0", "roughness=1", "surface_color=black", "clear=1", "ior=10"):
         assert expected in labels
     assert "roughness=0, clear=1, back=1" in labels  # a named combination
@@ -73,7 +73,7 @@ def test_parameter_cases_cover_every_extreme_and_the_named_combinations():
 
 
 def test_directions_hold_the_stiff_pairs():
-    d = stability.directions()
+    d = stability_cases.directions()
     np.testing.assert_allclose(np.linalg.norm(d, axis=1), 1.0, rtol=1e-12)
     z = set(np.round(d[:, 2], 12))
     assert {1.0, 0.5, 1e-4, 1e-7, 0.0, -0.5} <= z
@@ -84,9 +84,9 @@ def test_directions_hold_the_stiff_pairs():
 def test_plausible_excludes_pushed_parameters():
     from lookdev.materials.params import DisneyParams
 
-    assert stability._plausible(DisneyParams(sheen=1.0, specular=1.0))
-    assert not stability._plausible(DisneyParams(sheen=10.0))
-    assert stability._plausible(DisneyParams(ior=10.0))  # a range that does not start at 0
+    assert stability_cases.plausible(DisneyParams(sheen=1.0, specular=1.0))
+    assert not stability_cases.plausible(DisneyParams(sheen=10.0))
+    assert stability_cases.plausible(DisneyParams(ior=10.0))  # a range that does not start at 0
 
 
 # -- the command ----------------------------------------------------------------------------
@@ -142,7 +142,7 @@ def test_unknown_model_is_one_line_and_exit_2(cli):
 
 
 def test_missing_model_is_skipped_not_fatal(cli, monkeypatch):
-    monkeypatch.setitem(stability.MODEL_MODULES, "ghost", "lookdev.materials.no_such_model")
+    monkeypatch.setitem(stability_cases.MODEL_MODULES, "ghost", "lookdev.materials.no_such_model")
     result = cli("check", "--model", "ghost", "--model", "sheen", "--json")
     data = json.loads(result.out)
     assert result.code == 0

@@ -172,7 +172,7 @@ def run(
     """Measure every asked item now. ``render``/``models`` override what is discovered."""
     report = Report()
     if models is None:
-        from .stability import available_models
+        from .stability_cases import available_models
 
         models, missing = available_models()
         report.skipped.update({f"model {name}": why for name, why in missing.items()})

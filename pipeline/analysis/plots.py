@@ -58,7 +58,7 @@ class PlotError(LookdevError):
 
 def model_named(name: str) -> Model:
     """The installed :class:`Model` called ``name`` (the registry of ``lookdev check``)."""
-    from .stability import MODEL_MODULES, CheckError, available_models
+    from .stability_cases import MODEL_MODULES, CheckError, available_models
 
     try:
         models, missing = available_models([name])

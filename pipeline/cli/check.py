@@ -8,14 +8,14 @@ from typing import Annotated
 import typer
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 
-from lookdev.pipeline.analysis import stability
+from lookdev.pipeline.analysis import stability, stability_cases
 
 from .common import console, err_console, print_json, table
 
 COLUMNS = ["precision", "cases", "raised", "NaN", "inf", "negative", "energy gain"]
 
 
-_MODEL_HELP = f"Only this model (repeatable): {', '.join(stability.MODEL_MODULES)}."
+_MODEL_HELP = f"Only this model (repeatable): {', '.join(stability_cases.MODEL_MODULES)}."
 
 
 def check(

@@ -1,0 +1,225 @@
+"""What ``lookdev check`` sweeps: the models, their stiff and extreme inputs, allowances.
+
+The cases of DESIGN.md, "Numerics that need care", for every model:
+
+* **parameters** — every field at each end of its range, one at a time from the defaults
+  (roughness 0 and 1, black and white colours, each switch and each sheen model …), plus
+  the named combinations below where the field names exist (delta metal, tint of a black
+  base, glass at η = 1, Conty-Kulla at r → 0, Smits at roughness 0 …);
+* **directions** — normal, cos θ = 0.5 (the Conty-Kulla branches meet), 1e-4, 1e-7 and
+  exactly 0 (grazing and tangent), below the surface, random ones; the set is closed
+  under negation and mirroring, so every pair includes wi = −wo (zero half vector),
+  wi = wo and the mirror direction (the peak of a delta-like lobe);
+* **uniforms** — the corners 0, ½ and 1 − 2⁻²⁴ of every sampling dimension, and random;
+* **maps** — once more with every float and colour field given per element (mixing its
+  extremes), the array code path that textures take.
+
+Allowances: the Conty-Kulla lobe and Smits' model conserve energy by construction (sheen
+0.002: its albedo table's measured interpolation error; pixar 0). The Disney BRDF adds
+energy by design; its allowance is the Disney module's ``ENERGY_ALLOWANCE`` when it has
+one, else 0.77: tests/test_disney.py measures each lobe's gain up to θo = 89° (rough
+white plastic 1.567, sheen +0.09, clearcoat +0.05), and with all of them at once and
+``specular`` 1 the albedo keeps rising towards grazing: 1.721 at 89°, 1.758 at 89.9°,
+1.762 ± 0.001 at 89.99° and 89.9999° (4·10⁵ samples each). Parameters
+pushed past their plausible range (sheen 10, specular 12.5, clearcoat 4) are checked for
+NaN, infinity and sign only: Burley allows them precisely to add energy.
+"""
+
+from __future__ import annotations
+
+import importlib
+import itertools
+import typing
+from typing import Any
+
+import numpy as np
+
+from lookdev.materials.bsdf import Model
+from lookdev.materials.errors import LookdevError
+
+MODEL_MODULES = {
+    "disney": "lookdev.materials.disney",
+    "sheen": "lookdev.materials.sheen",
+    "pixar": "lookdev.materials.pixar",
+    "pixar_layered": "lookdev.materials.pixar",
+}
+MODEL_ATTRS = {"pixar_layered": "LAYERED_MODEL"}
+"""The attribute holding the Model, where it is not ``MODEL``."""
+ALLOWANCE = {"disney": 0.77, "sheen": 0.002, "pixar": 0.0, "pixar_layered": 0.0}
+UNBOUNDED_HIGH = 10.0  # the "pushed" value of a field with no upper bound
+
+# Named stiff combinations (DESIGN.md), applied where every named field exists.
+COMBINATIONS: tuple[dict[str, Any], ...] = (
+    {"roughness": 0.0, "metallic": 1.0},  # delta metal (α clamp)
+    {"roughness": 0.0, "anisotropic": 1.0},
+    {"roughness": 1.0, "anisotropic": 1.0},  # GTR 0/0 at α → 1
+    {"base_color": (0.0, 0.0, 0.0), "specular_tint": 1.0, "sheen": 1.0, "sheen_tint": 1.0},
+    {"roughness": 1.0, "sheen": 1.0, "clearcoat": 1.0, "clearcoat_gloss": 0.0},
+    {"clearcoat": 1.0, "clearcoat_gloss": 1.0},  # α = 0.001 clearcoat
+    {"spec_trans": 1.0, "roughness": 0.0},  # smooth glass
+    {"spec_trans": 1.0, "ior": 1.0, "roughness": 0.3},  # η = 1: refraction degenerates
+    {"spec_trans": 1.0, "thin": True, "roughness": 0.0},
+    {"diff_trans": 1.0, "thin": True, "flatness": 1.0},
+    {"sheen_model": "conty_kulla", "sheen": 1.0, "sheen_roughness": 0.0},
+    {"sheen_model": "conty_kulla", "sheen": 1.0, "sheen_roughness": 1.0},
+    {"roughness": 0.0, "terminator_softening": False},
+    {"roughness": 0.0, "clear": 1.0, "back": 1.0},  # powerR at its cone floor, refraction
+    {"roughness": 0.0, "specular_cone_scale": 0.0, "reflection_cone_scale": 0.0},
+    {"roughness": 0.5, "normal_fresnel": 20.0, "grazing_fresnel": 0.0, "clear": 1.0},
+)
+
+
+class CheckError(LookdevError):
+    """``lookdev check`` was asked for a model it does not know."""
+
+
+def available_models(names: list[str] | None = None) -> tuple[dict[str, Model], dict]:
+    """({name: Model} of the models that import, {name: why not} for the others)."""
+    wanted = list(MODEL_MODULES) if not names else names
+    unknown = [n for n in wanted if n not in MODEL_MODULES]
+    if unknown:
+        raise CheckError(
+            f"unknown model {unknown[0]!r}; known: {', '.join(MODEL_MODULES)}", field="--model"
+        )
+    models, missing = {}, {}
+    for name in wanted:
+        try:
+            module = importlib.import_module(MODEL_MODULES[name])
+            models[name] = getattr(module, MODEL_ATTRS.get(name, "MODEL"))
+        except (ImportError, AttributeError) as exc:
+            missing[name] = f"not available ({exc})"
+    return models, missing
+
+
+def allowance(name: str) -> float:
+    """Energy a model may add by design (see the module docstring); 0 if unknown."""
+    default = ALLOWANCE.get(name, 0.0)
+    if name not in MODEL_MODULES:
+        return default
+    module = importlib.import_module(MODEL_MODULES[name])
+    return float(getattr(module, "ENERGY_ALLOWANCE", default))
+
+
+def extremes(info: Any) -> list[Any]:
+    """The values at the ends of one schema field's range."""
+    annotation = info.annotation
+    args = typing.get_args(annotation)
+    if annotation is bool:
+        return [False, True]
+    if typing.get_origin(annotation) is typing.Literal:
+        return list(args)
+    if tuple in (typing.get_origin(annotation), *map(typing.get_origin, args)):
+        return [(0.0, 0.0, 0.0), (1.0, 1.0, 1.0)]
+    lo = hi = None
+    for m in info.metadata:
+        lo = getattr(m, "ge", lo) if getattr(m, "ge", None) is not None else lo
+        hi = getattr(m, "le", hi) if getattr(m, "le", None) is not None else hi
+    if lo is None:
+        return []
+    return [float(lo), float(hi) if hi is not None else float(lo) + UNBOUNDED_HIGH]
+
+
+def plausible(params: Any) -> bool:
+    """Every float field inside 0..1 where its range starts at 0 (Burley's plausible)."""
+    for name, info in type(params).model_fields.items():
+        value = getattr(params, name)
+        ext = extremes(info)
+        if isinstance(value, float) and ext and ext[0] == 0.0 and value > 1.0:
+            return False
+    return True
+
+
+def parameter_cases(params_type: type) -> list[tuple[str, Any]]:
+    """(label, params): defaults, each field at each extreme, and the named combinations."""
+    cases = [("defaults", params_type())]
+    fields = params_type.model_fields
+    for name, info in fields.items():
+        for value in extremes(info):
+            cases.append((f"{name}={short(value)}", {name: value}))
+    for combo in COMBINATIONS:
+        if set(combo) <= set(fields):
+            cases.append((", ".join(f"{k}={short(v)}" for k, v in combo.items()), combo))
+    out = []
+    for label, data in cases:
+        if isinstance(data, dict):
+            try:
+                data = params_type.parse(data)
+            except LookdevError:
+                continue  # a combination the schema forbids (e.g. specular with ior)
+        out.append((label, data))
+    return out
+
+
+def short(value: Any) -> str:
+    if isinstance(value, tuple):
+        return "white" if all(v == 1 for v in value) else "black"
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def directions() -> np.ndarray:
+    """Unit directions (M, 3), closed under negation and under mirroring about n."""
+    base = [(c, phi) for c in (1.0, 0.5, 1e-4, 1e-7, 0.0) for phi in (0.0, 1.1)]
+    rng = np.random.default_rng(11)
+    base += list(
+        zip(rng.uniform(0.05, 0.95, 4).tolist(), rng.uniform(0, 6, 4).tolist(), strict=True)
+    )
+    c, phi = np.array(base).T
+    s = np.sqrt(1.0 - c * c)
+    d = np.stack([s * np.cos(phi), s * np.sin(phi), c], axis=-1)
+    mirror = d * np.array([-1.0, -1.0, 1.0])
+    d = np.concatenate([d, -d, mirror, -mirror])
+    return np.unique(np.round(d, 15), axis=0)
+
+
+def uniforms() -> np.ndarray:
+    """(K, 3) uniforms: every corner of {0, ½, 1 − 2⁻²⁴}³ and sixteen random triples."""
+    corners = np.array(list(itertools.product((0.0, 0.5, 1.0 - 2.0**-24), repeat=3)))
+    return np.concatenate([corners, np.random.default_rng(12).random((16, 3))])
+
+
+def per_element_maps(params_type: type, lead: tuple[int, ...], seed: int = 13) -> dict:
+    """Every float and colour field as a per-element map mixing its extremes and midpoint.
+
+    Constants fold into Python floats and may take other branches than arrays do (the
+    Dr.Jit plugin sees textures as arrays), so the sweep runs once with maps as well.
+    """
+    rng = np.random.default_rng(seed)
+    maps = {}
+    for name, info in params_type.model_fields.items():
+        ext = extremes(info)
+        if ext == [(0.0, 0.0, 0.0), (1.0, 1.0, 1.0)]:
+            maps[name] = rng.choice([0.0, 0.5, 1.0], size=(*lead, 3))
+        elif len(ext) == 2 and all(isinstance(v, float) for v in ext):
+            lo, hi = ext
+            hi = min(hi, 1.0) if lo == 0.0 else hi
+            maps[name] = rng.choice([lo, 0.5 * (lo + hi), hi], size=lead)
+    return maps
+
+
+def white(params: Any) -> Any:
+    """The same parameters with every colour white (a furnace)."""
+    colours = {
+        k: (1.0, 1.0, 1.0)
+        for k, info in type(params).model_fields.items()
+        if extremes(info) == [(0.0, 0.0, 0.0), (1.0, 1.0, 1.0)]
+    }
+    return params.replace(**colours) if colours else params
+
+
+def furnace_cases(name: str) -> list[tuple[str, Any]]:
+    """Extra furnace inputs (already white) for a model whose own inputs need not
+    conserve energy.
+
+    Composited Pixar lobe weights partition energy only as compositing produces them, so
+    ``pixar_layered`` is put in the furnace with the weights of every plausible Pixar
+    parameter case made white (what a one-layer stack composites to), not with arbitrary
+    weights (twelve white weights would reflect several times the light).
+    """
+    if name != "pixar_layered":
+        return []
+    from lookdev.materials.pixar import PixarParams, as_lobe_weights
+
+    cases = parameter_cases(PixarParams)
+    return [
+        (f"weights of {label}", as_lobe_weights(white(p))) for label, p in cases if plausible(p)
+    ]
