@@ -24,7 +24,7 @@ The surface is two-sided: seen from below, the roles of the sides swap.
 Two models share these lobes. :data:`MODEL` takes Smits' parameters
 (:class:`PixarParams`); :data:`LAYERED_MODEL` takes the twelve weights themselves at the
 two ends of the view, cones, falloffs and IOR (:data:`PixarLobeWeights`), which is what
-compositing a layered stack produces (:mod:`lookdev.pipeline.blend.pixar`). The first
+compositing a layered stack produces (:mod:`lookdev.pipeline.blend.pixar_composite`). The first
 is the second after one step: parameters → weights → the same prepared dict
 (:func:`.pixar_scatter.prepared`), so a one-layer stack renders as its preset.
 
@@ -259,7 +259,7 @@ def _prepare_weights(xp: Any, params: Any, **maps: Any) -> dict[str, Any]:
     Each weight is taken at the two view ends and interpolated in s = (1 − V·n)⁵
     (:func:`at_view`): exact at every view for a plain material and for simple layering
     (both affine in s), exact at both ends for full layering, whose interactions
-    multiply view-dependent weights (lookdev.pipeline.blend.pixar). A weight whose
+    multiply view-dependent weights (lookdev.pipeline.blend.pixar_composite). A weight whose
     ends are the same constant is view-independent and costs no interpolation.
     """
     pairs = {}

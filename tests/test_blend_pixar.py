@@ -11,9 +11,9 @@ from hypothesis import strategies as st
 from lookdev.library import Material
 from lookdev.materials.layers import NoiseMask, TextureMask
 from lookdev.materials.pixar import PixarParams, lobe_weights
-from lookdev.materials.pixar_scatter import LOBES
+from lookdev.materials.pixar_scatter import LOBES, PREFIX
 from lookdev.pipeline.blend import BlendError, blend
-from lookdev.pipeline.blend.pixar import PREFIX, Part, composite, energy_sum, layer_lobes
+from lookdev.pipeline.blend.pixar_composite import Part, composite, energy_sum, layer_lobes
 
 GLAZE = PixarParams(surface_color=(0.9, 0.8, 0.7), roughness=0.1, clear=0.6, back=0.3)
 CLAY = PixarParams(surface_color=(0.6, 0.3, 0.2), roughness=0.7)

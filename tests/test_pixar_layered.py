@@ -22,7 +22,8 @@ from lookdev.materials.bsdf import density, draw, evaluate
 from lookdev.materials.layers import ConstantMask
 from lookdev.materials.pixar import LAYERED_MODEL, PixarLobeWeights, PixarParams
 from lookdev.pipeline.blend import blend
-from lookdev.pipeline.blend.pixar import VIEWS, composite, layer_lobes
+from lookdev.pipeline.blend.pixar import VIEWS
+from lookdev.pipeline.blend.pixar_composite import composite, layer_lobes
 
 P = PixarParams
 EDGES = [
