@@ -9,16 +9,22 @@ from typing import Annotated, Any
 
 import typer
 from rich.syntax import Syntax
-from rich.table import Table
 
-from lookdev.library import Library, Material, PresetError, read_preset
+from lookdev.library import Library, PresetError, read_preset
 from lookdev.library.index import Header
-from lookdev.library.library import apply_changes, set_by
+from lookdev.library.library import apply_changes
 from lookdev.library.preset import PresetFile, check_name, parse_value, preset_document
 from lookdev.library.schema import preset_schema
-from lookdev.materials.layers import children
 
-from .common import console, err_console, print_json, table
+from .common import console, err_console, print_json
+from .presets_view import (
+    header_json,
+    material_json,
+    origin,
+    plain_columns,
+    print_resolved,
+    text_table,
+)
 
 app = typer.Typer(
     help="Browse and edit material presets. Presets are TOML files found, in order, in each "
@@ -88,17 +94,17 @@ def list_(
         )
     if as_json:
         # One entry per line via the C encoder: print_json's indent=2 is 5x slower at 10^4.
-        lines = ",\n".join("  " + json.dumps(_header_json(h, lib)) for h in shown)
+        lines = ",\n".join("  " + json.dumps(header_json(h, lib)) for h in shown)
         sys.stdout.write(f"[\n{lines}\n]\n" if shown else "[]\n")
         return
     columns = ["name", "model", "tags", "library", "description"]
     rows = [
-        [h.name, h.model or "?", ", ".join(h.tags), _origin(h, lib), h.description] for h in shown
+        [h.name, h.model or "?", ", ".join(h.tags), origin(h, lib), h.description] for h in shown
     ]
     if len(rows) <= TABLE_MAX_ROWS:
-        console.print(_text_table(f"{len(rows)} presets", columns, rows))
+        console.print(text_table(f"{len(rows)} presets", columns, rows))
     else:
-        sys.stdout.write(_plain_columns(columns, rows) + f"\n({len(rows)} presets)\n")
+        sys.stdout.write(plain_columns(columns, rows) + f"\n({len(rows)} presets)\n")
 
 
 @app.command()
@@ -137,7 +143,7 @@ def show(
         }
         doc["preset"] = preset_document(preset)
         if material is not None:
-            doc["resolved"] = _material_json(material)
+            doc["resolved"] = material_json(material)
         print_json(doc)
         return
     console.print(f"[bold]{preset.name}[/] from {path}", highlight=False)
@@ -147,7 +153,7 @@ def show(
         text = path.read_text(encoding="utf-8")
         console.print(Syntax(text, "toml", theme="ansi_dark", word_wrap=True))
     else:
-        _print_resolved(material)
+        print_resolved(material)
 
 
 @app.command()
@@ -307,102 +313,8 @@ def parse_assignments(items: list[str]) -> dict[str, Any]:
     return out
 
 
-def _text_table(title: str, columns: list[str], rows: list[list[str]]) -> Table:
-    """A Rich table of text columns: left-aligned, names never wrapped."""
-    t = Table(title=title, title_justify="left")
-    for c in columns:
-        t.add_column(c, no_wrap=c in ("name", "model"), ratio={"tags": 1, "description": 2}.get(c))
-    for r in rows:
-        t.add_row(*r, style="dim" if r[1] == "?" else None)
-    return t
-
-
-def _plain_columns(columns: list[str], rows: list[list[str]]) -> str:
-    """Rows as left-aligned text columns, the last one unpadded (like ``ls -l``)."""
-    widths = [max(map(len, col)) for col in list(zip(columns, *rows, strict=True))[:-1]]
-    line = "  ".join([*(f"{{{i}:<{w}}}" for i, w in enumerate(widths)), f"{{{len(widths)}}}"])
-    return "\n".join(line.format(*r).rstrip() for r in [columns, *rows])
-
-
 def _matches(h: Header, tags: list[str], model: str | None) -> bool:
     return all(t in h.tags for t in tags) and (model is None or h.model == model)
-
-
-def _origin(h: Header, lib: Library) -> str:
-    return "built-in" if h.library == lib.builtin_str else h.library
-
-
-def _header_json(h: Header, lib: Library) -> dict[str, Any]:
-    return {
-        "name": h.name,
-        "model": h.model,
-        "description": h.description,
-        "tags": list(h.tags),
-        "extends": h.extends,
-        "file": h.file,
-        "library": _origin(h, lib),
-    }
-
-
-def _material_json(m: Material) -> dict[str, Any]:
-    doc = m.model_dump(mode="json", exclude={"layers", "params"})
-    doc["params"] = m.params.model_dump(mode="json") if m.params is not None else None
-    doc["layers"] = [
-        {
-            **layer.model_dump(mode="json", exclude={"material"}),
-            "material": _material_json(layer.material),
-        }
-        for layer in m.layers
-    ]
-    return doc
-
-
-def _print_resolved(m: Material) -> None:
-    if m.params is not None:
-        origin = {k: p.name for k, p in set_by(m).items()}
-        values = m.params.model_dump()
-        if getattr(m.params, "uses_ior", False):  # Disney: one parameter, two spellings
-            values["specular"], origin["specular"] = m.params.effective_specular, "(from ior)"
-        rows = [[k, _value(v), origin.get(k, "default")] for k, v in values.items()]
-        console.print(
-            table(f"{m.name} ({m.model}, resolved)", ["parameter", "value", "set by"], rows)
-        )
-        return
-    rows = [
-        [
-            i,
-            layer.name,
-            layer.material.name,
-            layer.material.model,
-            _mask_text(layer.mask),
-            layer.presence,
-        ]
-        for i, layer in enumerate(m.layers)
-    ]
-    console.print(
-        table(
-            f"{m.name} (layered, bottom to top)",
-            ["#", "layer", "material", "model", "mask", "presence"],
-            rows,
-        )
-    )
-
-
-def _value(v: Any) -> str:
-    if isinstance(v, tuple | list):
-        return "[" + ", ".join(f"{x:.4g}" for x in v) + "]"
-    return f"{v:.4g}" if isinstance(v, float) else str(v)
-
-
-def _mask_text(mask: Any) -> str:
-    """A mask tree as a call expression: ``levels(noise(scale=6.0, seed=7), low=0.42)``."""
-    fields = mask.model_dump(
-        mode="json", exclude_defaults=True, exclude={"kind", "input", "inputs"}
-    )
-    if "path" in fields:
-        fields["path"] = Path(fields["path"]).name
-    args = [_mask_text(c) for c in children(mask)] + [f"{k}={v}" for k, v in fields.items()]
-    return f"{mask.kind}({', '.join(args)})"
 
 
 def _report(verb: str, name: str, path: Path, as_json: bool) -> None:
