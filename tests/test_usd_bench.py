@@ -70,4 +70,4 @@ def test_bench_usd_reports_the_floor_and_its_bound(cli):
     assert data["floor_empty_specs_s"] > 0
     assert data["ratio_bound"] == pytest.approx(data["naive_s"] / data["floor_empty_specs_s"])
     people = cli("bench", "usd", "-n", "5", "--repeat", "1")
-    assert "target ≥ 5×" in people.out
+    assert "target ≥ 5×" in people.out and "that floor" in people.out

@@ -72,8 +72,13 @@ def command(
     rows = [[k, v] for k, v in result.items()]
     console.print(table(f"bench usd ({materials} materials)", ["measure", "value"], rows))
     ratio, bound = result["ratio_fast_to_naive"], result["ratio_bound"]
-    verdict = "met" if ratio >= 5 else f"missed: creating the specs empty bounds it at {bound:.2f}×"
-    console.print(f"fast path {ratio:.2f}× the naive reference (target ≥ 5×: {verdict})")
+    above_floor = result["fast_s"] / result["floor_empty_specs_s"]
+    console.print(
+        f"fast path {ratio:.2f}× the naive reference (target ≥ 5×: "
+        f"{'met' if ratio >= 5 else 'missed'}); creating the same specs empty, which no "
+        f"Python authoring can beat, is {bound:.2f}× it; the fast path takes "
+        f"{above_floor:.1f}× that floor to also set values, connections and metadata"
+    )
 
 
 def run(count: int, *, repeat: int = 3) -> dict[str, Any]:
