@@ -13,6 +13,11 @@ different per layer, so all parameter maps vary. Measured in one run:
 - ``peak_to_output``: peak bytes allocated during a cold blend (``tracemalloc``, which sees
   numpy's allocations but not OpenImageIO's decode buffers) over the output's bytes
   (target < 2);
+- ``peak_rss_to_output``: the same, measured as the rise of the resident set (VmHWM,
+  reset just before the blend) in a child process, so that everything counts, OpenImageIO
+  and OpenEXR included; for this stack and for :func:`large_mask_material`, float EXR
+  masks at twice the resolution driving a single map (where decoded masks, not maps,
+  would dominate);
 - pruning: the same blend with ``prune=False`` on the built-in ``rusty_car_paint`` (maps
   that need not vary) and on this stack with a full-coverage layer and a zero layer added
   (layers that need not be blended).
@@ -76,6 +81,7 @@ def run(resolution: int, folder: Path, *, repeat: int = 3) -> dict[str, Any]:
     best = _against_copy(lambda: blend(material, resolution, images=images), out.nbytes, repeat)
     cold = interleaved_best({"blend_cold_s": lambda: blend(material, resolution)}, 1)
     peak = peak_bytes(lambda: blend(material, resolution))
+    rss = {case: peak_rss(case, folder, resolution) for case in ("stack", "large_masks")}
     return {
         "resolution": resolution,
         "layers": LAYERS,
@@ -88,6 +94,11 @@ def run(resolution: int, folder: Path, *, repeat: int = 3) -> dict[str, Any]:
         "ratio_cold_blend_to_copy": cold["blend_cold_s"] / best["copy_s"],
         "peak_mb": peak / 1e6,
         "peak_to_output": peak / out.nbytes,
+        **{
+            f"peak_rss_to_output_{case}": r["peak_bytes"] / r["output_bytes"]
+            for case, r in rss.items()
+        },
+        **{f"peak_rss_mb_{case}": r["peak_bytes"] / 1e6 for case, r in rss.items()},
         "pruning": {
             PRUNING_PRESET: pruning_saving(_library_material(PRUNING_PRESET), resolution, repeat),
             "hidden+zero layers": pruning_saving(
@@ -175,6 +186,73 @@ def pruning_saving(material, resolution: int, repeat: int) -> dict[str, Any]:
         **best,
         "speedup": best["s_without"] / best["s"],
     }
+
+
+def large_mask_material(folder: Path, resolution: int, *, layers: int = 2):
+    """Layers that differ in roughness only, under float EXR masks of 2N × 2N texels."""
+    from lookdev.library import Layer, Material
+
+    rng = np.random.default_rng(3)
+    stack = [Layer(material=_roughness("base", 0.2), name="base")]
+    for i in range(layers):
+        path = folder / f"large{i}.exr"
+        if not path.exists():
+            write_mask(path, rng.random((2 * resolution, 2 * resolution), dtype=np.float32))
+        stack.append(
+            Layer(material=_roughness(f"r{i}", 0.4 + 0.2 * i), mask=TextureMask(path=path))
+        )
+    return Material(name="bench_large_masks", model="layered", layers=stack)
+
+
+def _roughness(name: str, value: float):
+    from lookdev.library import Material
+
+    return Material(name=name, model="disney", params=DisneyParams(roughness=value))
+
+
+_CASES = {"stack": bench_material, "large_masks": large_mask_material}
+
+
+def peak_rss(case: str, folder: Path, resolution: int) -> dict[str, int]:
+    """Peak resident-set rise of one cold blend of ``case``, in a fresh child process.
+
+    The child builds the material (its masks are already on disk), resets the kernel's
+    high-water mark (``/proc/self/clear_refs``), blends, and reports VmHWM − the RSS
+    before: every byte the blend touched, whoever allocated it.
+    """
+    import json
+    import subprocess
+    import sys
+
+    _CASES[case](folder, resolution)  # write the masks here, outside the child's clock
+    run = [sys.executable, "-c", _CHILD, case, str(folder), str(resolution)]
+    done = subprocess.run(run, capture_output=True, text=True, check=True)
+    return json.loads(done.stdout)
+
+
+_CHILD = (
+    "import sys; from lookdev.pipeline.analysis.bench_blend import child_peak; "
+    "child_peak(sys.argv[1], sys.argv[2], int(sys.argv[3]))"
+)
+
+
+def child_peak(case: str, folder: str, resolution: int) -> None:
+    """The child of :func:`peak_rss`: prints ``{"peak_bytes", "output_bytes"}``."""
+    import json
+
+    material = _CASES[case](Path(folder), resolution)
+    before = _status_kb("VmRSS")
+    Path("/proc/self/clear_refs").write_text("5")
+    out = blend(material, resolution)
+    peak = (_status_kb("VmHWM") - before) * 1024
+    print(json.dumps({"peak_bytes": peak, "output_bytes": out.nbytes}))
+
+
+def _status_kb(field: str) -> int:
+    for line in Path("/proc/self/status").read_text().splitlines():
+        if line.startswith(field + ":"):
+            return int(line.split()[1])
+    raise RuntimeError(f"/proc/self/status has no {field}")
 
 
 def peak_bytes(fn) -> int:

@@ -23,6 +23,7 @@ unit tangent-space vectors (decoded, not 0..1 encoded).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -134,8 +135,8 @@ def blend(
     width, height = (resolution, resolution) if isinstance(resolution, int) else resolution
     if width < 1 or height < 1:
         raise BlendError(f"resolution {width}x{height} must be at least 1x1", where=material.name)
-    sampler = MaskSampler((height, width), images)
     entries = stack_of(material)
+    sampler = MaskSampler((height, width), images, output_channels=_channels_bound(entries))
     if entries[0].model == "pixar":
         from . import pixar
 
@@ -152,6 +153,18 @@ def blend(
     result = _blend_disney(material.name, kept, sampler, progress, naive=not prune)
     result.decisions = decisions + result.decisions
     return result
+
+
+def _channels_bound(entries: list[Entry]) -> float:
+    """At most how many float channels a blend of ``entries`` writes per texel: the
+    Disney parameters that differ between layers (a normal map adds three); unbounded for
+    Pixar stacks, whose composited weights are many. Sizes the sampler's texture budget."""
+    if entries[0].model != "disney":
+        return math.inf
+    values = [disney.layer_values(e.params) for e in entries]
+    differing = [k for k in values[0] if any(v[k] != values[0][k] for v in values)]
+    normals = any(e.normal_map is not None for e in entries)
+    return sum(np.size(values[0][k]) for k in differing) + 3 * normals
 
 
 def _blend_disney(

@@ -23,7 +23,9 @@ under full coverage without evaluating a single texel.
 
 from __future__ import annotations
 
+import math
 from functools import reduce
+from typing import Any
 
 import numpy as np
 
@@ -37,32 +39,54 @@ from lookdev.materials.layers import (
     TextureMask,
 )
 
-from .resample import as_float, read_channels, resample, taps
+from .resample import TextureFile, as_float, resample, taps
+
+WHOLE_BUDGET = 0.5
+"""Share of the output's bytes that textures decoded whole may take; the rest stream."""
 
 
 class MaskSampler:
     """Evaluates masks for one output resolution, reading each texture once.
 
     ``resolution`` is ``(height, width)``. ``images`` is a cache of decoded texture
-    channels, ``{key: (array, (min, max))}``; pass one dict to several samplers (other
-    resolutions, other materials sharing masks) to decode each file once.
+    channels, ``{key: (source, (min, max))}``; pass one dict to several samplers (other
+    resolutions, other materials sharing masks) to decode each file once, whole.
+
+    Without ``images``, a sampler decodes textures whole only while they fit in
+    :data:`WHOLE_BUDGET` of the output, ``output_channels`` float32 channels at its
+    resolution (the engine's bound on what a blend writes); larger ones stay in their
+    files (:class:`.resample.TextureFile`) and each tile reads the rows it needs, so a
+    4096² float mask that varies one 2048² map costs rows, not 64 MB.
     """
 
-    def __init__(self, resolution: tuple[int, int], images: dict | None = None):
+    def __init__(
+        self,
+        resolution: tuple[int, int],
+        images: dict | None = None,
+        output_channels: float = math.inf,
+    ):
         self.height, self.width = resolution
-        self._images: dict[tuple, tuple[np.ndarray, tuple[float, float]]] = (
+        output_bytes = output_channels * self.height * self.width * 4
+        self._budget = math.inf if images is not None else WHOLE_BUDGET * output_bytes
+        self._images: dict[tuple, tuple[Any, tuple[float, float]]] = (
             {} if images is None else images
         )
         self._tap_cache: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
         self._mips: dict[tuple, np.ndarray] = {}
 
-    def image(self, tex: TextureMask, count: int = 1, *, where: str | None = None) -> np.ndarray:
-        """The source channels of ``tex`` (cached, as stored; see :func:`.read_channels`)."""
+    def image(self, tex: TextureMask, count: int = 1, *, where: str | None = None) -> Any:
+        """The source channels of ``tex``, as stored (see :func:`.read_channels`): an array
+        when decoded whole, else a :class:`.TextureFile` indexed by rows the same way."""
         key = (str(tex.path), tex.channel, count)
         if key not in self._images:
-            a = read_channels(tex, count, where=where)
-            lo, hi = as_float(np.array([a.min(), a.max()], dtype=a.dtype))
-            self._images[key] = (a, (float(lo), float(hi)))
+            source = TextureFile(tex, count, where=where)
+            if self._whole_bytes() + source.nbytes <= self._budget:
+                source = source[np.arange(source.shape[0])]
+                chunks = [(0, source)]
+            else:
+                chunks = source.chunks()
+            lo, hi = _min_max(a for _, a in chunks)
+            self._images[key] = (source, (lo, hi))
         return self._images[key][0]
 
     def lookup(
@@ -87,15 +111,21 @@ class MaskSampler:
         u_taps = self._taps(self.width, w, su, ou, tex.wrap)
         return resample(src, (v_idx[rows], v_w[rows]), u_taps)
 
-    def _reduced(self, tex: TextureMask, count: int, kv: int, ku: int) -> np.ndarray:
-        """The source averaged over kv × ku blocks (float32, cached)."""
+    def _reduced(self, tex: TextureMask, count: int, kv: int, ku: int) -> Any:
+        """The source averaged over kv × ku blocks (float32, cached): whole while it fits
+        the budget, else rows reduced when a tile asks for them."""
         key = (str(tex.path), tex.channel, count, kv, ku)
         if key not in self._mips:
-            a = as_float(self.image(tex, count))
-            h, w = a.shape[:2]
-            blocks = a.reshape(h // kv, kv, w // ku, ku, count)
-            self._mips[key] = blocks.mean(axis=(1, 3), dtype=np.float64).astype(np.float32)
+            reduced = BoxReduced(self.image(tex, count), kv, ku)
+            if self._whole_bytes() + reduced.nbytes <= self._budget:
+                reduced = reduced[np.arange(reduced.shape[0])]
+            self._mips[key] = reduced
         return self._mips[key]
+
+    def _whole_bytes(self) -> int:
+        """Bytes of the textures and reductions this sampler holds decoded whole."""
+        held = [a for a, _ in self._images.values()] + list(self._mips.values())
+        return sum(a.nbytes for a in held if isinstance(a, np.ndarray))
 
     def _taps(self, *key) -> tuple[np.ndarray, np.ndarray]:
         """Taps of a whole axis (:func:`.resample.taps`), computed once per sampler."""
@@ -176,6 +206,39 @@ class MaskSampler:
         v_w = taps(self.height, h, sv, ov, "black")[1].sum(axis=1)
         u_w = taps(self.width, w, su, ou, "black")[1].sum(axis=1)
         return bool((v_w < 1 - 1e-6).any() or (u_w < 1 - 1e-6).any())
+
+
+class BoxReduced:
+    """A source (array or :class:`.TextureFile`) averaged over kv × ku texel blocks, the
+    rows computed when indexed (``reduced[rows]``), from the source rows under them."""
+
+    def __init__(self, source: Any, kv: int, ku: int):
+        h, w, count = source.shape
+        self.source, self.kv, self.ku = source, kv, ku
+        self.shape = (h // kv, w // ku, count)
+        self.dtype = np.dtype(np.float32)
+        self.nbytes = self.shape[0] * self.shape[1] * count * 4
+
+    def __getitem__(self, rows: np.ndarray) -> np.ndarray:
+        rows = np.asarray(rows, dtype=np.int64)
+        wanted = np.unique(rows)
+        under = (wanted[:, None] * self.kv + np.arange(self.kv)).ravel()
+        a = as_float(self.source[under])
+        n, (_, w, count) = len(wanted), self.shape
+        blocks = a.reshape(n, self.kv, w, self.ku, count)
+        out = blocks.mean(axis=(1, 3), dtype=np.float64).astype(np.float32)
+        return out[np.searchsorted(wanted, rows)]
+
+
+def _min_max(chunks) -> tuple[float, float]:
+    """The smallest and largest texel over ``chunks`` (as stored), normalised like
+    :func:`.as_float`."""
+    lo, hi = math.inf, -math.inf
+    for a in chunks:
+        if a.size:
+            bounds = as_float(np.array([a.min(), a.max()], dtype=a.dtype))
+            lo, hi = min(lo, float(bounds[0])), max(hi, float(bounds[1]))
+    return lo, hi
 
 
 def _mip_factor(n_src: int, scale: float, n_out: int) -> int:

@@ -57,30 +57,78 @@ def read_channels(tex: TextureMask, count: int = 1, *, where: str | None = None)
     :class:`TextureError` (one line naming ``where`` and the file) when the file is
     missing, cannot be decoded, lacks the channel, or holds NaN or infinity.
     """
-    path = Path(tex.path)
-    if not path.is_file():
-        raise TextureError(f"texture file {path} does not exist", where=where)
-    buf = oiio.ImageBuf(str(path), 0, 0, _AS_DATA)
-    spec = buf.spec()
-    if buf.has_error or spec.nchannels == 0:
-        raise TextureError(f"cannot decode {path}: {_oiio_error(buf)}", where=where)
-    first = channel_index(tex.channel, list(spec.channelnames))
-    if first is None or first + count > spec.nchannels:
-        wanted = tex.channel if count == 1 else f"{tex.channel} (+{count - 1} more)"
-        raise TextureError(
-            f"{path} has no channel {wanted!r}; it has {', '.join(spec.channelnames)}",
-            where=where,
+    source = TextureFile(tex, count, where=where)
+    return source[np.arange(source.shape[0])]
+
+
+class TextureFile:
+    """A texture's channels read from its file a run of rows at a time, never whole.
+
+    Indexing with UV row indices (``source[rows]``, as a numpy array would be indexed)
+    decodes just those rows, in the file's pixel format (see :func:`read_channels`), so a
+    tile of output needs only the source rows under it in memory. Opening reads the
+    header alone; every read checks what it decoded for NaN and infinity.
+    """
+
+    def __init__(self, tex: TextureMask, count: int = 1, *, where: str | None = None):
+        self.path, self.where, self.count = Path(tex.path), where, count
+        if not self.path.is_file():
+            raise TextureError(f"texture file {self.path} does not exist", where=where)
+        spec = self._open().spec()
+        self.first = channel_index(tex.channel, list(spec.channelnames))
+        if self.first is None or self.first + count > spec.nchannels:
+            wanted = tex.channel if count == 1 else f"{tex.channel} (+{count - 1} more)"
+            raise TextureError(
+                f"{self.path} has no channel {wanted!r}; it has {', '.join(spec.channelnames)}",
+                where=where,
+            )
+        self.y0 = spec.y
+        self.shape = (spec.height, spec.width, count)
+        self.format, self.dtype = _STORED.get(str(spec.format), (oiio.FLOAT, np.float32))
+        self.nbytes = spec.height * spec.width * count * np.dtype(self.dtype).itemsize
+
+    def _open(self) -> oiio.ImageInput:
+        image = oiio.ImageInput.open(str(self.path), _AS_DATA)
+        if image is None or image.spec().nchannels == 0:
+            raise TextureError(f"cannot decode {self.path}: {_oiio_error()}", where=self.where)
+        return image
+
+    def __getitem__(self, rows: np.ndarray) -> np.ndarray:
+        """UV rows ``rows`` (int array, any order, repeats allowed): (len, w, count)."""
+        rows = np.asarray(rows, dtype=np.int64)
+        if rows.size == 0:
+            return np.zeros((0, *self.shape[1:]), dtype=self.dtype)
+        wanted = np.unique(rows)
+        runs = np.split(wanted, np.flatnonzero(np.diff(wanted) != 1) + 1)
+        image = self._open()
+        try:
+            parts = [self._run(image, int(run[0]), int(run[-1]) + 1) for run in runs]
+        finally:
+            image.close()
+        return np.concatenate(parts)[np.searchsorted(wanted, rows)]
+
+    def _run(self, image: oiio.ImageInput, lo: int, hi: int) -> np.ndarray:
+        """UV rows lo..hi-1: file rows h-hi..h-lo-1, flipped (row 0 is v = 0)."""
+        h = self.shape[0]
+        c0 = self.first
+        pixels = image.read_scanlines(
+            0, 0, self.y0 + h - hi, self.y0 + h - lo, 0, c0, c0 + self.count, self.format
         )
-    roi = oiio.ROI(spec.x, spec.x + spec.width, spec.y, spec.y + spec.height, 0, 1)
-    roi.chbegin, roi.chend = first, first + count
-    oiio_type, dtype = _STORED.get(str(spec.format), (oiio.FLOAT, np.float32))
-    pixels = buf.get_pixels(oiio_type, roi)
-    if buf.has_error or pixels is None or np.size(pixels) == 0:
-        raise TextureError(f"cannot read pixels of {path}: {_oiio_error(buf)}", where=where)
-    pixels = np.asarray(pixels, dtype=dtype).reshape(spec.height, spec.width, count)
-    if pixels.dtype.kind == "f" and not np.isfinite(pixels).all():
-        raise TextureError(f"{path} has non-finite pixels (NaN or infinity)", where=where)
-    return np.ascontiguousarray(pixels[::-1])
+        if pixels is None or np.size(pixels) == 0:
+            raise TextureError(
+                f"cannot read pixels of {self.path}: {_oiio_error(image)}", where=self.where
+            )
+        pixels = np.asarray(pixels, dtype=self.dtype).reshape(hi - lo, *self.shape[1:])
+        if pixels.dtype.kind == "f" and not np.isfinite(pixels).all():
+            raise TextureError(
+                f"{self.path} has non-finite pixels (NaN or infinity)", where=self.where
+            )
+        return pixels[::-1]
+
+    def chunks(self, rows: int = 256):
+        """(first UV row, its rows as stored) in runs of ``rows``, bottom to top."""
+        for lo in range(0, self.shape[0], rows):
+            yield lo, self[np.arange(lo, min(lo + rows, self.shape[0]))]
 
 
 def as_float(a: np.ndarray) -> np.ndarray:
@@ -111,8 +159,9 @@ def channel_index(channel: int | str, names: list[str]) -> int | None:
     return alias if alias is not None and alias < len(names) else None
 
 
-def _oiio_error(buf: oiio.ImageBuf) -> str:
-    message = " ".join(buf.geterror().split()) or oiio.geterror() or "unknown format"
+def _oiio_error(image: oiio.ImageInput | None = None) -> str:
+    own = image.geterror() if image is not None else ""
+    message = " ".join(own.split()) or " ".join(oiio.geterror().split()) or "unknown format"
     return message[:200]
 
 
