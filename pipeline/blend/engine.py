@@ -157,13 +157,17 @@ def blend(
 
 def _channels_bound(entries: list[Entry]) -> float:
     """At most how many float channels a blend of ``entries`` writes per texel: the
-    Disney parameters that differ between layers (a normal map adds three); unbounded for
-    Pixar stacks, whose composited weights are many. Sizes the sampler's texture budget."""
+    Disney parameters that differ between layers (each kind of normal map adds three);
+    unbounded for Pixar stacks, whose composited weights are many. Sizes the sampler's
+    texture budget."""
     if entries[0].model != "disney":
         return math.inf
     values = [disney.layer_values(e.params) for e in entries]
     differing = [k for k in values[0] if any(v[k] != values[0][k] for v in values)]
-    normals = any(e.normal_map is not None for e in entries)
+    normals = sum(
+        any(getattr(e, which) is not None for e in entries)
+        for which in ("normal_map", "specular_normal_map")
+    )
     return sum(np.size(values[0][k]) for k in differing) + 3 * normals
 
 
