@@ -36,9 +36,21 @@ import numpy as np
 from .arrays import NumpyOps, from_channel_first, to_channel_first
 
 
+def keep_lobes(xp: Any, prepared: dict[str, Any], names: Any) -> dict[str, Any]:
+    """``prepared`` with only its lobes named in ``names`` evaluated and sampled: the
+    default :attr:`Model.restrict`, for models that choose among ``prepared["lobes"]``
+    as they go (a model that stores sampling odds recomputes them in its own)."""
+    return {**prepared, "lobes": tuple(k for k in prepared["lobes"] if k in names)}
+
+
 @dataclass(frozen=True)
 class Model:
-    """A reflectance model: its name, parameter schema and four core functions."""
+    """A reflectance model: its name, parameter schema and four core functions.
+
+    ``restrict(xp, prepared, names)`` limits a prepared material to some of its lobes:
+    a material whose lobe groups have their own shading normals renders as two
+    restricted halves (:mod:`lookdev.pipeline.export.mitsuba.normals`).
+    """
 
     name: str
     params_type: type
@@ -46,6 +58,7 @@ class Model:
     eval: Callable[..., Any]
     pdf: Callable[..., Any]
     sample: Callable[..., Any]
+    restrict: Callable[..., Any] = keep_lobes
 
 
 def _flatten_maps(maps: dict[str, Any], lead: tuple[int, ...], dtype: Any) -> dict[str, Any]:

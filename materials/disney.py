@@ -363,7 +363,14 @@ def sample_core(xp: Any, pr: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any,
     return wi, weight, pdf
 
 
-MODEL = Model("disney", DisneyParams, prepare, eval_core, pdf_core, sample_core)
+def restrict(xp: Any, prepared: dict[str, Any], names: Any) -> dict[str, Any]:
+    """``prepared`` with only the lobes in ``names``, their sampling odds renormalised."""
+    pr = {**prepared, "lobes": tuple(k for k in prepared["lobes"] if k in names)}
+    pr["odds"], pr["odds_inside"] = lobe_odds(xp, pr)
+    return pr
+
+
+MODEL = Model("disney", DisneyParams, prepare, eval_core, pdf_core, sample_core, restrict)
 
 
 def keep_every_lobe(xp: Any, prepared: dict[str, Any]) -> dict[str, Any]:
@@ -385,10 +392,7 @@ def lobe_model(*names: str) -> Model:
         raise ValueError(f"unknown lobe(s) {sorted(unknown)}; known: {', '.join(LOBES)}")
 
     def prepare_only(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
-        pr = prepare(xp, params, **maps)
-        pr["lobes"] = tuple(k for k in pr["lobes"] if k in names)
-        pr["odds"], pr["odds_inside"] = lobe_odds(xp, pr)
-        return pr
+        return restrict(xp, prepare(xp, params, **maps), names)
 
     return Model(
         "disney[" + ",".join(names) + "]",
@@ -397,6 +401,7 @@ def lobe_model(*names: str) -> Model:
         eval_core,
         pdf_core,
         sample_core,
+        restrict,
     )
 
 

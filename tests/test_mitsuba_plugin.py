@@ -176,9 +176,11 @@ def test_furnace_view_angles_off_centre(mi, monkeypatch):
     np.testing.assert_allclose(got, expected, rtol=0.02)
 
 
-def test_chi2_rejects_a_pdf_that_does_not_match_sampling(mi):
+def test_chi2_rejects_a_pdf_that_does_not_match_sampling(mi, tmp_path, monkeypatch):
     """Negative control: the same chi2 set-up catches a model whose pdf is wrong."""
     import dataclasses
+
+    monkeypatch.chdir(tmp_path)  # a failed test writes chi2_data.py into the working folder
 
     from mitsuba.chi2 import BSDFAdapter, ChiSquareTest, SphericalDomain
 

@@ -389,13 +389,6 @@ def test_normal_maps_wrap_our_bsdf(mi, m, tmp_path):
     assert '<bsdf type="normalmap"' in text and "tiled_normal.exr" in text
 
 
-def test_specular_normal_map_is_reported_not_silently_dropped(m):
-    blended = _blended()
-    blended.specular_normal_map = np.zeros((2, 2, 3), np.float32)
-    with pytest.warns(RuntimeWarning, match="specular normal map"):
-        m.flatten(blended)
-
-
 SCALAR_SCRIPT = """
 import sys, numpy as np, mitsuba as mi
 mi.set_variant("scalar_rgb")

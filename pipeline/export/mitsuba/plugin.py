@@ -36,6 +36,10 @@ from lookdev.materials.errors import LookdevError
 
 PLUGIN_PREFIX = "lookdev_"
 FORCE_ALL_LOBES = "force_all_lobes"
+ONLY_LOBES = "only_lobes"
+"""Comma-separated lobe names: the plugin evaluates and samples only these (Model.restrict)."""
+WEIGHT_SCALE = "weight_scale"
+"""A factor on f and on sampled weights, not on pdfs: halves of a split material carry 2."""
 
 
 class MitsubaExportError(LookdevError):
@@ -133,12 +137,18 @@ def _plugin_class(variant: str) -> type:
             self.xp = DrJitOps.for_mitsuba()
             fields = model.params_type.model_fields
             self.force_all_lobes = False
+            self.only_lobes: tuple[str, ...] | None = None
+            self.weight_scale = 1.0
             self.constants: dict[str, Any] = {}
             self.textures: dict[str, mi.Texture] = {}
             for key in props.keys():
                 value = props[key]
                 if key == FORCE_ALL_LOBES:
                     self.force_all_lobes = bool(value)
+                elif key == ONLY_LOBES:
+                    self.only_lobes = tuple(n.strip() for n in str(value).split(",") if n.strip())
+                elif key == WEIGHT_SCALE:
+                    self.weight_scale = float(value)
                 elif key not in fields:
                     raise MitsubaExportError(
                         f"unknown parameter; allowed: {', '.join(fields)}",
@@ -165,7 +175,9 @@ def _plugin_class(variant: str) -> type:
                 self.constants, where=plugin_name(self.model)
             )
             placeholders = {k: self._placeholder(k) for k in self.textures}
-            prepared = self.model.prepare(self.xp, self.params, **self._forced(), **placeholders)
+            prepared = self._restricted(
+                self.model.prepare(self.xp, self.params, **self._forced(), **placeholders)
+            )
             kinds = lobe_kinds(lobes_of(prepared), self.model.name)
             reflect = [getattr(flag, k) for k in sorted(kinds) if "Reflection" in k]
             transmit = [getattr(flag, k) for k in sorted(kinds) if "Transmission" in k]
@@ -211,7 +223,15 @@ def _plugin_class(variant: str) -> type:
                     maps[key] = self.xp.Array3(tex.eval(si, active))
                 else:
                     maps[key] = tex.eval_1(si, active)
-            return self.model.prepare(self.xp, self.params, **maps)
+            return self._restricted(self.model.prepare(self.xp, self.params, **maps))
+
+        def _scaled(self, value: Any) -> Any:
+            return value if self.weight_scale == 1.0 else value * self.weight_scale
+
+        def _restricted(self, prepared: Any) -> Any:
+            if self.only_lobes is None:
+                return prepared
+            return self.model.restrict(self.xp, prepared, self.only_lobes)
 
         def traverse(self, callback: Any) -> None:
             for key, value in self.traversed.items():
@@ -241,7 +261,7 @@ def _plugin_class(variant: str) -> type:
             prepared = self._prepare(si, active)
             f = self.model.eval(self.xp, prepared, wo, si.wi)  # ours: wi = light, wo = viewer
             ok = active & self._hemisphere_mask(ctx, si.wi.z, wo.z)
-            return dr.select(ok, mi.Spectrum(f) * dr.abs(wo.z), 0.0)
+            return dr.select(ok, self._scaled(mi.Spectrum(f) * dr.abs(wo.z)), 0.0)
 
         def pdf(self, ctx, si, wo, active=True):
             prepared = self._prepare(si, active)
@@ -255,7 +275,7 @@ def _plugin_class(variant: str) -> type:
             pdf = self.model.pdf(self.xp, prepared, wo, si.wi)
             ok = active & self._hemisphere_mask(ctx, si.wi.z, wo.z)
             return (
-                dr.select(ok, mi.Spectrum(f) * dr.abs(wo.z), 0.0),
+                dr.select(ok, self._scaled(mi.Spectrum(f) * dr.abs(wo.z)), 0.0),
                 dr.select(ok, mi.Float(pdf), 0.0),
             )
 
@@ -277,7 +297,7 @@ def _plugin_class(variant: str) -> type:
                 mi.UInt32(_leading(self.components[1], flag)),
             )
             ok = active & (bs.pdf > 0) & self._hemisphere_mask(ctx, si.wi.z, bs.wo.z)
-            value = dr.select(ok, mi.Spectrum(weight), 0.0)
+            value = dr.select(ok, self._scaled(mi.Spectrum(weight)), 0.0)
             bs.pdf = dr.select(ok, bs.pdf, 0.0)
             return bs, value
 

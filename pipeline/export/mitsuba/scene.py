@@ -18,7 +18,6 @@ import importlib
 import math
 import os
 import tempfile
-import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,6 +29,7 @@ from lookdev.materials.bsdf import Model
 from lookdev.materials.params import Params
 from lookdev.materials.pixar import GRAZING
 
+from .normals import with_normals
 from .plugin import (
     FORCE_ALL_LOBES,
     MitsubaExportError,
@@ -99,6 +99,7 @@ class Flat:
     constants: dict[str, Any]
     maps: dict[str, np.ndarray] = field(default_factory=dict)
     normal_map: np.ndarray | None = None
+    specular_normal_map: np.ndarray | None = None  # the highlights' own (see .normals)
 
 
 def flatten(material: Any, resolution: int = DEFAULT_MAP_RESOLUTION) -> Flat:
@@ -160,15 +161,8 @@ def _from_blended(blended: Any) -> Flat:
     maps = {k: np.asarray(v, dtype=np.float32) for k, v in dict(blended.maps).items()}
     if model != blended.model:
         _drop_view_independent(constants, maps)
-    if getattr(blended, "specular_normal_map", None) is not None:
-        warnings.warn(
-            f"{blended.name}: Mitsuba proofs ignore the specular normal map (a Model "
-            "evaluates one shading frame)",
-            RuntimeWarning,
-            stacklevel=3,
-        )
-    normal = getattr(blended, "normal_map", None)
-    return Flat(blended.name, model, constants, maps, normal)
+    normals = (getattr(blended, k, None) for k in ("normal_map", "specular_normal_map"))
+    return Flat(blended.name, model, constants, maps, *normals)
 
 
 def _drop_view_independent(constants: dict[str, Any], maps: dict[str, np.ndarray]) -> None:
@@ -234,10 +228,23 @@ def bsdf_dict(
     flat = flatten(material, resolution)
     register_plugins()
     model = model_for(flat.model)
-    model.params_type.parse(flat.constants, where=flat.name)  # one line on bad input, here
-    fast = None if force_all_lobes or not allow_principled else principled_equivalent(flat)
-    if fast is not None:
-        return fast
+    params = model.params_type.parse(flat.constants, where=flat.name)  # one line, here
+    one_frame = flat.specular_normal_map is None
+    fast = principled_equivalent(flat) if allow_principled and one_frame else None
+    out = _plugin_dict(model, flat, texture_dir) if force_all_lobes or fast is None else fast
+    if force_all_lobes:
+        out[FORCE_ALL_LOBES] = True
+
+    def normal_texture(normals: np.ndarray, name: str) -> dict[str, Any]:
+        encoded = _encode_normals(np.asarray(normals, dtype=np.float32))
+        return _bitmap(encoded, True, flat, name, texture_dir)
+
+    frames = (flat.normal_map, flat.specular_normal_map)
+    return with_normals(out, model, params, flat.maps, frames, normal_texture, force_all_lobes)
+
+
+def _plugin_dict(model: Model, flat: Flat, texture_dir: str | Path | None) -> dict[str, Any]:
+    """Our plugin for ``flat``: constants as values, maps as ``bitmap`` textures."""
     out: dict[str, Any] = {"type": register_model(model)}
     for key, value in flat.constants.items():
         out[key] = _constant(value)
@@ -245,12 +252,6 @@ def bsdf_dict(
         if key not in model.params_type.model_fields:
             raise MitsubaExportError("unknown parameter map", where=flat.name, field=key)
         out[key] = _bitmap(array, is_color_field(model.params_type, key), flat, key, texture_dir)
-    if force_all_lobes:
-        out[FORCE_ALL_LOBES] = True
-    if flat.normal_map is not None:
-        normal = _encode_normals(np.asarray(flat.normal_map, dtype=np.float32))
-        tex = _bitmap(normal, True, flat, "normal", texture_dir)
-        out = {"type": "normalmap", "normalmap": tex, "bsdf": out}
     return out
 
 
