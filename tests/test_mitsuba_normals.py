@@ -179,3 +179,8 @@ def test_a_split_material_exports_to_xml_and_renders(mi, tmp_path):
     out.write_text(text)
     image = np.array(mi.render(mi.load_file(str(out))))
     assert image.shape == (8, 8, 3) and np.all(np.isfinite(image)) and image.mean() > 0
+
+
+def test_a_metal_on_the_principled_fast_path_keeps_its_normal_map(mi):
+    d = _bsdf(_blended(metallic=1.0, roughness=0.2, normal=TILTED, specular=None))
+    assert d["type"] == "normalmap" and d["bsdf"]["type"] == "principled"
