@@ -105,7 +105,10 @@ class TextureFile:
             parts = [self._run(image, int(run[0]), int(run[-1]) + 1) for run in runs]
         finally:
             image.close()
-        return np.concatenate(parts)[np.searchsorted(wanted, rows)]
+        read = parts[0] if len(parts) == 1 else np.concatenate(parts)
+        if len(rows) == len(wanted) and (rows == wanted).all():
+            return read  # rows asked for in order, each once: no copy
+        return read[np.searchsorted(wanted, rows)]
 
     def _run(self, image: oiio.ImageInput, lo: int, hi: int) -> np.ndarray:
         """UV rows lo..hi-1: file rows h-hi..h-lo-1, flipped (row 0 is v = 0)."""
@@ -123,7 +126,7 @@ class TextureFile:
             raise TextureError(
                 f"{self.path} has non-finite pixels (NaN or infinity)", where=self.where
             )
-        return pixels[::-1]
+        return np.ascontiguousarray(pixels[::-1])
 
     def chunks(self, rows: int = 256):
         """(first UV row, its rows as stored) in runs of ``rows``, bottom to top."""
