@@ -62,7 +62,7 @@ def read_channels(tex: TextureMask, count: int = 1, *, where: str | None = None)
 
 
 class TextureFile:
-    """A texture's channels read from its file a run of rows at a time, never whole.
+    """A texture's channels read from its file a run of rows at a time, only those asked for.
 
     Indexing with UV row indices (``source[rows]``, as a numpy array would be indexed)
     decodes just those rows, in the file's pixel format (see :func:`read_channels`), so a
@@ -74,7 +74,9 @@ class TextureFile:
         self.path, self.where, self.count = Path(tex.path), where, count
         if not self.path.is_file():
             raise TextureError(f"texture file {self.path} does not exist", where=where)
-        spec = self._open().spec()
+        image = self._open()
+        spec = image.spec()
+        image.close()
         self.first = channel_index(tex.channel, list(spec.channelnames))
         if self.first is None or self.first + count > spec.nchannels:
             wanted = tex.channel if count == 1 else f"{tex.channel} (+{count - 1} more)"
