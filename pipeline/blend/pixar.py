@@ -14,11 +14,10 @@ from typing import Any
 
 import numpy as np
 
-from lookdev.materials.pixar import WEIGHT_NAMES
 from lookdev.materials.pixar_scatter import LOBES, PREFIX
 
 from .masks import MaskSampler
-from .pixar_composite import GROUP, Lobes, Part, composite, energy_sum, layer_lobes, unit
+from .pixar_composite import GROUP, Lobes, Part, composite, layer_lobes, unit
 from .stack import Entry, prune_stack
 
 VIEWS = {"": 1.0, "_grazing": 0.0}
@@ -186,4 +185,4 @@ def _is_flat(normals: np.ndarray) -> bool:
     return bool(np.all(normals == np.array([0.0, 0.0, 1.0], dtype=normals.dtype)))
 
 
-__all__ = ["WEIGHT_NAMES", "Lobes", "Part", "composite", "energy_sum", "layer_lobes"]
+__all__ = ["VIEWS", "blend_stack", "opaque"]
