@@ -109,3 +109,13 @@ def test_bench_blend_reports_resident_peaks_of_both_cases(cli):
     doc = json.loads(r.out)
     for case in ("stack", "large_masks"):
         assert doc[f"peak_rss_mb_{case}"] >= 0 and math.isfinite(doc[f"peak_rss_to_output_{case}"])
+        assert doc["targets_met"][f"peak_rss_to_output_{case}"] in (True, False)
+    assert doc["output_mb_large_masks"] == 16 * 16 * 4 / 1e6  # one float32 map: roughness
+    assert "peak_to_output" in doc  # tracemalloc's figure stays beside the resident one
+
+
+def test_bench_blend_table_says_met_or_missed(cli):
+    r = cli("bench", "blend", "--resolution", "16", "--repeat", "1")
+    assert r.code == 0, r.err
+    assert "peak_rss_to_output_large_masks" in r.out
+    assert "< 2: met" in r.out or "< 2: missed" in r.out
