@@ -17,7 +17,7 @@ different per layer, so all parameter maps vary. Measured in one run:
   reset just before the blend) in a child process, so that everything counts, OpenImageIO
   and OpenEXR included; for this stack and for :func:`large_mask_material`, float EXR
   masks at twice the resolution driving a single map (where decoded masks, not maps,
-  would dominate);
+  would dominate), streamed and, as the baseline, ``_decoded`` whole;
 - ``targets_met``: each bounded figure against :data:`TARGETS` (the table's target column);
 - pruning: the same blend with ``prune=False`` on the built-in ``rusty_car_paint`` (maps
   that need not vary) and on this stack with a full-coverage layer and a zero layer added
@@ -109,7 +109,7 @@ def run(resolution: int, folder: Path, *, repeat: int = 3) -> dict[str, Any]:
     best = _against_copy(lambda: blend(material, resolution, images=images), out.nbytes, repeat)
     cold = interleaved_best({"blend_cold_s": lambda: blend(material, resolution)}, 1)
     peak = peak_bytes(lambda: blend(material, resolution))
-    rss = {case: peak_rss(case, folder, resolution) for case in ("stack", "large_masks")}
+    rss = {case: peak_rss(case, folder, resolution) for case in _CASES}
     result = {
         "resolution": resolution,
         "layers": LAYERS,
@@ -241,7 +241,13 @@ def _roughness(name: str, value: float):
     return Material(name=name, model="disney", params=DisneyParams(roughness=value))
 
 
-_CASES = {"stack": bench_material, "large_masks": large_mask_material}
+_CASES = {
+    "stack": bench_material,
+    "large_masks": large_mask_material,
+    "large_masks_decoded": large_mask_material,
+}
+"""Cases of :func:`peak_rss`; ``*_decoded`` blends with the masks decoded whole (a caller's
+image cache, as blend did before it streamed large masks): the baseline of the same run."""
 
 
 def peak_rss(case: str, folder: Path, resolution: int) -> dict[str, int]:
@@ -274,7 +280,7 @@ def child_peak(case: str, folder: str, resolution: int) -> None:
     material = _CASES[case](Path(folder), resolution)
     before = _status_kb("VmRSS")
     Path("/proc/self/clear_refs").write_text("5")
-    out = blend(material, resolution)
+    out = blend(material, resolution, images={} if case.endswith("_decoded") else None)
     peak = (_status_kb("VmHWM") - before) * 1024
     print(json.dumps({"peak_bytes": peak, "output_bytes": out.nbytes}))
 
