@@ -11,7 +11,7 @@ import pytest
 from _blend_helpers import disney, layer, layered, write_image
 
 from lookdev.materials.layers import TextureMask
-from lookdev.pipeline.blend import MaskSampler, TextureError, blend
+from lookdev.pipeline.blend import MaskSampler, TextureError, blend, resample
 from lookdev.pipeline.blend.masks import BoxReduced
 from lookdev.pipeline.blend.resample import TextureFile, read_channels
 
@@ -37,6 +37,30 @@ def test_rows_read_from_the_file_equal_the_whole_image(tmp_path, fmt, suffix, ch
     assert source.shape == whole.shape and source.dtype == whole.dtype
     for rows in ([0], [36], [36, 0, 36], [5, 6, 7, 20, 21], list(range(37))[::-1], []):
         np.testing.assert_array_equal(source[np.array(rows, dtype=int)], whole[rows])
+
+
+@pytest.mark.parametrize("fmt, suffix", FORMATS)
+@pytest.mark.parametrize("channel, count", [("R", 1), ("G", 1), ("R", 3)])
+def test_rows_read_in_chunks_equal_openimageio_whole_image(
+    tmp_path, monkeypatch, fmt, suffix, channel, count
+):
+    """Chunks of 32 rows (the smallest) across runs of every length: each chunk lands
+    flipped in its place, as stored; the reference is ImageBuf's whole decode."""
+    monkeypatch.setattr(resample, "_CHUNK_BYTES", 1)
+    rng = np.random.default_rng(11)
+    pixels = rng.random((101, 19, 3), dtype=np.float32)
+    pixels[:7] = 0.0  # exactly 0 and 1 survive every format
+    pixels[-5:] = 1.0
+    path = write_image(tmp_path / f"m.{suffix}", pixels, fmt=fmt)
+    first = "RGB".index(channel)
+    buf = oiio.ImageBuf(str(path))
+    whole = buf.get_pixels(fmt, oiio.ROI(0, 19, 0, 101, 0, 1, first, first + count))
+    expected = np.asarray(whole).reshape(101, 19, count)[::-1]  # UV order: row 0 at v = 0
+    source = TextureFile(TextureMask(path=path, channel=channel), count)
+    for rows in (range(101), range(31, 97), range(32, 64), [100, 0, 33, 34, 35, 64, 65]):
+        np.testing.assert_array_equal(source[np.array(list(rows))], expected[list(rows)])
+    exact = resample.as_float(expected)
+    assert (exact[-7:] == 0).all() and (exact[:5] == 1).all()
 
 
 @pytest.mark.parametrize("wrap", ["periodic", "clamp", "black", "mirror"])

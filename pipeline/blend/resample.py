@@ -44,6 +44,10 @@ _STORED = {
 }
 """File pixel formats kept as they are in memory (OpenImageIO type, numpy dtype)."""
 
+_CHUNK_BYTES = 1 << 20
+"""Bytes of scanlines decoded per OpenImageIO call (rounded to 32 rows, OpenEXR's largest
+common block), the transient a read costs on top of the rows it returns."""
+
 _ALIASES = {"r": 0, "g": 1, "b": 2, "a": 3, "x": 0, "y": 1, "z": 2}
 """Channel letters understood when a file does not name its channels that way."""
 
@@ -102,33 +106,40 @@ class TextureFile:
             return np.zeros((0, *self.shape[1:]), dtype=self.dtype)
         wanted = np.unique(rows)
         runs = np.split(wanted, np.flatnonzero(np.diff(wanted) != 1) + 1)
+        read = np.empty((wanted.size, *self.shape[1:]), dtype=self.dtype)
         image = self._open()
         try:
-            parts = [self._run(image, int(run[0]), int(run[-1]) + 1) for run in runs]
+            start = 0
+            for run in runs:
+                self._run(image, int(run[0]), read[start : start + run.size])
+                start += run.size
         finally:
             image.close()
-        read = parts[0] if len(parts) == 1 else np.concatenate(parts)
         if len(rows) == len(wanted) and (rows == wanted).all():
             return read  # rows asked for in order, each once: no copy
         return read[np.searchsorted(wanted, rows)]
 
-    def _run(self, image: oiio.ImageInput, lo: int, hi: int) -> np.ndarray:
-        """UV rows lo..hi-1: file rows h-hi..h-lo-1, flipped (row 0 is v = 0)."""
-        h = self.shape[0]
-        c0 = self.first
-        pixels = image.read_scanlines(
-            0, 0, self.y0 + h - hi, self.y0 + h - lo, 0, c0, c0 + self.count, self.format
-        )
-        if pixels is None or np.size(pixels) == 0:
-            raise TextureError(
-                f"cannot read pixels of {self.path}: {_oiio_error(image)}", where=self.where
-            )
-        pixels = np.asarray(pixels, dtype=self.dtype).reshape(hi - lo, *self.shape[1:])
-        if pixels.dtype.kind == "f" and not np.isfinite(pixels).all():
-            raise TextureError(
-                f"{self.path} has non-finite pixels (NaN or infinity)", where=self.where
-            )
-        return np.ascontiguousarray(pixels[::-1])
+    def _run(self, image: oiio.ImageInput, lo: int, out: np.ndarray) -> None:
+        """UV rows lo..lo+len(out)-1 into ``out``: file rows h-lo-n..h-lo-1, flipped (row 0
+        is v = 0). Read a chunk of about :data:`_CHUNK_BYTES` at a time and flipped into
+        place, so that a run costs its own bytes plus one chunk, not twice its bytes."""
+        h, w, count = self.shape
+        n, c0 = len(out), self.first
+        step = max(32, _CHUNK_BYTES // (w * count * out.itemsize) // 32 * 32)
+        for top in range(0, n, step):  # top: rows from the run's top edge, in file order
+            rows = min(step, n - top)
+            y = self.y0 + h - lo - n + top
+            pixels = image.read_scanlines(0, 0, y, y + rows, 0, c0, c0 + count, self.format)
+            if pixels is None or np.size(pixels) == 0:
+                raise TextureError(
+                    f"cannot read pixels of {self.path}: {_oiio_error(image)}", where=self.where
+                )
+            pixels = np.asarray(pixels, dtype=self.dtype).reshape(rows, w, count)
+            if pixels.dtype.kind == "f" and not np.isfinite(pixels).all():
+                raise TextureError(
+                    f"{self.path} has non-finite pixels (NaN or infinity)", where=self.where
+                )
+            out[n - top - rows : n - top] = pixels[::-1]
 
     def chunks(self, rows: int = 256):
         """(first UV row, its rows as stored) in runs of ``rows``, bottom to top."""
