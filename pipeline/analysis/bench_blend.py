@@ -58,8 +58,10 @@ def command(
     """Blend 4 texture-masked Disney layers into all parameter maps vs a numpy copy.
 
     Reports the time against the memory-bandwidth bound measured in the same run
-    (target ≤ 4×), peak memory against the output size (target < 2×), and what pruning
-    saved on a preset where it applies.
+    (target ≤ 4×), peak memory against the output size (target < 2×: numpy's traced peak,
+    and the resident peak of a child process, OpenImageIO's buffers included, for this
+    stack and for large float EXR masks driving one map), and what pruning saved on a
+    preset where it applies. The target column says met or missed.
     """
     from lookdev.pipeline.cli.common import console, print_json, table
 
