@@ -26,15 +26,17 @@ from typing import Any, Literal
 import tomli_w
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
+from lookdev.materials import registry
 from lookdev.materials.errors import ParameterError
 from lookdev.materials.layers import ConstantMask, LayerSpec
-from lookdev.materials.params import DisneyParams, Params, parameter_error
-from lookdev.materials.pixar import PixarParams
+from lookdev.materials.params import Params, parameter_error
 
 from .errors import PresetError
 
-MODELS: dict[str, type[Params]] = {"disney": DisneyParams, "pixar": PixarParams}
-"""Parameter schema of each reflectance model a preset may name."""
+MODELS: dict[str, type[Params]] = {
+    name: registry.MODELS[name].params_type for name in registry.PRESET_MODELS
+}
+"""Parameter schema of each reflectance model a preset may name (from the registry)."""
 
 MAX_BYTES = 1 << 20  # presets are hand-written text; anything larger is not one
 NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]{0,99}")  # whole names: fullmatch

@@ -36,6 +36,34 @@ import numpy as np
 from .arrays import NumpyOps, from_channel_first, to_channel_first
 
 
+@dataclass(frozen=True)
+class Lobe:
+    """One lobe of a model: how it scatters, which normal shades it, what drives it.
+
+    ``params`` are the parameters that act through this lobe alone (or only through lobes
+    listed with them): where every lobe naming a parameter is dead, the parameter has no
+    effect. Parameters no lobe names (``base_color``, ``roughness`` …) are always live.
+    Whether the lobe is live is never decided here but by the model's own ``prepare``
+    (:func:`lookdev.materials.registry.live_lobes`), the one rule every consumer asks.
+    """
+
+    name: str
+    scattering: str
+    """``"diffuse"`` or ``"glossy"`` (Mitsuba's BSDF flag families)."""
+    transmits: bool = False
+    highlight: bool = False
+    """Shaded with the highlight (specular) normal where a material has two (Smits, Burley §6)."""
+    family: str = ""
+    """Smits' lobe type (diffuse, specular, reflection) shared by a lobe and its
+    transmitted twin; the lobe's own name where it has no twin."""
+    params: tuple[str, ...] = ()
+
+    @property
+    def mitsuba_flag(self) -> str:
+        """The ``mi.BSDFFlags`` member of this lobe (``GlossyTransmission`` …)."""
+        return self.scattering.title() + ("Transmission" if self.transmits else "Reflection")
+
+
 def keep_lobes(xp: Any, prepared: dict[str, Any], names: Any) -> dict[str, Any]:
     """``prepared`` with only its lobes named in ``names`` evaluated and sampled: the
     default :attr:`Model.restrict`, for models that choose among ``prepared["lobes"]``
@@ -59,6 +87,19 @@ class Model:
     pdf: Callable[..., Any]
     sample: Callable[..., Any]
     restrict: Callable[..., Any] = keep_lobes
+    lobes: tuple[Lobe, ...] = ()
+
+    def lobe(self, name: str) -> Lobe:
+        """The lobe called ``name``; a ``KeyError`` naming the known ones otherwise."""
+        for lobe in self.lobes:
+            if lobe.name == name:
+                return lobe
+        known = ", ".join(lobe.name for lobe in self.lobes)
+        raise KeyError(f"model {self.name!r} has no lobe {name!r}; known: {known}")
+
+    @property
+    def lobe_names(self) -> tuple[str, ...]:
+        return tuple(lobe.name for lobe in self.lobes)
 
 
 def _flatten_maps(maps: dict[str, Any], lead: tuple[int, ...], dtype: Any) -> dict[str, Any]:

@@ -49,6 +49,7 @@ from .arrays import NumpyOps
 from .bsdf import Model, density, draw, evaluate
 from .disney_prepare import (
     CLEARCOAT_F0,
+    DISNEY_LOBES,
     INV_PI,
     LOBES,
     lobe_odds,
@@ -370,7 +371,9 @@ def restrict(xp: Any, prepared: dict[str, Any], names: Any) -> dict[str, Any]:
     return pr
 
 
-MODEL = Model("disney", DisneyParams, prepare, eval_core, pdf_core, sample_core, restrict)
+MODEL = Model(
+    "disney", DisneyParams, prepare, eval_core, pdf_core, sample_core, restrict, DISNEY_LOBES
+)
 
 
 def keep_every_lobe(xp: Any, prepared: dict[str, Any]) -> dict[str, Any]:
@@ -402,6 +405,7 @@ def lobe_model(*names: str) -> Model:
         pdf_core,
         sample_core,
         restrict,
+        DISNEY_LOBES,
     )
 
 

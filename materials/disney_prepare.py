@@ -11,6 +11,7 @@ from typing import Any
 
 from . import fresnel as fr
 from . import microfacet as mf
+from .bsdf import Lobe
 from .params import SPECULAR_F0_SCALE, DisneyParams
 
 INV_PI = 1.0 / math.pi
@@ -19,7 +20,16 @@ CLEARCOAT_F0 = 0.04  # IOR 1.5 polyurethane (Burley §5.4)
 SCHLICK_MEAN = 1.0 / 21.0  # ∫ (1 − μ)⁵ 2μ dμ: hemispherical mean of the Schlick weight
 SHEEN_ALBEDO_GUESS = 0.1  # rough albedo of sheen 1, only used to weight sampling
 ETA_MIN = 1.001  # as Mitsuba: at η = 1 the rough BTDF becomes a delta
-LOBES = ("diffuse", "diff_trans", "sheen", "specular", "clearcoat", "spec_trans")
+DISNEY_LOBES = (
+    Lobe("diffuse", "diffuse", params=("subsurface", "flatness")),
+    Lobe("diff_trans", "diffuse", transmits=True, params=("diff_trans",)),
+    Lobe("sheen", "glossy", params=("sheen", "sheen_tint", "sheen_model", "sheen_roughness")),
+    Lobe("specular", "glossy", highlight=True),
+    Lobe("clearcoat", "glossy", highlight=True, params=("clearcoat", "clearcoat_gloss")),
+    Lobe("spec_trans", "glossy", transmits=True, highlight=True, params=("spec_trans",)),
+)
+"""Burley 2012 §5 and Schutte 2018 §3; weights in :func:`prepare` (``weights``)."""
+LOBES = tuple(lobe.name for lobe in DISNEY_LOBES)
 
 
 # -- parameters --------------------------------------------------------------------------

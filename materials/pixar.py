@@ -35,6 +35,7 @@ is the second after one step: parameters → weights → the same prepared dict
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Annotated, Any
 
 import numpy as np
@@ -45,7 +46,15 @@ from .arrays import NumpyOps
 from .bsdf import Model, density, draw, evaluate
 from .params import Color, Params, parse_color, register_schema
 from .pixar_lobes import LN_10
-from .pixar_scatter import at_view, prepared, scatter_eval, scatter_pdf, scatter_sample
+from .pixar_scatter import (
+    PIXAR_LOBES,
+    PREFIX,
+    at_view,
+    prepared,
+    scatter_eval,
+    scatter_pdf,
+    scatter_sample,
+)
 
 DIELECTRIC_REFL = 0.05  # Smits' default normal reflectance of a dielectric
 
@@ -280,10 +289,24 @@ def _scalar(xp: Any, params: Any, maps: dict[str, Any], name: str) -> Any:
     return xp.scalar(maps.get(name, getattr(params, name)))
 
 
+def _weights_of(lobe: str) -> tuple[str, ...]:
+    """The composited weights (both ends of the view) that drive one lobe."""
+    stems = (PREFIX[lobe] + end for end in "NG")
+    return tuple(name for stem in stems for name in (stem, stem + GRAZING))
+
+
 # -- the Model -----------------------------------------------------------------------------
-MODEL = Model("pixar", PixarParams, _prepare, scatter_eval, scatter_pdf, scatter_sample)
+MODEL = Model(
+    "pixar", PixarParams, _prepare, scatter_eval, scatter_pdf, scatter_sample, lobes=PIXAR_LOBES
+)
 LAYERED_MODEL = Model(
-    "pixar_layered", PixarLobeWeights, _prepare_weights, scatter_eval, scatter_pdf, scatter_sample
+    "pixar_layered",
+    PixarLobeWeights,
+    _prepare_weights,
+    scatter_eval,
+    scatter_pdf,
+    scatter_sample,
+    lobes=tuple(replace(lobe, params=_weights_of(lobe.name)) for lobe in PIXAR_LOBES),
 )
 """The same lobes driven by composited weights: a layered Pixar material's BSDF."""
 

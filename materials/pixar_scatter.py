@@ -13,8 +13,45 @@ from __future__ import annotations
 from typing import Any
 
 from . import pixar_lobes as lobes
+from .bsdf import Lobe
 
-LOBES = ("diffuse", "specular", "reflection", "diffuse_t", "specular_t", "reflection_t")
+PIXAR_LOBES = (
+    Lobe("diffuse", "diffuse", family="diffuse", params=("diffuse_scale",)),
+    Lobe(
+        "specular",
+        "glossy",
+        highlight=True,
+        family="specular",
+        params=("specular_scale", "specular_cone_scale", "specular_tint"),
+    ),
+    Lobe(
+        "reflection",
+        "glossy",
+        highlight=True,
+        family="reflection",
+        params=("reflection_scale", "reflection_cone_scale", "specular_tint"),
+    ),
+    Lobe("diffuse_t", "diffuse", True, family="diffuse", params=("back", "diffuse_t_scale")),
+    Lobe(
+        "specular_t",
+        "glossy",
+        True,
+        highlight=True,
+        family="specular",
+        params=("specular_t_scale", "transmission_tint", "ior"),
+    ),
+    Lobe(
+        "reflection_t",
+        "glossy",
+        True,
+        highlight=True,
+        family="reflection",
+        params=("reflection_t_scale", "transmission_tint", "ior"),
+    ),
+)
+"""Smits' three lobes and their transmitted twins; a lobe's ``family`` is its type in
+his interaction table. Parameters named by a lobe act through it (and its listed peers)."""
+LOBES = tuple(lobe.name for lobe in PIXAR_LOBES)
 PREFIX = dict(zip(LOBES, ("diff", "spec", "refl", "diffT", "specT", "reflT"), strict=True))
 """lobe → the stem of its weights in Smits' notebook (``diffN``, ``diffG`` …)."""
 

@@ -48,7 +48,7 @@ import numpy as np
 from pydantic import Field
 
 from .arrays import NumpyOps
-from .bsdf import Model, density, draw, evaluate
+from .bsdf import Lobe, Model, density, draw, evaluate
 from .params import Color, Params, register_schema
 from .sheen_albedo import N_MU as _N_MU
 from .sheen_albedo import N_R as _N_R
@@ -234,7 +234,7 @@ def base_scale(
 def _prepare(xp: Any, params: SheenParams, **maps: Any) -> dict[str, Any]:
     color = xp.color(maps.get("color", params.color))
     r = xp.scalar(maps.get("roughness", params.roughness))
-    lobes = () if xp.known_zero(color) else ("sheen",)
+    lobes = () if xp.known_zero(color) else (SHEEN_LOBES[0].name,)
     return {"color": color, "r": r, "soften": params.terminator_softening, "lobes": lobes}
 
 
@@ -264,7 +264,8 @@ def _sample(xp: Any, prepared: dict[str, Any], wo: Any, u: Any) -> tuple[Any, An
 
 # [without, with] terminator softening, each (n_r, n_mu).
 _TABLES = np.asarray(_TABLE_VALUES, dtype=np.float64).reshape(2, _N_R, _N_MU)
-MODEL = Model("sheen", SheenParams, _prepare, _eval, _pdf, _sample)
+SHEEN_LOBES = (Lobe("sheen", "glossy", params=("color", "roughness", "terminator_softening")),)
+MODEL = Model("sheen", SheenParams, _prepare, _eval, _pdf, _sample, lobes=SHEEN_LOBES)
 
 
 # -- public numpy API ----------------------------------------------------------------------

@@ -11,7 +11,7 @@ import math
 
 from pydantic import Field
 
-from lookdev.materials.bsdf import Model
+from lookdev.materials.bsdf import Lobe, Model
 from lookdev.materials.params import Color, Params
 
 
@@ -56,5 +56,6 @@ def _sample(xp, p, wo, u):
     return wi, p["rho"] * _view_factor(xp, wo), _pdf(xp, p, wi, wo)
 
 
-TINY = Model("tiny_test", TinyParams, _prepare, _eval, _pdf, _sample)
+LOBES = (Lobe("diffuse", "diffuse"), Lobe("diff_trans", "diffuse", transmits=True))
+TINY = Model("tiny_test", TinyParams, _prepare, _eval, _pdf, _sample, lobes=LOBES)
 MODEL = TINY  # what lookdev.pipeline.export.mitsuba.scene.model_for looks up

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from _lambert import LambertParams
 
+from lookdev.materials import registry
 from lookdev.materials.bsdf import Model
 from lookdev.pipeline.analysis import stability, stability_cases
 
@@ -45,7 +46,7 @@ MODEL = Model("broken", LambertParams, _prepare, _eval, _pdf, _sample)
 
 @pytest.fixture
 def broken_registered(monkeypatch):
-    monkeypatch.setitem(stability_cases.MODEL_MODULES, "broken", "test_check")
+    monkeypatch.setitem(registry.MODELS, "broken", MODEL)
 
 
 # -- the sweep ------------------------------------------------------------------------------
@@ -139,11 +140,3 @@ def test_unknown_model_is_one_line_and_exit_2(cli):
     assert result.err.count("\n") == 1
     assert "velvet" in result.err and "disney, sheen, pixar" in result.err
     assert "Traceback" not in result.err
-
-
-def test_missing_model_is_skipped_not_fatal(cli, monkeypatch):
-    monkeypatch.setitem(stability_cases.MODEL_MODULES, "ghost", "lookdev.materials.no_such_model")
-    result = cli("check", "--model", "ghost", "--model", "sheen", "--json")
-    data = json.loads(result.out)
-    assert result.code == 0
-    assert "ghost" in data["missing"] and "sheen" in data["models"]

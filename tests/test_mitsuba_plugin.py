@@ -162,9 +162,10 @@ def test_unknown_parameter_is_one_line_error(mi, tiny):
 
 def test_furnace_view_angles_off_centre(mi, monkeypatch):
     """The pixel-angle helper, checked where the tiny model's albedo ρ(1 + cos θ)/2 varies."""
+    from lookdev.materials import registry
     from lookdev.pipeline.export.mitsuba import scene as export
 
-    monkeypatch.setitem(export.MODEL_MODULES, "tiny_test", "_mitsuba_tiny")
+    monkeypatch.setitem(registry.MODELS, "tiny_test", TINY)
     params = TinyParams(base_color=(0.8, 0.5, 0.2))
     scene = export.scene_dict(params, resolution=(32, 32), spp=512, max_depth=2)
     image = np.array(mi.render(mi.load_dict(scene), seed=2))

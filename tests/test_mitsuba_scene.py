@@ -24,9 +24,12 @@ def mi():
 @pytest.fixture
 def m(mi, monkeypatch):
     """The export module with the tiny test model known as model 'tiny_test'."""
+    from _mitsuba_tiny import TINY
+
+    from lookdev.materials import registry
     from lookdev.pipeline.export.mitsuba import scene
 
-    monkeypatch.setitem(scene.MODEL_MODULES, "tiny_test", "_mitsuba_tiny")
+    monkeypatch.setitem(registry.MODELS, "tiny_test", TINY)
     return scene
 
 

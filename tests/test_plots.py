@@ -287,9 +287,9 @@ def test_layered_preset_is_plotted_at_its_centre_texel():
     from lookdev.pipeline.blend import blend
 
     subject = P.subject_for("rusty_iron")
-    blended = blend(load_material("rusty_iron"), P.LAYERED_RESOLUTION)
+    blended = blend(load_material("rusty_iron"), P.MAP_RESOLUTION)
     assert blended.maps, "rusty_iron should vary across the surface"
-    n = P.LAYERED_RESOLUTION // 2
+    n = P.MAP_RESOLUTION // 2
     assert subject.label == "rusty_iron"
     assert subject.params == blended.params_at(n, n)
     assert subject.maps.keys() == blended.maps.keys()

@@ -51,13 +51,13 @@ def measure(preset: str, s: Settings) -> dict[str, Any]:
     import mitsuba as mi
 
     from lookdev.library import load_material
+    from lookdev.pipeline.blend import blend
     from lookdev.pipeline.export.mitsuba import bsdf_dict, max_depth_for
-    from lookdev.pipeline.export.mitsuba.scene import flatten
-    from lookdev.pipeline.proof import ibl, shaderball
+    from lookdev.pipeline.proof import batch, ibl, shaderball
 
-    flat = flatten(load_material(preset))
-    depth = max_depth_for(flat)
-    bsdf = bsdf_dict(flat)
+    hub = blend(load_material(preset), batch.MAP_RESOLUTION)
+    depth = max_depth_for(hub)
+    bsdf = bsdf_dict(hub)
     env = ibl.load(s.ibl, s.ibl_width)
     if s.reference_depth <= depth:
         raise BenchDepthError(

@@ -250,13 +250,14 @@ def run(s: Settings) -> dict[str, Any]:
     steadier of the two, and the recorded load average says which to trust.
     """
     from lookdev.library import load_material
-    from lookdev.pipeline.proof import ibl
+    from lookdev.pipeline.blend import blend
+    from lookdev.pipeline.proof import batch, ibl
     from lookdev.pipeline.proof.turntable import material_bsdf
     from lookdev.pipeline.variant import use_mitsuba
 
     variant = use_mitsuba()
     load_before = os.getloadavg()[0]
-    material = load_material(s.preset)
+    material = blend(load_material(s.preset), batch.MAP_RESOLUTION)
     env = ibl.load(s.ibl, s.ibl_width)
     bsdf, depth = material_bsdf(material)
     forced, _ = material_bsdf(material, force_all_lobes=True)

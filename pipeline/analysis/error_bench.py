@@ -144,7 +144,9 @@ def render_cases(library: Any = None) -> tuple[list[tuple[str, dict, int]], dict
     and the reasons for any gaps."""
     try:
         from lookdev.library import load_material
+        from lookdev.pipeline.blend import blend
         from lookdev.pipeline.export.mitsuba import register_plugins
+        from lookdev.pipeline.proof.batch import MAP_RESOLUTION
         from lookdev.pipeline.proof.turntable import material_bsdf
     except ImportError as exc:
         return [], {f"render: {label}": f"not available: {exc}" for label in RENDER_PRESETS}
@@ -152,7 +154,7 @@ def render_cases(library: Any = None) -> tuple[list[tuple[str, dict, int]], dict
     cases, missing = [], {}
     for label, preset in RENDER_PRESETS.items():
         try:
-            bsdf, depth = material_bsdf(load_material(preset, library))
+            bsdf, depth = material_bsdf(blend(load_material(preset, library), MAP_RESOLUTION))
             cases.append((f"{label} ({preset})", bsdf, depth))
         except LookdevError as exc:
             missing[f"render: {label}"] = str(exc)
@@ -172,12 +174,7 @@ def run(
     """Measure every asked item now. ``render``/``models`` override what is discovered."""
     report = Report()
     if models is None:
-        from .stability_cases import available_models
-
-        models, missing = available_models()
-        report.skipped.update({f"model {name}": why for name, why in missing.items()})
-    if not models:
-        report.skipped["albedo, precision"] = "no reflectance model is installed"
+        from lookdev.materials.registry import MODELS as models
     tasks: list[tuple[str, Callable[[], list[Row]]]] = []
     if "render" in items:
         from lookdev.pipeline.variant import use_mitsuba

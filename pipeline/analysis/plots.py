@@ -2,7 +2,9 @@
 
 Each view is a pair: a pure function that computes its numbers (tested against
 independent computations) and a ``draw_*`` function that puts them on a matplotlib axis.
-:func:`figure` lays several materials side by side, one column each, labelled.
+:func:`figure` lays several blended materials side by side, one column each, labelled;
+a material that varies across its surface is wrapped onto the sphere and shown by its
+centre texel in the other views.
 
 * ``slice``  — f(θh, θd) at φd = 90° (Burley Fig. 3): θh to the right (left edge = the
   specular peak), θd up (top edge = the Fresnel peak, bottom edge = retro-reflection),
@@ -17,7 +19,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -30,6 +31,7 @@ import numpy as np  # noqa: E402
 
 from lookdev.materials.bsdf import Model, evaluate  # noqa: E402
 from lookdev.materials.errors import LookdevError  # noqa: E402
+from lookdev.pipeline.blend.result import BlendedMaterial  # noqa: E402
 
 from .albedo import albedo_monte_carlo, albedo_tabulated  # noqa: E402
 from .sphere import REC709_Y, ibl_sphere, point_light_sphere  # noqa: E402
@@ -38,76 +40,12 @@ VIEWS = ("slice", "albedo", "polar", "sphere")
 CHANNEL_COLOURS = ("#d62728", "#2ca02c", "#1f77b4")
 
 
-@dataclass(frozen=True)
-class Subject:
-    """One material to show: its label, model and parameters.
-
-    A layered material that varies across its surface also carries its blend's ``maps``:
-    the sphere wraps them on, the other views show ``params`` (its centre texel).
-    """
-
-    label: str
-    model: Model
-    params: Any
-    maps: dict[str, np.ndarray] | None = None
+MAP_RESOLUTION = 256
+"""Texels a side of a layered material's maps when it is blended for plots."""
 
 
 class PlotError(LookdevError):
     """A view cannot be made as asked (unknown model, unreadable environment …)."""
-
-
-def model_named(name: str) -> Model:
-    """The installed :class:`Model` called ``name`` (the registry of ``lookdev check``)."""
-    from .stability_cases import MODEL_MODULES, CheckError, available_models
-
-    try:
-        models, missing = available_models([name])
-    except CheckError:
-        known = ", ".join(MODEL_MODULES)
-        raise PlotError(
-            f"no reflectance model named {name!r}; known: {known}", field="model"
-        ) from None
-    if name in missing:
-        raise PlotError(f"model {name!r} is {missing[name]}", field="model")
-    return models[name]
-
-
-LAYERED_RESOLUTION = 256
-
-
-def subject_for(name_or_path: str, library: Any = None) -> Subject:
-    """Load a preset (name or file) from ``library`` (a Library; None = default) and make
-    it plottable.
-
-    A layered preset is blended first (at :data:`LAYERED_RESOLUTION`); views show its
-    parameters at the centre texel unless the blend is uniform.
-    """
-    from lookdev.library import load_material
-
-    material = load_material(name_or_path, library)
-    if material.model != "layered":
-        return Subject(material.name, model_named(material.model), material.params)
-    from lookdev.pipeline.blend import blend
-
-    blended = blend(material, LAYERED_RESOLUTION)
-    if blended.representation == "lobe_weights":
-        return _weights_subject(material.name, blended)
-    model = model_named(blended.model)
-    if not blended.maps:
-        return Subject(material.name, model, blended.to_params())
-    h, w = next(iter(blended.maps.values())).shape[:2]
-    return Subject(material.name, model, blended.params_at(h // 2, w // 2), blended.maps)
-
-
-def _weights_subject(name: str, blended: Any) -> Subject:
-    """A layered Pixar blend (Smits' composited lobe weights) on the model that takes them."""
-    from lookdev.materials.pixar import LAYERED_MODEL
-
-    fields = LAYERED_MODEL.params_type.model_fields
-    h, w = blended.resolution[1], blended.resolution[0]
-    values = {k: v for k, v in blended.params_at(h // 2, w // 2).items() if k in fields}
-    params = LAYERED_MODEL.params_type.parse(values, where=f"{name} centre texel")
-    return Subject(name, LAYERED_MODEL, params, blended.maps or None)
 
 
 def load_environment(name_or_path: str, width: int = 256) -> np.ndarray:
@@ -175,8 +113,8 @@ def incidence_on_slice(theta_h: np.ndarray, theta_d: np.ndarray) -> np.ndarray:
     return np.degrees(np.arccos(np.cos(theta_h) * np.cos(theta_d)))
 
 
-def draw_slice(ax: Any, subject: Subject, *, exposure: float = 0.0, n: int = 128) -> None:
-    th, td, f = brdf_slice(subject.model, subject.params, n)
+def draw_slice(ax: Any, hub: BlendedMaterial, *, exposure: float = 0.0, n: int = 128) -> None:
+    th, td, f = brdf_slice(hub.bsdf_model, hub.centre_params, n)
     ax.imshow(to_display(f, exposure), origin="lower", extent=(0, 90, 0, 90))
     deg_h, deg_d = np.meshgrid(np.degrees(th), np.degrees(td))
     lines = ax.contour(
@@ -200,7 +138,7 @@ def draw_slice(ax: Any, subject: Subject, *, exposure: float = 0.0, n: int = 128
 ALBEDO_SAMPLES = 2048
 
 
-def albedo_curves(subject: Subject, n_theta: int = 46) -> list:
+def albedo_curves(hub: BlendedMaterial, n_theta: int = 46) -> list:
     """The albedo curve(s) drawn, 0..89.5°: Monte Carlo, and the shipped table if any.
 
     The curve is the model's own importance-sampled estimate: unbiased at any roughness,
@@ -208,12 +146,12 @@ def albedo_curves(subject: Subject, n_theta: int = 46) -> list:
     bench error`` measures by how much).
     """
     theta = np.radians(np.linspace(0.0, 89.5, n_theta))
-    mc = albedo_monte_carlo(subject.model, subject.params, theta, n_samples=ALBEDO_SAMPLES)
-    table = albedo_tabulated(subject.model, subject.params, theta)
+    mc = albedo_monte_carlo(hub.bsdf_model, hub.centre_params, theta, n_samples=ALBEDO_SAMPLES)
+    table = albedo_tabulated(hub.bsdf_model, hub.centre_params, theta)
     return [mc] + ([table] if table is not None else [])
 
 
-def total_curve(subject: Subject, n_theta: int = 46):
+def total_curve(hub: BlendedMaterial, n_theta: int = 46):
     """Reflected plus transmitted albedo, or None for a model that transmits nothing.
 
     Same seed and samples as the reflected curve, so the two differ exactly by what
@@ -222,15 +160,15 @@ def total_curve(subject: Subject, n_theta: int = 46):
     """
     theta = np.radians(np.linspace(0.0, 89.5, n_theta))
     both = albedo_monte_carlo(
-        subject.model, subject.params, theta, n_samples=ALBEDO_SAMPLES, hemisphere="both"
+        hub.bsdf_model, hub.centre_params, theta, n_samples=ALBEDO_SAMPLES, hemisphere="both"
     )
-    reflect = albedo_monte_carlo(subject.model, subject.params, theta, n_samples=ALBEDO_SAMPLES)
+    reflect = albedo_monte_carlo(hub.bsdf_model, hub.centre_params, theta, n_samples=ALBEDO_SAMPLES)
     return both if np.any(both.albedo > reflect.albedo) else None
 
 
-def draw_albedo(ax: Any, subject: Subject) -> None:
-    mc, *table = albedo_curves(subject)
-    total = total_curve(subject)
+def draw_albedo(ax: Any, hub: BlendedMaterial) -> None:
+    mc, *table = albedo_curves(hub)
+    total = total_curve(hub)
     deg = np.degrees(mc.theta)
     for c, colour in enumerate(CHANNEL_COLOURS):
         if total is not None:
@@ -284,13 +222,15 @@ def polar_curves(
 POLAR_DECADES = 4
 
 
-def draw_polar(ax: Any, subject: Subject, incidence_deg: Sequence[float] = (0, 30, 60, 80)) -> None:
+def draw_polar(
+    ax: Any, hub: BlendedMaterial, incidence_deg: Sequence[float] = (0, 30, 60, 80)
+) -> None:
     """Luminance of f on a logarithmic radius spanning :data:`POLAR_DECADES` decades.
 
     A glossy peak is thousands of times its surroundings; on a linear radius it would
     flatten every other curve and every diffuse material to a dot.
     """
-    theta_o, lum = polar_curves(subject.model, subject.params, incidence_deg)
+    theta_o, lum = polar_curves(hub.bsdf_model, hub.centre_params, incidence_deg)
     top = math.log10(max(float(lum.max()), 1e-12))
     floor = top - POLAR_DECADES
     for ti, row in zip(incidence_deg, lum, strict=True):
@@ -326,7 +266,7 @@ def draw_sphere(ax: Any, image: np.ndarray, exposure: float, title: str) -> None
 
 # -- figure --------------------------------------------------------------------------
 def figure(
-    subjects: Sequence[Subject],
+    hubs: Sequence[BlendedMaterial],
     view: str,
     *,
     exposure: float = 0.0,
@@ -337,36 +277,36 @@ def figure(
     """A matplotlib figure of one view for several materials side by side."""
     if view not in VIEWS:
         raise ValueError(f"view must be one of {', '.join(VIEWS)}")
-    cols = len(subjects)
+    cols = len(hubs)
     rows = 2 if view == "sphere" and environment is not None else 1
     polar = view == "polar"
     fig = plt.figure(figsize=(3.6 * cols, 3.4 * rows + 0.6), layout="constrained")
-    for i, subject in enumerate(subjects):
+    for i, hub in enumerate(hubs):
         if view == "sphere":
             img = point_light_sphere(
-                subject.model, subject.params, resolution=resolution, maps=subject.maps
+                hub.bsdf_model, hub.centre_params, resolution=resolution, maps=(hub.maps or None)
             )
             ax = fig.add_subplot(rows, cols, i + 1)
-            draw_sphere(ax, img, exposure, f"{subject.label}\npoint light")
+            draw_sphere(ax, img, exposure, f"{hub.name}\npoint light")
             if environment is not None:
                 img = ibl_sphere(
-                    subject.model,
-                    subject.params,
+                    hub.bsdf_model,
+                    hub.centre_params,
                     environment,
                     resolution=min(resolution, 96),
-                    maps=subject.maps,
+                    maps=(hub.maps or None),
                 )
                 ax = fig.add_subplot(rows, cols, cols + i + 1)
-                draw_sphere(ax, img, exposure, f"{subject.label}\n{ibl_name}")
+                draw_sphere(ax, img, exposure, f"{hub.name}\n{ibl_name}")
             continue
         ax = fig.add_subplot(1, cols, i + 1, projection="polar" if polar else None)
         if view == "slice":
-            draw_slice(ax, subject, exposure=exposure, n=resolution)
+            draw_slice(ax, hub, exposure=exposure, n=resolution)
         elif view == "albedo":
-            draw_albedo(ax, subject)
+            draw_albedo(ax, hub)
         else:
-            draw_polar(ax, subject)
-        ax.set_title(subject.label + ("\n(centre texel)" if subject.maps else ""))
+            draw_polar(ax, hub)
+        ax.set_title(hub.name + ("\n(centre texel)" if (hub.maps or None) else ""))
     suffix = f", exposure {exposure:+g}" if view in ("slice", "sphere") else ""
     fig.suptitle(f"{view}{suffix}", fontsize="medium")
     return fig

@@ -19,7 +19,7 @@ import html
 import json
 import os
 import urllib.parse
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -218,26 +218,24 @@ def web_image(src: Path, out_dir: Path, exposure: float = 0.0) -> Path:
 
 
 def material_plots(
-    materials: Iterable[str], out_dir: Path, library: Any = None, ibl: str | None = None
+    names: Iterable[str], hubs: Mapping[str, Any], out_dir: Path, ibl: str | None = None
 ) -> dict:
     """``{material: {view: png}}``; the sphere also under ``ibl`` (one of the batch's).
 
-    A material that cannot be loaded here (a preset that has since been removed) gets no
-    plots; its frames and numbers are still shown.
+    ``hubs`` are the blended materials by name; a material of the batch not among them
+    (proofed in an earlier run) gets no plots; its frames and numbers are still shown.
     """
-    from .plots import figure, load_environment, save_figure, subject_for
+    from .plots import figure, load_environment, save_figure
 
     environment = _environment(ibl, load_environment)
     result: dict[str, dict[str, Path]] = {}
-    for name in materials:
-        try:
-            subject = subject_for(name, library)
-        except LookdevError:
+    for name in names:
+        if name not in hubs:
             continue
         result[name] = {
             view: save_figure(
                 figure(
-                    [subject],
+                    [hubs[name]],
                     view,
                     resolution=64,
                     environment=environment if view == "sphere" else None,
@@ -336,8 +334,13 @@ def render_page(batch_dir: Path, entries: list[Entry], sheets: list[Path], plots
     return "\n".join(parts)
 
 
-def write_report(batch_dir: str | Path, *, library: Any = None, plots: bool = True) -> Path:
-    """Write ``batch_dir/index.html`` (and its thumbnails and plots); return its path."""
+def write_report(
+    batch_dir: str | Path, *, materials: Mapping[str, Any] | None = None, plots: bool = True
+) -> Path:
+    """Write ``batch_dir/index.html`` (and its thumbnails and plots); return its path.
+
+    ``materials`` are blended materials by name, plotted where the batch holds them.
+    """
     batch_dir = Path(batch_dir).resolve()
     if not batch_dir.is_dir():
         raise ReportError("no such batch folder", where=str(batch_dir))
@@ -346,8 +349,8 @@ def write_report(batch_dir: str | Path, *, library: Any = None, plots: bool = Tr
         raise ReportError("no manifest.json found: is this a proof batch?", where=str(batch_dir))
     out = batch_dir / REPORT_DIR
     out.mkdir(exist_ok=True)
-    materials = dict.fromkeys(e.material for e in entries)
-    made = material_plots(materials, out, library, entries[0].ibl) if plots else {}
+    names = dict.fromkeys(e.material for e in entries)
+    made = material_plots(names, materials or {}, out, entries[0].ibl) if plots else {}
     page = render_page(batch_dir, entries, contact_sheets(batch_dir), made)
     index = batch_dir / "index.html"
     tmp = index.with_name(".index.html.tmp")

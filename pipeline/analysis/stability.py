@@ -1,7 +1,7 @@
 """Stability sweep of every reflectance model (``lookdev check``).
 
-Each model of :data:`.stability_cases.MODEL_MODULES` (a missing one is skipped, not an
-error) is driven through the cases of :mod:`.stability_cases` in float32 and float64.
+Each model of the registry (:data:`lookdev.materials.registry.MODELS`) is driven through
+the cases of :mod:`.stability_cases` in float32 and float64.
 
 It counts cases where the model raised (a finding, not a stop), queries whose output
 (f, pdf, sampled direction, weight) holds a NaN, an infinity or a negative value, and
@@ -23,9 +23,9 @@ from lookdev.materials.bsdf import Model, density, draw, evaluate
 from .albedo import albedo_monte_carlo
 from .stability_cases import (
     allowance,
-    available_models,
     directions,
     furnace_cases,
+    models_named,
     parameter_cases,
     per_element_maps,
     plausible,
@@ -228,16 +228,15 @@ def check_model(
 
 def run(
     names: list[str] | None = None, progress: Callable[[str, str], None] = lambda m, c: None
-) -> tuple[dict[str, ModelReport], dict[str, str]]:
-    """Reports for every available (or named) model, and why any are missing."""
-    models, missing = available_models(names)
+) -> dict[str, ModelReport]:
+    """Reports for every model of the registry (or those named)."""
     reports = {}
-    for name, model in models.items():
+    for name, model in models_named(names).items():
         reports[name] = check_model(name, model, lambda label, n=name: progress(n, label))
-    return reports, missing
+    return reports
 
 
 def case_count(names: list[str] | None = None) -> int:
     """How many parameter sets :func:`run` will sweep (for a progress bar)."""
-    models, _ = available_models(names)
-    return sum(len(parameter_cases(m.params_type)) + 1 for m in models.values())
+    models = models_named(names).values()
+    return sum(len(parameter_cases(m.params_type)) + 1 for m in models)

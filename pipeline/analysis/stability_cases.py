@@ -16,10 +16,9 @@ The cases of DESIGN.md, "Numerics that need care", for every model:
 
 Allowances: the Conty-Kulla lobe and Smits' model conserve energy by construction (sheen
 0.002: its albedo table's measured interpolation error; pixar 0). The Disney BRDF adds
-energy by design; its allowance is the Disney module's ``ENERGY_ALLOWANCE`` when it has
-one, else 0.77: tests/test_disney.py measures each lobe's gain up to θo = 89° (rough
-white plastic 1.567, sheen +0.09, clearcoat +0.05), and with all of them at once and
-``specular`` 1 the albedo keeps rising towards grazing: 1.721 at 89°, 1.758 at 89.9°,
+energy by design; its allowance is 0.77: tests/test_disney.py measures each lobe's gain up
+to θo = 89° (rough white plastic 1.567, sheen +0.09, clearcoat +0.05), and with all of them
+at once and ``specular`` 1 the albedo keeps rising towards grazing: 1.721 at 89°, 1.758 at 89.9°,
 1.762 ± 0.001 at 89.99° and 89.9999° (4·10⁵ samples each). Parameters
 pushed past their plausible range (sheen 10, specular 12.5, clearcoat 4) are checked for
 NaN, infinity and sign only: Burley allows them precisely to add energy.
@@ -27,24 +26,16 @@ NaN, infinity and sign only: Burley allows them precisely to add energy.
 
 from __future__ import annotations
 
-import importlib
 import itertools
 import typing
 from typing import Any
 
 import numpy as np
 
+from lookdev.materials import registry
 from lookdev.materials.bsdf import Model
 from lookdev.materials.errors import LookdevError
 
-MODEL_MODULES = {
-    "disney": "lookdev.materials.disney",
-    "sheen": "lookdev.materials.sheen",
-    "pixar": "lookdev.materials.pixar",
-    "pixar_layered": "lookdev.materials.pixar",
-}
-MODEL_ATTRS = {"pixar_layered": "LAYERED_MODEL"}
-"""The attribute holding the Model, where it is not ``MODEL``."""
 ALLOWANCE = {"disney": 0.77, "sheen": 0.002, "pixar": 0.0, "pixar_layered": 0.0}
 UNBOUNDED_HIGH = 10.0  # the "pushed" value of a field with no upper bound
 
@@ -73,31 +64,20 @@ class CheckError(LookdevError):
     """``lookdev check`` was asked for a model it does not know."""
 
 
-def available_models(names: list[str] | None = None) -> tuple[dict[str, Model], dict]:
-    """({name: Model} of the models that import, {name: why not} for the others)."""
-    wanted = list(MODEL_MODULES) if not names else names
-    unknown = [n for n in wanted if n not in MODEL_MODULES]
+def models_named(names: list[str] | None = None) -> dict[str, Model]:
+    """{name: Model} of the registry's models, or of those named."""
+    wanted = list(registry.MODELS) if not names else names
+    unknown = [n for n in wanted if n not in registry.MODELS]
     if unknown:
         raise CheckError(
-            f"unknown model {unknown[0]!r}; known: {', '.join(MODEL_MODULES)}", field="--model"
+            f"unknown model {unknown[0]!r}; known: {', '.join(registry.MODELS)}", field="--model"
         )
-    models, missing = {}, {}
-    for name in wanted:
-        try:
-            module = importlib.import_module(MODEL_MODULES[name])
-            models[name] = getattr(module, MODEL_ATTRS.get(name, "MODEL"))
-        except (ImportError, AttributeError) as exc:
-            missing[name] = f"not available ({exc})"
-    return models, missing
+    return {name: registry.MODELS[name] for name in wanted}
 
 
 def allowance(name: str) -> float:
     """Energy a model may add by design (see the module docstring); 0 if unknown."""
-    default = ALLOWANCE.get(name, 0.0)
-    if name not in MODEL_MODULES:
-        return default
-    module = importlib.import_module(MODEL_MODULES[name])
-    return float(getattr(module, "ENERGY_ALLOWANCE", default))
+    return ALLOWANCE.get(name, 0.0)
 
 
 def extremes(info: Any) -> list[Any]:

@@ -8,14 +8,15 @@ from typing import Annotated
 import typer
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 
-from lookdev.pipeline.analysis import stability, stability_cases
+from lookdev.materials import registry
+from lookdev.pipeline.analysis import stability
 
 from .common import console, err_console, print_json, table
 
 COLUMNS = ["precision", "cases", "raised", "NaN", "inf", "negative", "energy gain"]
 
 
-_MODEL_HELP = f"Only this model (repeatable): {', '.join(stability_cases.MODEL_MODULES)}."
+_MODEL_HELP = f"Only this model (repeatable): {', '.join(registry.MODELS)}."
 
 
 def check(
@@ -57,23 +58,22 @@ def check(
         def advance(name: str, label: str) -> None:
             bar.update(task, advance=1, model=name, case=label)
 
-        reports, missing = stability.run(names, advance)
+        reports = stability.run(names, advance)
     seconds = time.perf_counter() - started
     if json_out:
         print_json(
             {
                 "models": {name: r.to_json() for name, r in reports.items()},
-                "missing": missing,
                 "seconds": round(seconds, 3),
             }
         )
     else:
-        _print(reports, missing, seconds)
+        _print(reports, seconds)
     if any(r.failed for r in reports.values()):
         raise typer.Exit(1)
 
 
-def _print(reports: dict[str, stability.ModelReport], missing: dict[str, str], seconds: float):
+def _print(reports: dict[str, stability.ModelReport], seconds: float):
     for name, r in reports.items():
         rows = [
             [dtype, r.cases_by_dtype[dtype], *(c[k] for k in stability.KINDS)]
@@ -89,6 +89,4 @@ def _print(reports: dict[str, stability.ModelReport], missing: dict[str, str], s
             t.caption = f"{label}: {worst.kind}{value} at {worst.case}"
             t.caption_justify = "left"
         console.print(t)
-    for name, why in missing.items():
-        console.print(f"{name}: skipped, {why}", markup=False)
     console.print(f"checked in {seconds:.1f} s", style="dim")

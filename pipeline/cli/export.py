@@ -91,8 +91,9 @@ def mitsuba(
       lookdev export mitsuba rusty_iron -o rust/scene.xml --ibl studio --spp 64
     """
     from lookdev.library import Library, load_material
+    from lookdev.pipeline.blend import blend
     from lookdev.pipeline.export.mitsuba import MitsubaExportError, export_scene
-    from lookdev.pipeline.export.mitsuba.scene import files_of, flatten, uses_our_plugins
+    from lookdev.pipeline.export.mitsuba.scene import files_of, uses_our_plugins
 
     if min(resolution) < 1:
         raise MitsubaExportError(
@@ -103,7 +104,7 @@ def mitsuba(
     env = _environment(environment)
     with console.status(f"exporting {material.name}…", spinner="dots"):
         scene = export_scene(
-            flatten(material, map_resolution),
+            blend(material, map_resolution),
             output,
             resolution=resolution,
             spp=spp,

@@ -83,18 +83,19 @@ def plot(
             f"cannot write {output.suffix or 'no extension'}; allowed {', '.join(FORMATS)}",
             where=str(output),
         )
-    from lookdev.library import Library
+    from lookdev.library import Library, load_material
+    from lookdev.pipeline.blend import blend
 
     lib = Library(library)
-    subjects = [plots.subject_for(name, lib) for name in presets]
+    hubs = [blend(load_material(name, lib), plots.MAP_RESOLUTION) for name in presets]
     environment = None
     if ibl is not None:
         if view is not View.sphere:
             raise PlotError("--ibl only applies to --view sphere", field="--ibl")
         environment = plots.load_environment(ibl)
-    with console.status(f"plotting {view.value} of {len(subjects)} material(s)"):
+    with console.status(f"plotting {view.value} of {len(hubs)} material(s)"):
         fig = plots.figure(
-            subjects,
+            hubs,
             view.value,
             exposure=exposure,
             environment=environment,
@@ -103,8 +104,6 @@ def plot(
         )
         plots.save_figure(fig, output)
     if as_json:
-        print_json(
-            {"output": str(output), "view": view.value, "materials": [s.label for s in subjects]}
-        )
+        print_json({"output": str(output), "view": view.value, "materials": [h.name for h in hubs]})
     else:
         console.print(f"wrote {output}")

@@ -131,11 +131,12 @@ def proof(
       lookdev proof copper --spp 256 --resolution 640 320 --scheduler tcp://farm:8786
     """
     from lookdev.library import Library, load_material
+    from lookdev.pipeline.blend import blend
     from lookdev.pipeline.proof import batch, ibl
 
     lib = Library(library or None)
     names = list(dict.fromkeys(presets or representative_presets(lib)))
-    materials = [load_material(name, lib) for name in names]
+    materials = [blend(load_material(name, lib), batch.MAP_RESOLUTION) for name in names]
     ibl_names = list(dict.fromkeys(ibls or ibl.builtin_names()))
     environments = [ibl.load(name, ibl_width) for name in ibl_names]
     if resolution[0] < 8 or resolution[1] < 8:
@@ -170,7 +171,7 @@ def proof(
     if report:
         from lookdev.pipeline.analysis.report import write_report
 
-        doc["report"] = str(write_report(output, library=lib))
+        doc["report"] = str(write_report(output, materials={m.name: m for m in materials}))
     if as_json:
         print_json(doc)
         return

@@ -45,6 +45,8 @@ from .turntable import Frame, frames
 MANIFEST = "manifest.json"
 TICK_S = 0.5
 FORMAT_VERSION = 1
+MAP_RESOLUTION = 512
+"""Texels a side of a layered material's maps in a proof (the blend the proof renders)."""
 
 
 class ProofError(LookdevError):
@@ -73,7 +75,7 @@ class Settings:
 class Job:
     """One material under one IBL; everything a worker needs, picklable."""
 
-    material: Any  # lookdev.library.Material
+    material: Any  # the blended material (lookdev.pipeline.blend.BlendedMaterial)
     ibl: str
     environment: np.ndarray
     folder: Path
@@ -83,7 +85,7 @@ class Job:
     def __post_init__(self) -> None:
         h = hashlib.sha256()
         h.update(json.dumps([FORMAT_VERSION, self.settings.as_json()], sort_keys=True).encode())
-        h.update(self.material.model_dump_json().encode())
+        h.update(self.material.digest().encode())
         h.update(np.ascontiguousarray(self.environment).tobytes())
         self.key = h.hexdigest()[:16]
 
@@ -151,7 +153,7 @@ def run_job(job: Job) -> dict[str, Any]:
     todo = [f for f in job.settings.frames() if f.index not in done]
     doc = {
         "material": job.material.name,
-        "model": job.material.model,
+        "model": job.material.preset_model,
         "ibl": job.ibl,
         "key": job.key,
         "variant": variant,

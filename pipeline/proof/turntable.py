@@ -50,17 +50,11 @@ def frames(element: int, light: int) -> list[Frame]:
     return out + [Frame(element + i, "light", 360.0 * i / light) for i in range(light)]
 
 
-def material_bsdf(material: Any, *, force_all_lobes: bool = False) -> tuple[dict, int]:
-    """The Mitsuba BSDF dict of a material (our plugins) and the path depth it needs.
-
-    A layered material is blended once (:func:`~lookdev.pipeline.export.mitsuba.scene.flatten`)
-    and both answers come from that.
-    """
+def material_bsdf(hub: Any, *, force_all_lobes: bool = False) -> tuple[dict, int]:
+    """The Mitsuba BSDF dict of a blended material (our plugins) and the path depth it needs."""
     from lookdev.pipeline.export.mitsuba import bsdf_dict, max_depth_for
-    from lookdev.pipeline.export.mitsuba.scene import flatten
 
-    flat = flatten(material)
-    return bsdf_dict(flat, force_all_lobes=force_all_lobes), max_depth_for(flat)
+    return bsdf_dict(hub, force_all_lobes=force_all_lobes), max_depth_for(hub)
 
 
 class Turntable:

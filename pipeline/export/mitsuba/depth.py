@@ -3,7 +3,7 @@
 Mitsuba's ``max_depth`` counts path segments: 2 is direct lighting only. Light that
 bounces inside the proof's concavities (the cup) or passes through a transmissive element
 needs more, and every extra segment costs render time, so the depth follows the material:
-which lobes it keeps (:func:`lobes_for`) and, for opaque ones, how much light each bounce
+which lobes it keeps (the blend's live lobes) and, for opaque ones, how much light each bounce
 keeps (:func:`albedo_for`).
 
 The depths were chosen on the proof shader ball under the ``studio`` IBL, as the smallest
@@ -32,14 +32,14 @@ darkened gold's cavities by 27 %.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
-from lookdev.materials.arrays import NumpyOps
 from lookdev.materials.bsdf import draw
+from lookdev.pipeline.blend.result import as_hub
 
-from .plugin import lobe_kinds, lobes_of
-from .scene import Flat, flatten, model_for
+from .plugin import lobe_kinds
 
 DEPTH_DARK = 4
 DEPTH_BRIGHT = 6
@@ -50,25 +50,16 @@ BRIGHT_ALBEDO = 0.5
 """Above this directional albedo (any channel, anywhere) interreflections show."""
 
 
-def lobes_for(flat: Flat) -> tuple[str, ...]:
-    """The lobes the model keeps for this material, everywhere on it (numpy backend)."""
-    model = model_for(flat.model)
-    params = model.params_type.parse(flat.constants, where=flat.name)
-    maps = {k: (v.reshape(-1, 3).T if v.ndim == 3 else v.reshape(-1)) for k, v in flat.maps.items()}
-    with np.errstate(all="ignore"):
-        return lobes_of(model.prepare(NumpyOps(np.float32), params, **maps))
-
-
-def albedo_for(flat: Flat, *, samples: int = 256, texels: int = 64) -> float:
+def albedo_for(hub: Any, *, samples: int = 256, texels: int = 64) -> float:
     """The largest directional albedo at normal incidence, over channels and texels.
 
     The mean of the model's own sample weights f·cos θ/pdf over stratified uniforms
     (reflection only), at up to ``texels`` texels spread evenly over the maps.
     """
-    model = model_for(flat.model)
-    params = model.params_type.parse(flat.constants, where=flat.name)
+    hub = as_hub(hub)
+    model, params = hub.bsdf_model, hub.params
     maps, count = {}, 1
-    for key, value in flat.maps.items():
+    for key, value in hub.maps.items():
         rows = value.reshape(-1, 3) if value.ndim == 3 else value.reshape(-1)
         pick = np.linspace(0, len(rows) - 1, min(texels, len(rows))).astype(int)
         maps[key] = rows[pick][:, None]  # (K, 1) or (K, 1, 3): one row of samples per texel
@@ -82,12 +73,13 @@ def albedo_for(flat: Flat, *, samples: int = 256, texels: int = 64) -> float:
     return float(np.max(np.where(keep[..., None], weight, 0.0).mean(axis=-2)))
 
 
-def max_depth_for(material: object) -> int:
-    """The path depth a material needs (see the table in the module docstring)."""
-    flat = flatten(material)
-    kinds = lobe_kinds(lobes_for(flat), flat.model)
+def max_depth_for(hub: Any) -> int:
+    """The path depth a blended material needs (see the table in the module docstring):
+    by the kinds of its live lobes, and for opaque ones by its albedo."""
+    hub = as_hub(hub)
+    kinds = lobe_kinds(hub.live_lobes, hub.bsdf_model)
     if "GlossyTransmission" in kinds:
-        return DEPTH_THIN_GLOSSY if flat.constants.get("thin", False) else DEPTH_SOLID_GLOSSY
+        return DEPTH_THIN_GLOSSY if hub.constants.get("thin", False) else DEPTH_SOLID_GLOSSY
     if "DiffuseTransmission" in kinds:
         return DEPTH_THIN_DIFFUSE
-    return DEPTH_BRIGHT if albedo_for(flat) >= BRIGHT_ALBEDO else DEPTH_DARK
+    return DEPTH_BRIGHT if albedo_for(hub) >= BRIGHT_ALBEDO else DEPTH_DARK

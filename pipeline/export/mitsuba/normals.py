@@ -17,15 +17,9 @@ from typing import Any
 
 import numpy as np
 
-from lookdev.materials.arrays import NumpyOps
 from lookdev.materials.bsdf import Model
 
-from .plugin import LOBE_KINDS, ONLY_LOBES, WEIGHT_SCALE, is_color_field, lobes_of
-
-HIGHLIGHT_LOBES = frozenset(
-    ("specular", "clearcoat", "spec_trans", "reflection", "specular_t", "reflection_t")
-)
-"""Lobes shaded with the highlight (specular) normal; every other lobe takes the diffuse one."""
+from .plugin import ONLY_LOBES, WEIGHT_SCALE
 
 Texture = Callable[[np.ndarray, str], dict[str, Any]]
 """(unit normals (H, W, 3), a name for the file) → a Mitsuba texture dict."""
@@ -34,23 +28,19 @@ Texture = Callable[[np.ndarray, str], dict[str, Any]]
 def with_normals(
     plugin: dict[str, Any],
     model: Model,
-    params: Any,
-    maps: dict[str, np.ndarray],
+    lobes: tuple[str, ...],
     normals: tuple[np.ndarray | None, np.ndarray | None],
     texture: Texture,
-    force_all_lobes: bool = False,
 ) -> dict[str, Any]:
-    """``plugin`` under its shading normals ``(diffuse, highlight)``; either may be None.
-
-    With ``force_all_lobes`` every lobe of each group is kept (the pruning baseline).
-    """
+    """``plugin`` (rendering ``lobes`` of ``model``) under its shading normals
+    ``(diffuse, highlight)``; either may be None. Lobe groups are the registry's
+    (:attr:`lookdev.materials.bsdf.Lobe.highlight`)."""
     diffuse, highlight = normals
     if highlight is None or (diffuse is not None and np.array_equal(diffuse, highlight)):
         return _under(plugin, diffuse, "normal", texture)
-    live = tuple(LOBE_KINDS) if force_all_lobes else live_lobes(model, params, maps)
     groups = [
-        ([k for k in live if k not in HIGHLIGHT_LOBES], diffuse, "normal"),
-        ([k for k in live if k in HIGHLIGHT_LOBES], highlight, "specular_normal"),
+        ([k for k in lobes if not model.lobe(k).highlight], diffuse, "normal"),
+        ([k for k in lobes if model.lobe(k).highlight], highlight, "specular_normal"),
     ]
     halves = [(lobes, normal, name) for lobes, normal, name in groups if lobes]
     if len(halves) == 1:
@@ -61,14 +51,6 @@ def with_normals(
         for lobes, normal, name in halves
     ]
     return {"type": "blendbsdf", "weight": 0.5, "bsdf_0": parts[0], "bsdf_1": parts[1]}
-
-
-def live_lobes(model: Model, params: Any, maps: dict[str, np.ndarray]) -> tuple[str, ...]:
-    """The lobes ``model`` keeps for ``params`` where ``maps`` may take any non-zero value
-    (a mapped weight keeps its lobe, as in the plugin)."""
-    xp = NumpyOps()
-    stand_in = {k: (0.5, 0.5, 0.5) if is_color_field(model.params_type, k) else 0.5 for k in maps}
-    return lobes_of(model.prepare(xp, params, **stand_in))
 
 
 def _under(

@@ -25,14 +25,13 @@ baseline).
 from __future__ import annotations
 
 import functools
-import types
-import typing
 from collections.abc import Iterable
 from typing import Any
 
 from lookdev.materials.arrays import DrJitOps
 from lookdev.materials.bsdf import Model
 from lookdev.materials.errors import LookdevError
+from lookdev.materials.registry import is_color_field
 
 PLUGIN_PREFIX = "lookdev_"
 FORCE_ALL_LOBES = "force_all_lobes"
@@ -46,28 +45,6 @@ class MitsubaExportError(LookdevError):
     """A material cannot become a Mitsuba BSDF or scene as asked."""
 
 
-# How each lobe name a model's ``prepare`` records shows up in Mitsuba's flags. A model
-# records the lobes it kept under ``prepared["lobes"]``; names are the models' own.
-_DIFFUSE_R = "DiffuseReflection"
-_GLOSSY_R = "GlossyReflection"
-_DIFFUSE_T = "DiffuseTransmission"
-_GLOSSY_T = "GlossyTransmission"
-LOBE_KINDS: dict[str, str] = {
-    # Disney (materials/disney.py LOBES) and Conty-Kulla (materials/sheen.py)
-    "diffuse": _DIFFUSE_R,
-    "sheen": _GLOSSY_R,
-    "specular": _GLOSSY_R,
-    "clearcoat": _GLOSSY_R,
-    "spec_trans": _GLOSSY_T,
-    "diff_trans": _DIFFUSE_T,
-    # Pixar (materials/pixar.py LOBES): the transmitted twins of the three lobes
-    "reflection": _GLOSSY_R,
-    "diffuse_t": _DIFFUSE_T,
-    "specular_t": _GLOSSY_T,
-    "reflection_t": _GLOSSY_T,
-}
-
-
 def lobes_of(prepared: Any) -> tuple[str, ...]:
     """The lobe names a prepared material kept (``prepared["lobes"]`` or ``.lobes``)."""
     lobes = (
@@ -78,25 +55,13 @@ def lobes_of(prepared: Any) -> tuple[str, ...]:
     return tuple(lobes)
 
 
-def lobe_kinds(lobes: Iterable[str], model_name: str) -> set[str]:
-    """Mitsuba flag names of the given lobes; an unknown name is an error, not a guess."""
-    kinds = set()
-    for lobe in lobes:
-        if lobe not in LOBE_KINDS:
-            raise MitsubaExportError(
-                f"lobe {lobe!r} of model {model_name!r} has no Mitsuba flag; "
-                f"known: {', '.join(sorted(LOBE_KINDS))}"
-            )
-        kinds.add(LOBE_KINDS[lobe])
-    return kinds
-
-
-def is_color_field(params_type: type, field: str) -> bool:
-    """True when a schema field holds an RGB triple (its texture is evaluated as colour)."""
-    annotation = params_type.model_fields[field].annotation
-    while typing.get_origin(annotation) in (typing.Annotated, typing.Union, types.UnionType):
-        annotation = typing.get_args(annotation)[0]  # Colour | None: the colour
-    return typing.get_origin(annotation) is tuple
+def lobe_kinds(lobes: Iterable[str], model: Model) -> set[str]:
+    """Mitsuba flag names (``GlossyReflection`` …) of the given lobes of ``model``,
+    as the registry describes them (:class:`lookdev.materials.bsdf.Lobe`)."""
+    try:
+        return {model.lobe(name).mitsuba_flag for name in lobes}
+    except KeyError as exc:
+        raise MitsubaExportError(exc.args[0]) from None
 
 
 def plugin_name(model: Model) -> str:
@@ -178,7 +143,7 @@ def _plugin_class(variant: str) -> type:
             prepared = self._restricted(
                 self.model.prepare(self.xp, self.params, **self._forced(), **placeholders)
             )
-            kinds = lobe_kinds(lobes_of(prepared), self.model.name)
+            kinds = lobe_kinds(lobes_of(prepared), self.model)
             reflect = [getattr(flag, k) for k in sorted(kinds) if "Reflection" in k]
             transmit = [getattr(flag, k) for k in sorted(kinds) if "Transmission" in k]
             self.components = [_union(reflect, flag), _union(transmit, flag)]

@@ -14,71 +14,36 @@ texel (0, 0) is UV (0, 0), so maps go to Mitsuba row for row, in memory and in E
 
 from __future__ import annotations
 
-import importlib
 import math
 import os
 import tempfile
 from collections.abc import Mapping
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from lookdev.materials.bsdf import Model
-from lookdev.materials.params import Params
+from lookdev.materials import registry
 from lookdev.materials.pixar import GRAZING
+from lookdev.materials.registry import is_color_field
+from lookdev.pipeline.blend.result import LOBE_WEIGHTS, BlendedMaterial, as_hub
 
+from .depth import max_depth_for
 from .normals import with_normals
-from .plugin import (
-    FORCE_ALL_LOBES,
-    MitsubaExportError,
-    is_color_field,
-    register_model,
-)
+from .plugin import FORCE_ALL_LOBES, ONLY_LOBES, MitsubaExportError, register_model
 
-MODEL_MODULES = {
-    "disney": "lookdev.materials.disney",
-    "sheen": "lookdev.materials.sheen",
-    "pixar": "lookdev.materials.pixar",
-    "pixar_layered": "lookdev.materials.pixar:LAYERED_MODEL",
-}
-"""Where each model lives (``module`` for its ``MODEL``, or ``module:NAME``); a plugin
-``lookdev_<name>`` is registered for each."""
-
-DEFAULT_MAP_RESOLUTION = 512
-
-
-def model_for(name: str) -> Model:
-    """The :class:`Model` called ``name`` (its module's ``MODEL``)."""
-    module = MODEL_MODULES.get(name)
-    if module is None:
-        raise MitsubaExportError(
-            f"no Mitsuba plugin for model {name!r}; known: {', '.join(MODEL_MODULES)}"
-        )
-    module, _, attr = module.partition(":")
-    try:
-        return getattr(importlib.import_module(module), attr or "MODEL")
-    except (ImportError, AttributeError) as exc:
-        raise MitsubaExportError(
-            f"model {name!r} is not available ({module}.MODEL: {exc})"
-        ) from None
+BLEND_ONLY = frozenset({"layering"})
+"""Constants a blend records for the record, which no BSDF takes."""
 
 
 def register_plugins() -> dict[str, str]:
-    """Register a Mitsuba plugin per available model; ``{model: plugin name}``.
+    """Register a Mitsuba plugin per model of the registry; ``{model: plugin name}``.
 
     Sets the Mitsuba variant first (:func:`lookdev.pipeline.variant.use_mitsuba`) unless one
     is set already. Call this before ``mi.load_dict`` / ``mi.load_file`` of our scenes.
     """
     _ensure_variant()
-    names = {}
-    for name in MODEL_MODULES:
-        try:
-            names[name] = register_model(model_for(name))
-        except MitsubaExportError:
-            continue  # a model not written yet simply has no plugin
-    return names
+    return {name: register_model(model) for name, model in registry.MODELS.items()}
 
 
 def _ensure_variant() -> None:
@@ -90,79 +55,22 @@ def _ensure_variant() -> None:
         use_mitsuba()
 
 
-@dataclass
-class Flat:
-    """A material reduced to what a BSDF needs: model, constants and maps."""
-
-    name: str
-    model: str
-    constants: dict[str, Any]
-    maps: dict[str, np.ndarray] = field(default_factory=dict)
-    normal_map: np.ndarray | None = None
-    specular_normal_map: np.ndarray | None = None  # the highlights' own (see .normals)
-
-
-def flatten(material: Any, resolution: int = DEFAULT_MAP_RESOLUTION) -> Flat:
-    """A Params object, a library ``Material`` or a ``BlendedMaterial`` as a :class:`Flat`.
-
-    Layered materials are blended first (:func:`lookdev.pipeline.blend.blend`) at
-    ``resolution`` texels a side; a :class:`Flat` is returned as it is.
-    """
-    if isinstance(material, Flat):
-        return material
-    if isinstance(material, Params):
-        return Flat(type(material).__name__, _model_of(material), _given(material))
-    if getattr(material, "maps", None) is not None:  # a BlendedMaterial
-        return _from_blended(material)
-    if getattr(material, "model", None) == "layered":
-        from lookdev.pipeline.blend import blend
-
-        return _from_blended(blend(material, resolution))
-    if getattr(material, "params", None) is not None:
-        return Flat(material.name, material.model, _given(material.params))
-    raise MitsubaExportError(f"cannot make a Mitsuba BSDF from {type(material).__name__}")
-
-
-def _model_of(params: Params) -> str:
-    for name in MODEL_MODULES:
-        try:
-            if isinstance(params, model_for(name).params_type):
-                return name
-        except MitsubaExportError:
-            continue
-    raise MitsubaExportError(f"no model takes parameters of type {type(params).__name__}")
-
-
-def _given(params: Params) -> dict[str, Any]:
-    """The parameters a preset gave (defaults are the schema's, on both sides)."""
-    return {k: v for k, v in params.model_dump(exclude_unset=True).items() if v is not None}
-
-
-LAYERED_MODELS = {"pixar": "pixar_layered"}
-"""The model that renders a blend of ``representation = "lobe_weights"`` (Smits' weights)."""
-BLEND_ONLY = frozenset({"layering"})
-"""Constants a blend records for the record, which no BSDF takes."""
-
-
-def _from_blended(blended: Any) -> Flat:
-    model = blended.model
-    if getattr(blended, "representation", "params") == "lobe_weights":
-        model = LAYERED_MODELS.get(model, model)
-    fields = model_for(model).params_type.model_fields
-    given = set(blended.constants) - BLEND_ONLY
-    foreign = sorted(given - set(fields)) + sorted(set(blended.maps) - set(fields))
+def plugin_inputs(hub: BlendedMaterial) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+    """(constants, maps) the hub's model plugin takes."""
+    fields = hub.bsdf_model.params_type.model_fields
+    given = set(hub.constants) - BLEND_ONLY
+    foreign = sorted(given - set(fields)) + sorted(set(hub.maps) - set(fields))
     if foreign:
         raise MitsubaExportError(
             f"blended material carries {', '.join(foreign[:3])}, which are not inputs of "
-            f"the {model} model",
-            where=blended.name,
+            f"the {hub.bsdf_model.name} model",
+            where=hub.name,
         )
-    constants = {k: _plain(v) for k, v in blended.constants.items() if k in given and v is not None}
-    maps = {k: np.asarray(v, dtype=np.float32) for k, v in dict(blended.maps).items()}
-    if model != blended.model:
+    constants = {k: _plain(v) for k, v in hub.constants.items() if k in given and v is not None}
+    maps = {k: np.asarray(v, dtype=np.float32) for k, v in hub.maps.items()}
+    if hub.representation == LOBE_WEIGHTS:
         _drop_view_independent(constants, maps)
-    normals = (getattr(blended, k, None) for k in ("normal_map", "specular_normal_map"))
-    return Flat(blended.name, model, constants, maps, *normals)
+    return constants, maps
 
 
 def _drop_view_independent(constants: dict[str, Any], maps: dict[str, np.ndarray]) -> None:
@@ -182,7 +90,7 @@ def _plain(value: Any) -> Any:
     return value.item() if isinstance(value, np.generic) else value
 
 
-def principled_equivalent(flat: Flat) -> dict[str, Any] | None:
+def principled_equivalent(hub: BlendedMaterial) -> dict[str, Any] | None:
     """Mitsuba's ``principled`` parameters where it equals our Disney model, else None.
 
     Where: untextured metals (``metallic`` = 1 exactly, no clearcoat). There Burley's
@@ -193,21 +101,17 @@ def principled_equivalent(flat: Flat) -> dict[str, Any] | None:
     0..1 and anisotropic 0..1. Tinted and dielectric speculars, clearcoat (Mitsuba leaves
     out its 1/(4 cos θl cos θv)) and transmission differ on purpose and keep our plugin.
     """
-    c = flat.constants
-    if flat.model != "disney" or flat.maps or c.get("metallic") != 1.0:
+    c = hub.constants
+    if hub.bsdf_model.name != "disney" or hub.maps or c.get("metallic") != 1.0:
         return None
     if c.get("clearcoat", 0.0) != 0.0:
         return None
     out: dict[str, Any] = {"type": "principled", "metallic": 1.0}
-    out["base_color"] = {"type": "rgb", "value": list(c.get("base_color", _default(flat)))}
+    out["base_color"] = {"type": "rgb", "value": list(hub.params.base_color)}
     for key in ("roughness", "anisotropic"):
         if key in c:
             out[key] = float(c[key])
     return out
-
-
-def _default(flat: Flat) -> Any:
-    return model_for(flat.model).params_type.model_fields["base_color"].default
 
 
 def bsdf_dict(
@@ -215,43 +119,47 @@ def bsdf_dict(
     texture_dir: str | Path | None = None,
     *,
     force_all_lobes: bool = False,
-    resolution: int = DEFAULT_MAP_RESOLUTION,
     allow_principled: bool = True,
 ) -> dict[str, Any]:
-    """The Mitsuba BSDF dict of a material (Params, library Material or BlendedMaterial).
+    """The Mitsuba BSDF dict of a blended material (or of a model's parameters).
 
     Maps become ``bitmap`` textures: EXR files written into ``texture_dir`` when given
-    (for XML export), in-memory tensors otherwise. ``force_all_lobes`` keeps lobes with
+    (for XML export), in-memory tensors otherwise. The plugin traces exactly the hub's
+    live lobes (:attr:`BlendedMaterial.live_lobes`); ``force_all_lobes`` keeps lobes with
     zero weight traced (the pruning benchmark's baseline) and never takes the
     ``principled`` fast path.
     """
-    flat = flatten(material, resolution)
+    hub = as_hub(material)
     register_plugins()
-    model = model_for(flat.model)
-    params = model.params_type.parse(flat.constants, where=flat.name)  # one line, here
-    one_frame = flat.specular_normal_map is None
-    fast = principled_equivalent(flat) if allow_principled and one_frame else None
-    out = _plugin_dict(model, flat, texture_dir) if force_all_lobes or fast is None else fast
+    model = hub.bsdf_model
+    one_frame = hub.specular_normal_map is None
+    fast = principled_equivalent(hub) if allow_principled and one_frame else None
+    out = _plugin_dict(hub, texture_dir) if force_all_lobes or fast is None else fast
+    lobes = model.lobe_names if force_all_lobes else hub.live_lobes
     if force_all_lobes:
         out[FORCE_ALL_LOBES] = True
+    elif hub.maps and fast is None:
+        # A texture's lobes cannot be pruned while the kernel is traced: say which live.
+        out[ONLY_LOBES] = ",".join(lobes)
 
     def normal_texture(normals: np.ndarray, name: str) -> dict[str, Any]:
         encoded = _encode_normals(np.asarray(normals, dtype=np.float32))
-        return _bitmap(encoded, True, flat, name, texture_dir)
+        return _bitmap(encoded, True, hub.name, name, texture_dir)
 
-    frames = (flat.normal_map, flat.specular_normal_map)
-    return with_normals(out, model, params, flat.maps, frames, normal_texture, force_all_lobes)
+    frames = (hub.normal_map, hub.specular_normal_map)
+    return with_normals(out, model, lobes, frames, normal_texture)
 
 
-def _plugin_dict(model: Model, flat: Flat, texture_dir: str | Path | None) -> dict[str, Any]:
-    """Our plugin for ``flat``: constants as values, maps as ``bitmap`` textures."""
+def _plugin_dict(hub: BlendedMaterial, texture_dir: str | Path | None) -> dict[str, Any]:
+    """Our plugin for ``hub``: constants as values, maps as ``bitmap`` textures."""
+    model = hub.bsdf_model
+    constants, maps = plugin_inputs(hub)
     out: dict[str, Any] = {"type": register_model(model)}
-    for key, value in flat.constants.items():
+    for key, value in constants.items():
         out[key] = _constant(value)
-    for key, array in flat.maps.items():
-        if key not in model.params_type.model_fields:
-            raise MitsubaExportError("unknown parameter map", where=flat.name, field=key)
-        out[key] = _bitmap(array, is_color_field(model.params_type, key), flat, key, texture_dir)
+    for key, array in maps.items():
+        colour = is_color_field(model.params_type, key)
+        out[key] = _bitmap(array, colour, hub.name, key, texture_dir)
     return out
 
 
@@ -269,7 +177,7 @@ def _encode_normals(normals: np.ndarray) -> np.ndarray:
 
 
 def _bitmap(
-    array: np.ndarray, color: bool, flat: Flat, key: str, texture_dir: str | Path | None
+    array: np.ndarray, color: bool, name: str, key: str, texture_dir: str | Path | None
 ) -> dict[str, Any]:
     import mitsuba as mi
 
@@ -280,14 +188,14 @@ def _bitmap(
     if data.ndim != 3 or data.shape[-1] != expected:
         raise MitsubaExportError(
             f"map of shape {array.shape}; expected (H, W{', 3' if color else ''})",
-            where=flat.name,
+            where=name,
             field=key,
         )
     tex: dict[str, Any] = {"type": "bitmap", "raw": True, "wrap_mode": "repeat"}
     if texture_dir is None:
         tex["data"] = mi.TensorXf(np.ascontiguousarray(data))
     else:
-        tex["filename"] = str(write_exr(data, Path(texture_dir) / f"{_slug(flat.name)}_{key}.exr"))
+        tex["filename"] = str(write_exr(data, Path(texture_dir) / f"{_slug(name)}_{key}.exr"))
     return tex
 
 
@@ -334,7 +242,6 @@ def scene_dict(
     texture_dir: str | Path | None = None,
     force_all_lobes: bool = False,
     max_depth: int | None = None,
-    map_resolution: int = DEFAULT_MAP_RESOLUTION,
 ) -> dict[str, Any]:
     """A minimal scene: the material on a unit sphere, framed, under an environment.
 
@@ -344,9 +251,7 @@ def scene_dict(
     """
     import mitsuba as mi
 
-    from .depth import max_depth_for  # depth builds on this module's flatten
-
-    flat = flatten(material, map_resolution)
+    hub = as_hub(material)
     _ensure_variant()
     width, height = resolution
     distance = 4.0
@@ -358,7 +263,7 @@ def scene_dict(
         emitter = {"type": "envmap", "filename": str(environment)}
     return {
         "type": "scene",
-        "integrator": {"type": "path", "max_depth": max_depth or max_depth_for(flat)},
+        "integrator": {"type": "path", "max_depth": max_depth or max_depth_for(hub)},
         "sensor": {
             "type": "perspective",
             "fov": fov,
@@ -377,7 +282,7 @@ def scene_dict(
         "environment": emitter,
         "ball": {
             "type": "sphere",
-            "bsdf": bsdf_dict(flat, texture_dir, force_all_lobes=force_all_lobes),
+            "bsdf": bsdf_dict(hub, texture_dir, force_all_lobes=force_all_lobes),
         },
     }
 
