@@ -12,6 +12,7 @@ from pxr import Sdf, Usd, UsdShade  # noqa: E402
 
 from lookdev.library import Library, load_material  # noqa: E402
 from lookdev.materials.params import DisneyParams  # noqa: E402
+from lookdev.pipeline.blend import blend  # noqa: E402
 from lookdev.pipeline.export.usd import mtlx  # noqa: E402
 from lookdev.pipeline.export.usd.network import CONTEXTS, source_from_params  # noqa: E402
 from lookdev.pipeline.export.usd.sources import source_for  # noqa: E402
@@ -46,7 +47,7 @@ def library_stage(tmp_path_factory):
     scratch = tmp / "scratch"
     scratch.mkdir()
     sources = [
-        source_for(load_material(n, lib), tmp / "tex", MAP_RES, scratch=scratch, bake=False)
+        source_for(blend(load_material(n, lib), MAP_RES), tmp / "tex", scratch=scratch, bake=False)
         for n in names
     ]
     out = tmp / "all.usda"
@@ -204,7 +205,7 @@ def test_layered_live_mixes_masks_and_bakes_procedural_ones(tmp_path):
     material = load_material("rusty_iron", Library(use_env=False))
     scratch = tmp_path / "scratch"
     scratch.mkdir()
-    source = source_for(material, tmp_path / "tex", MAP_RES, scratch=scratch, bake=False)
+    source = source_for(blend(material, MAP_RES), tmp_path / "tex", scratch=scratch, bake=False)
     export_usd([source], tmp_path / "r.usda")
     stage = Usd.Stage.Open(str(tmp_path / "r.usda"))
     ids = {
@@ -224,7 +225,7 @@ def test_layered_bake_reads_maps_everywhere(tmp_path):
     material = load_material("rusty_iron", Library(use_env=False))
     scratch = tmp_path / "scratch"
     scratch.mkdir()
-    source = source_for(material, tmp_path / "tex", MAP_RES, scratch=scratch, bake=True)
+    source = source_for(blend(material, MAP_RES), tmp_path / "tex", scratch=scratch, bake=True)
     result = export_usd([source], tmp_path / "r.usda")
     stage = Usd.Stage.Open(str(tmp_path / "r.usda"))
     ids = [UsdShade.Shader(p).GetIdAttr().Get() for p in stage.Traverse() if p.IsA(UsdShade.Shader)]
@@ -238,7 +239,7 @@ def test_package_holds_stage_and_textures(tmp_path):
     material = load_material("rusty_iron", Library(use_env=False))
     scratch = tmp_path / "scratch"
     scratch.mkdir()
-    source = source_for(material, scratch / "tex", MAP_RES, scratch=scratch)
+    source = source_for(blend(material, MAP_RES), scratch / "tex", scratch=scratch)
     result = export_usd([source], tmp_path / "r.usdz", contexts=CONTEXTS, workdir=scratch)
     assert result.files == [tmp_path / "r.usdz"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.usdz", "scratch"]
@@ -263,7 +264,7 @@ def test_layered_pixar_exports_its_lobe_weights(tmp_path):
     material = Material(name="stack", model="layered", layers=[metal])
     scratch = tmp_path / "scratch"
     scratch.mkdir()
-    source = source_for(material, tmp_path / "tex", MAP_RES, scratch=scratch)
+    source = source_for(blend(material, MAP_RES), tmp_path / "tex", scratch=scratch)
     assert source.model == "pixar_weights" and not source.maps
     export_usd([source], tmp_path / "s.usda")
     assert validate_usd(tmp_path / "s.usda").ok
@@ -307,7 +308,7 @@ def test_texture_mask_and_normal_map_live(tmp_path):
     scratch = tmp_path / "scratch"
     scratch.mkdir()
     source = source_for(
-        load_material("scuffed", lib), out_dir / "tex", 8, scratch=scratch, bake=False
+        blend(load_material("scuffed", lib), 8), out_dir / "tex", scratch=scratch, bake=False
     )
     export_usd([source], out_dir / "s.usda")
     report = validate_usd(out_dir / "s.usda")

@@ -14,6 +14,7 @@ from pxr import Sdf, Usd, UsdShade  # noqa: E402
 
 from lookdev.library import Library, load_material  # noqa: E402
 from lookdev.materials.params import DisneyParams  # noqa: E402
+from lookdev.pipeline.blend import blend  # noqa: E402
 from lookdev.pipeline.export.usd.lobes import DEFAULTS, canonical, effective  # noqa: E402
 from lookdev.pipeline.export.usd.names import PREVIEW_DISNEY  # noqa: E402
 from lookdev.pipeline.export.usd.network import source_from_params  # noqa: E402
@@ -131,7 +132,7 @@ def test_baked_maps_come_back_as_paths(tmp_path):
     material = load_material("rusty_iron", Library(use_env=False))
     scratch = tmp_path / "scratch"
     scratch.mkdir()
-    source = source_for(material, tmp_path / "tex", 16, scratch=scratch, bake=True)
+    source = source_for(blend(material, 16), tmp_path / "tex", scratch=scratch, bake=True)
     export_usd([source], tmp_path / "r.usda", contexts=("universal",))
     (found,) = import_usd(tmp_path / "r.usda")
     assert set(found.maps) == set(source.maps) - {"specular"}  # universal reads F0 as ior

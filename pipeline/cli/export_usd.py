@@ -97,6 +97,7 @@ def export_usd(
       lookdev export usd rusty_iron -o rust.usdz --package
     """
     from lookdev.library import Library, load_material
+    from lookdev.pipeline.blend import blend
     from lookdev.pipeline.export.usd.network import CONTEXTS, ExportError
     from lookdev.pipeline.export.usd.sources import source_for
     from lookdev.pipeline.export.usd.writer import export_usd as write
@@ -115,10 +116,8 @@ def export_usd(
         texture_dir = Path(scratch, textures) if package else out.parent / textures
         sources = []
         for name in _progress(names, "reading presets", as_json):
-            material = load_material(name, lib)
-            sources.append(
-                source_for(material, texture_dir, resolution, scratch=Path(scratch), bake=bake_maps)
-            )
+            hub = blend(load_material(name, lib), resolution)
+            sources.append(source_for(hub, texture_dir, scratch=Path(scratch), bake=bake_maps))
         result = write(
             sources,
             out,

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from lookdev.materials.layers import ConstantMask, TextureMask
+from lookdev.materials.layers import TextureMask
 
 from .lobes import canonical
 from .names import Slot
@@ -37,36 +37,27 @@ class LiveLayer:
     mask: Image | float
 
 
-def live_stack(material: Any, texture_dir: Path, resolution: int) -> list[LiveLayer]:
-    """The visible layers of a layered ``material``, bottom first, masks resolved."""
-    layers = [ly for ly in material.layers if not _is_constant(ly.mask, 0.0)]
-    for i in range(len(layers) - 1, 0, -1):
-        if _is_constant(layers[i].mask, 1.0):
-            layers = layers[i:]  # a full-coverage layer hides everything below it
-            break
+def live_stack(hub: Any, texture_dir: Path) -> list[LiveLayer]:
+    """The layers the blend kept (:attr:`BlendedMaterial.layers`), bottom first, with
+    their coverage (mask × presence) as a weight, a texture read as it is, or a bake."""
     out = []
-    for i, layer in enumerate(layers):
-        name = layer.name or f"layer{i}"
-        mask = 1.0 if i == 0 else _mask(layer.mask, material.name, i, texture_dir, resolution)
-        out.append(LiveLayer(name, canonical(layer.material.params), mask))
+    for i, entry in enumerate(hub.layers):
+        mask = 1.0 if i == 0 else _coverage(entry, hub, i, texture_dir)
+        out.append(LiveLayer(entry.label, canonical(entry.params), mask))
     return out
 
 
-def _is_constant(mask: Any, value: float) -> bool:
-    return isinstance(mask, ConstantMask) and mask.value == value
-
-
-def _mask(mask: Any, material: str, index: int, texture_dir: Path, resolution: int):
-    if isinstance(mask, ConstantMask):
-        return float(mask.value)
-    if _plain_texture(mask):
-        return Image(Path(mask.path))
+def _coverage(entry: Any, hub: Any, index: int, texture_dir: Path) -> Image | float:
+    if entry.uniform:
+        return float(entry.low)
+    if entry.presence == 1.0 and _plain_texture(entry.mask):
+        return Image(Path(entry.mask.path))
     from lookdev.pipeline.blend import MaskSampler
 
-    uv_order = MaskSampler((resolution, resolution)).evaluate(
-        mask, where=f"{material} layer {index}"
-    )
-    path = texture_dir / f"{material}_mask{index}.exr"
+    width, height = hub.resolution
+    sampler = MaskSampler((height, width))
+    uv_order = np.asarray(entry.coverage(sampler, slice(0, height)), dtype=np.float32)
+    path = texture_dir / f"{hub.name}_mask{index}.exr"
     return Image(path, np.flipud(uv_order), write=True)
 
 

@@ -1,12 +1,11 @@
 """Which lobes of a material carry weight, and its parameters with the dead ones reset.
 
-"A lobe whose weight is zero everywhere is not … exported" (DESIGN.md). A Disney
-material's lobe weights follow Burley 2012 §5 and Schutte 2018 §3: the dielectric part
-is weighted ``1 - metallic``; sheen and subsurface sit on the diffuse, which is further
-weighted ``1 - spec_trans``; ``diff_trans`` and ``flatness`` exist only on thin surfaces.
-Smits' six lobes (Pixar) live where his weights are not zero (:mod:`.pixar`). A parameter
-of a dead lobe has no effect, so it is neither written nor compared. Weights are judged as
-USD stores them (float32).
+"A lobe whose weight is zero everywhere is not … exported" (DESIGN.md). Which of a
+model's lobes live is the model's own rule (:func:`lookdev.materials.registry.live_lobes`);
+this module adds the exporter's finer groups of inputs (the dielectric part of the
+specular, Conty-Kulla sheen, the 2012 subsurface, flatness on thin sheets, the scatter
+distance of a solid). A parameter of a dead lobe has no effect, so it is neither written
+nor compared. Values are judged as USD stores them (float32).
 
 >>> from lookdev.materials.params import DisneyParams
 >>> on = active_lobes(canonical(DisneyParams(metallic=1.0, sheen=0.5)))
@@ -20,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from lookdev.materials import registry
 from lookdev.materials.params import DisneyParams
 from lookdev.materials.pixar import PixarParams
 
@@ -90,45 +90,50 @@ def canonical(params: Any) -> dict[str, Any]:
     return data
 
 
-def active_lobes(values: dict[str, Any], model: str = "disney") -> dict[str, bool]:
-    """lobe → whether it carries any weight, for canonical ``values`` of ``model``."""
-    if model == "pixar" and "amp_diffuse" not in values:  # bare parameters: derive weights
-        fields = {k: values[k] for k in PixarParams.model_fields if k in values}
-        values = {**values, **canonical(PixarParams.parse(fields))}
+REGISTRY_MODEL = {"disney": "disney", "pixar": "pixar", "pixar_weights": "pixar_layered"}
+"""This exporter's model names → the registry's (a Pixar blend is Smits' lobe weights)."""
+
+
+def active_lobes(
+    values: dict[str, Any], model: str = "disney", live: tuple[str, ...] | None = None
+) -> dict[str, bool]:
+    """lobe → whether it carries any weight, for canonical ``values`` of ``model``.
+
+    The model's own lobes are live as the registry says: ``live`` (a blend's answer, maps
+    included), or :func:`lookdev.materials.registry.live_lobes` of ``values`` as USD
+    stores them (float32: a weight of 1e-50 is written, and read, as 0). The rest are the
+    exporter's finer groups of inputs, each switched by a live lobe and a value.
+    """
+    if live is None:
+        live = _live(values, model)
+    on = {lobe.name: lobe.name in live for lobe in registry.MODELS[REGISTRY_MODEL[model]].lobes}
     v = {k: _stored(x) for k, x in values.items()}
     if model in ("pixar", "pixar_weights"):
-        return _pixar_lobes(v)
-    dielectric = v["metallic"] < 1.0
-    diffuse = dielectric and v["spec_trans"] < 1.0
-    spec_trans = dielectric and v["spec_trans"] > 0.0
-    subsurface = diffuse and v["subsurface"] > 0.0
-    sheen = dielectric and v["sheen"] > 0.0
+        on["highlights"] = on["specular"] or on["reflection"]
+        on["transmission"] = on["specular_t"] or on["reflection_t"]
+        on["dielectric"] = v.get("metallic", 0.0) < 1.0
+        return on
+    thin = bool(v["thin"])
+    subsurface = on["diffuse"] and v["subsurface"] > 0.0
     return {
-        "specular": True,
-        "dielectric": dielectric,
-        "diffuse": diffuse,
-        "sheen": sheen,
-        "conty_kulla": sheen and v["sheen_model"] == "conty_kulla",
-        "clearcoat": v["clearcoat"] > 0.0,
-        "spec_trans": spec_trans,
+        **on,
+        "dielectric": v["metallic"] < 1.0,
+        "conty_kulla": on["sheen"] and v["sheen_model"] == "conty_kulla",
         "subsurface": subsurface,
-        "diff_trans": diffuse and v["thin"] and v["diff_trans"] > 0.0,
-        "flatness": diffuse and v["thin"] and v["flatness"] > 0.0,
-        "scatter": (spec_trans or subsurface) and not v["thin"] and v["scatter_distance"] > 0,
-        "thin": bool(v["thin"]),
+        "flatness": on["diffuse"] and thin and v["flatness"] > 0.0,
+        "scatter": (on["spec_trans"] or subsurface) and not thin and v["scatter_distance"] > 0,
+        "thin": thin,
     }
 
 
-def _pixar_lobes(v: dict[str, Any]) -> dict[str, bool]:
-    """Smits' six lobes live where their weight amplitude (:mod:`.pixar`) is not zero."""
-    on = {lobe: v[f"amp_{lobe}"] > 0.0 for lobe in LOBES_PIXAR}
-    on["highlights"] = on["specular"] or on["reflection"]
-    on["transmission"] = on["specular_t"] or on["reflection_t"]
-    on["dielectric"] = v.get("metallic", 0.0) < 1.0
-    return on
-
-
-LOBES_PIXAR = ("diffuse", "diffuse_t", "specular", "reflection", "specular_t", "reflection_t")
+def _live(values: dict[str, Any], model: str) -> tuple[str, ...]:
+    """The registry's live lobes for canonical ``values`` (constants) as USD stores them."""
+    target = registry.MODELS[REGISTRY_MODEL[model]]
+    fields = target.params_type.model_fields
+    given = {k: _stored(v) for k, v in values.items() if k in fields and v is not None}
+    if model == "disney" and "ior" in given and "specular" in given:
+        del given["ior"]  # canonical values spell the F0 both ways; the model takes one
+    return registry.live_lobes(target, target.params_type.parse(given))
 
 
 def _stored(x: Any) -> Any:

@@ -115,15 +115,14 @@ class Source:
     description: str = ""
     layers: list[Any] = field(default_factory=list)  # live.LiveLayer, bottom first
     notes: list[str] = field(default_factory=list)  # losses every context shares
+    live: tuple[str, ...] | None = None
+    """The model's live lobes (the blend's, maps included); None: judged from ``values``."""
 
     @cached_property
     def lobes(self) -> dict[str, bool]:
-        """Lobes with weight; a mapped weight parameter counts as live."""
-        values = dict(self.values)
-        for k in self.maps:
-            if isinstance(values.get(k), float):
-                values[k] = max(values[k], 1e-6)
-        return active_lobes(values, self.model)
+        """The model's live lobes and the exporter's groups of inputs (:mod:`.lobes`)."""
+        mapped = self.maps or self.model == "pixar_weights"  # values are not all it has
+        return active_lobes(self.values, self.model, self.live if mapped else None)
 
     @cached_property
     def live_values(self) -> dict[str, Any]:

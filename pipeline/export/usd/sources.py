@@ -1,10 +1,11 @@
-"""Library materials → :class:`~.network.Source`: constants, or baked blends.
+"""Blended materials → :class:`~.network.Source`: constants, or baked maps.
 
-A disney material is all constants. A layered one goes through the blending engine
-(issue 5): :func:`lookdev.pipeline.blend.blend` gives constants where uniform and maps
-where a parameter varies, :func:`lookdev.pipeline.blend.bake` writes those maps as EXRs
-beside the exported file, and the networks read them. UsdPreviewSurface has no mix node,
-so the universal context always reads the baked parameter maps.
+The exporter takes the blend (:class:`~lookdev.pipeline.blend.BlendedMaterial`), never a
+preset: a plain material is all constants; a layered one has constants where uniform and
+maps where a parameter varies, which :func:`lookdev.pipeline.blend.bake` writes as EXRs
+beside the exported file for the networks to read. UsdPreviewSurface has no mix node, so
+the universal context always reads the baked parameter maps. Which lobes live is the
+blend's answer (:attr:`~lookdev.pipeline.blend.BlendedMaterial.live_lobes`).
 """
 
 from __future__ import annotations
@@ -15,7 +16,9 @@ from typing import Any
 import numpy as np
 
 from lookdev.materials.params import DisneyParams
+from lookdev.pipeline.blend.result import LOBE_WEIGHTS, BlendedMaterial
 
+from .live import live_stack
 from .lobes import DEFAULTS, canonical
 from .names import specular_to_ior
 from .network import ExportError, Image, Source, source_from_params
@@ -24,25 +27,25 @@ SUPPORTED = ("disney", "pixar")  # layered Pixar: see weights_source
 
 
 def source_for(
-    material: Any, texture_dir: Path, resolution: int, *, scratch: Path, bake: bool = True
+    hub: BlendedMaterial, texture_dir: Path, *, scratch: Path, bake: bool = True
 ) -> Source:
-    """The :class:`Source` of a library material; layered ones are blended and baked.
+    """The :class:`Source` of a blended material; varying parameters are baked to maps.
 
     Maps are baked into ``scratch`` and copied to ``texture_dir`` by the writer, so an
-    export that fails leaves nothing behind. ``bake=False`` also records the layer stack
-    so the MaterialX context mixes the layers live (:mod:`.live`); the universal and
-    RenderMan contexts read the baked maps.
+    export that fails leaves nothing behind. ``bake=False`` also records the kept layers
+    so the MaterialX context mixes them live (:mod:`.live`); the universal and RenderMan
+    contexts read the baked maps.
     """
-    if material.model != "layered":
-        _check_model(material.model, material.name)
-        return source_from_params(
-            material.name, material.model, material.params, material.description
-        )
-    source = baked_source(material, texture_dir, resolution, scratch)
-    if not bake and source.model == "disney":  # Smits' layering is not a parameter mix
-        from .live import live_stack
-
-        source.layers = live_stack(material, texture_dir, resolution)
+    _check_model(hub.model, hub.name)
+    if hub.representation == LOBE_WEIGHTS:
+        return weights_source(hub, texture_dir)
+    if not hub.layered:
+        source = source_from_params(hub.name, hub.model, hub.params, hub.description)
+        source.live = hub.live_lobes
+        return source
+    source = baked_source(hub, texture_dir, scratch)
+    if not bake and len(hub.layers) > 1:
+        source.layers = live_stack(hub, texture_dir)
     return source
 
 
@@ -56,33 +59,30 @@ def _check_model(model: str, name: str) -> None:
         )
 
 
-def baked_source(material: Any, texture_dir: Path, resolution: int, scratch: Path) -> Source:
-    """Blend ``material``, bake its varying parameters, and read the maps from there."""
-    from lookdev.pipeline.blend import bake, blend
+def baked_source(hub: BlendedMaterial, texture_dir: Path, scratch: Path) -> Source:
+    """Bake the varying parameters of a Disney blend and read the maps from there."""
+    from lookdev.pipeline.blend import bake
 
-    blended = blend(material, resolution)
-    _check_model(blended.model, material.name)
-    if getattr(blended, "representation", "params") == "lobe_weights":
-        return weights_source(material, blended, texture_dir)
-    files = bake(blended, scratch)
+    files = bake(hub, scratch)
 
     def image(name: str, array: np.ndarray) -> Image:
         return Image(texture_dir / files[name].name, np.flipud(array), True, files[name])
 
-    maps = {name: image(name, array) for name, array in blended.maps.items()}
+    maps = {name: image(name, array) for name, array in hub.maps.items()}
     if "specular" in maps:  # the universal surface reads the same F0 as an IOR
         ior = np.vectorize(specular_to_ior, otypes=[np.float32])(maps["specular"].pixels)
-        maps["ior"] = Image(texture_dir / f"{material.name}_ior.exr", ior, write=True)
-    normal = None if blended.normal_map is None else image("normal_map", blended.normal_map)
+        maps["ior"] = Image(texture_dir / f"{hub.name}_ior.exr", ior, write=True)
+    normal = None if hub.normal_map is None else image("normal_map", hub.normal_map)
     return Source(
-        material.name,
-        blended.model,
-        _constants(blended),
+        hub.name,
+        hub.model,
+        _constants(hub),
         maps=maps,
         normal_map=normal,
         spelling="specular",
-        description=material.description,
-        notes=_specular_normal_note(blended),
+        description=hub.description,
+        notes=_specular_normal_note(hub),
+        live=hub.live_lobes,
     )
 
 
@@ -93,18 +93,16 @@ def _specular_normal_note(blended) -> list[str]:
     return ["the specular normal map (Burley §6) is not written: no surface has a second normal"]
 
 
-def _constants(blended) -> dict[str, Any]:
+def _constants(hub: BlendedMaterial) -> dict[str, Any]:
     """Canonical values: the constants, and for mapped parameters their mean (a fallback)."""
-    data = dict(blended.constants)
-    for name, array in blended.maps.items():
-        mean = np.asarray(array, dtype=np.float64).reshape(-1, *np.shape(array)[2:]).mean(axis=0)
-        data[name] = tuple(float(x) for x in mean) if np.ndim(mean) else float(mean)
+    data = dict(hub.constants)
+    data.update({name: hub.mean(name) for name in hub.maps})
     if "ior" in data and "specular" in data:
         del data["specular"]
-    return canonical(DisneyParams.parse(data, where=blended.name))
+    return canonical(DisneyParams.parse(data, where=hub.name))
 
 
-def weights_source(material: Any, blended, texture_dir: Path) -> Source:
+def weights_source(hub: BlendedMaterial, texture_dir: Path) -> Source:
     """A Pixar blend (Smits' lobe weights): the target quantities, maps where they vary.
 
     Derived quantities (:func:`.pixar.from_weights`) are computed on the blend's arrays
@@ -114,27 +112,28 @@ def weights_source(material: Any, blended, texture_dir: Path) -> Source:
     """
     from .pixar import from_weights
 
-    arrays = {k: np.asarray(v) for k, v in {**blended.constants, **blended.maps}.items()}
+    arrays = {k: np.asarray(v) for k, v in {**hub.constants, **hub.maps}.items()}
     ior = arrays.pop("ior", None)
     eta = DEFAULTS["pixar_weights"]["eta"] if ior is None else float(np.mean(ior))
     values: dict[str, Any] = {"eta": eta}
     maps: dict[str, Image] = {}
     for name, value in from_weights(arrays).items():
         if np.ndim(value) >= 2:
-            path = texture_dir / f"{material.name}_{name}.exr"
+            path = texture_dir / f"{hub.name}_{name}.exr"
             maps[name] = Image(path, np.flipud(value).astype(np.float32), write=True)
             value = value.reshape(-1, *value.shape[2:]).mean(axis=0)
         values[name] = tuple(float(x) for x in value) if np.ndim(value) else float(value)
     normal = None
-    if blended.normal_map is not None:  # encoded (n + 1)/2 like every normal map
-        pixels = np.flipud(0.5 * blended.normal_map + 0.5).astype(np.float32)
-        normal = Image(texture_dir / f"{material.name}_normal_map.exr", pixels, write=True)
+    if hub.normal_map is not None:  # encoded (n + 1)/2 like every normal map
+        pixels = np.flipud(0.5 * hub.normal_map + 0.5).astype(np.float32)
+        normal = Image(texture_dir / f"{hub.name}_normal_map.exr", pixels, write=True)
     return Source(
-        material.name,
+        hub.name,
         "pixar_weights",
         values,
         maps=maps,
         normal_map=normal,
-        description=material.description,
-        notes=_specular_normal_note(blended),
+        description=hub.description,
+        notes=_specular_normal_note(hub),
+        live=hub.live_lobes,
     )
