@@ -42,7 +42,7 @@ class Lobe:
 
     ``params`` are the parameters that act through this lobe alone (or only through lobes
     listed with them): where every lobe naming a parameter is dead, the parameter has no
-    effect. Parameters no lobe names (``base_color``, ``roughness`` …) are always live.
+    effect. ``switches`` are those of them that turn it on. Parameters no lobe names (``base_color``, ``roughness`` …) are always live.
     Whether the lobe is live is never decided here but by the model's own ``prepare``
     (:func:`lookdev.materials.registry.live_lobes`), the one rule every consumer asks.
     """
@@ -57,6 +57,9 @@ class Lobe:
     """Smits' lobe type (diffuse, specular, reflection) shared by a lobe and its
     transmitted twin; the lobe's own name where it has no twin."""
     params: tuple[str, ...] = ()
+    switches: tuple[str, ...] = ()
+    """The parameters that switch the lobe on (its own weight); none for a base lobe that
+    any material has unless others take its energy (the Disney diffuse and specular)."""
 
     @property
     def mitsuba_flag(self) -> str:

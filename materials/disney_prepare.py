@@ -22,11 +22,29 @@ SHEEN_ALBEDO_GUESS = 0.1  # rough albedo of sheen 1, only used to weight samplin
 ETA_MIN = 1.001  # as Mitsuba: at η = 1 the rough BTDF becomes a delta
 DISNEY_LOBES = (
     Lobe("diffuse", "diffuse", params=("subsurface", "flatness")),
-    Lobe("diff_trans", "diffuse", transmits=True, params=("diff_trans",)),
-    Lobe("sheen", "glossy", params=("sheen", "sheen_tint", "sheen_model", "sheen_roughness")),
+    Lobe("diff_trans", "diffuse", True, params=("diff_trans",), switches=("diff_trans",)),
+    Lobe(
+        "sheen",
+        "glossy",
+        params=("sheen", "sheen_tint", "sheen_model", "sheen_roughness"),
+        switches=("sheen",),
+    ),
     Lobe("specular", "glossy", highlight=True),
-    Lobe("clearcoat", "glossy", highlight=True, params=("clearcoat", "clearcoat_gloss")),
-    Lobe("spec_trans", "glossy", transmits=True, highlight=True, params=("spec_trans",)),
+    Lobe(
+        "clearcoat",
+        "glossy",
+        highlight=True,
+        params=("clearcoat", "clearcoat_gloss"),
+        switches=("clearcoat",),
+    ),
+    Lobe(
+        "spec_trans",
+        "glossy",
+        transmits=True,
+        highlight=True,
+        params=("spec_trans",),
+        switches=("spec_trans",),
+    ),
 )
 """Burley 2012 §5 and Schutte 2018 §3; weights in :func:`prepare` (``weights``)."""
 LOBES = tuple(lobe.name for lobe in DISNEY_LOBES)

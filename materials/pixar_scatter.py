@@ -31,7 +31,14 @@ PIXAR_LOBES = (
         family="reflection",
         params=("reflection_scale", "reflection_cone_scale", "specular_tint"),
     ),
-    Lobe("diffuse_t", "diffuse", True, family="diffuse", params=("back", "diffuse_t_scale")),
+    Lobe(
+        "diffuse_t",
+        "diffuse",
+        True,
+        family="diffuse",
+        params=("back", "diffuse_t_scale"),
+        switches=("back",),
+    ),
     Lobe(
         "specular_t",
         "glossy",
@@ -39,6 +46,7 @@ PIXAR_LOBES = (
         highlight=True,
         family="specular",
         params=("specular_t_scale", "transmission_tint", "ior"),
+        switches=("clear",),
     ),
     Lobe(
         "reflection_t",
@@ -47,6 +55,7 @@ PIXAR_LOBES = (
         highlight=True,
         family="reflection",
         params=("reflection_t_scale", "transmission_tint", "ior"),
+        switches=("clear",),
     ),
 )
 """Smits' three lobes and their transmitted twins; a lobe's ``family`` is its type in

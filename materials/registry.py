@@ -97,11 +97,25 @@ def live_lobes(model: Model, params: Any, maps: Mapping[str, Any] | None = None)
     ``params`` are the constants; ``maps`` override fields with per-texel arrays ((H, W)
     scalars, (H, W, 3) colours, all of one size). The model's own ``prepare`` decides, on
     the numpy backend, so this is the rule its evaluation, sampling and plugin follow.
+    Values are judged as every consumer stores them, in float32: a weight of 1e-50 is 0
+    in a Mitsuba kernel and in a USD file alike.
     """
     flat = _flattened(model.params_type, maps or {})
     with np.errstate(all="ignore"):
-        prepared = model.prepare(NumpyOps(), params, **flat)
+        prepared = model.prepare(NumpyOps(), _stored(params), **flat)
     return tuple(prepared["lobes"])
+
+
+def _stored(params: Any) -> Any:
+    """``params`` with every number rounded to float32 (the type of a scene or a stage)."""
+    update = {}
+    for name in type(params).model_fields:
+        value = getattr(params, name)
+        if isinstance(value, float):
+            update[name] = float(np.float32(value))
+        elif isinstance(value, tuple) and all(isinstance(v, float) for v in value):
+            update[name] = tuple(float(np.float32(v)) for v in value)
+    return params.model_copy(update=update)
 
 
 def _flattened(params_type: type, maps: Mapping[str, Any]) -> dict[str, np.ndarray]:
@@ -109,6 +123,7 @@ def _flattened(params_type: type, maps: Mapping[str, Any]) -> dict[str, np.ndarr
     out = {}
     for name, value in maps.items():
         a = np.asarray(value, dtype=np.float64)
+        a = a.astype(np.float32).astype(np.float64)
         out[name] = a.reshape(-1, 3).T if is_color_field(params_type, name) else a.reshape(-1)
     return out
 

@@ -28,6 +28,8 @@ import functools
 from collections.abc import Iterable
 from typing import Any
 
+import numpy as np
+
 from lookdev.materials.arrays import DrJitOps
 from lookdev.materials.bsdf import Model
 from lookdev.materials.errors import LookdevError
@@ -143,7 +145,9 @@ def _plugin_class(variant: str) -> type:
             prepared = self._restricted(
                 self.model.prepare(self.xp, self.params, **self._forced(), **placeholders)
             )
-            kinds = lobe_kinds(lobes_of(prepared), self.model)
+            self.lobes = lobes_of(prepared)
+            """The lobes this instance traces (the model's live lobes, or ``only_lobes``)."""
+            kinds = lobe_kinds(self.lobes, self.model)
             reflect = [getattr(flag, k) for k in sorted(kinds) if "Reflection" in k]
             transmit = [getattr(flag, k) for k in sorted(kinds) if "Transmission" in k]
             self.components = [_union(reflect, flag), _union(transmit, flag)]
@@ -308,9 +312,13 @@ def _leading(component: Any, flag: Any) -> int:
 
 
 def _python_value(value: Any) -> Any:
-    """A Mitsuba property as a plain value for the pydantic schema."""
-    if isinstance(value, bool | int | float | str):
-        return float(value) if isinstance(value, int) and not isinstance(value, bool) else value
+    """A Mitsuba property as a plain value for the pydantic schema; numbers as the
+    float32 the kernel computes in (so a lobe is pruned exactly where its stored weight is
+    0, as :func:`lookdev.materials.registry.live_lobes` judges)."""
+    if isinstance(value, bool | str):
+        return value
+    if isinstance(value, int | float):
+        return float(np.float32(value))
     try:
         return tuple(float(c) for c in value)  # ScalarColor3f / ScalarColor3d
     except TypeError:

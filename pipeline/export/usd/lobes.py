@@ -130,7 +130,7 @@ def _live(values: dict[str, Any], model: str) -> tuple[str, ...]:
     """The registry's live lobes for canonical ``values`` (constants) as USD stores them."""
     target = registry.MODELS[REGISTRY_MODEL[model]]
     fields = target.params_type.model_fields
-    given = {k: _stored(v) for k, v in values.items() if k in fields and v is not None}
+    given = {k: v for k, v in values.items() if k in fields and v is not None}
     if model == "disney" and "ior" in given and "specular" in given:
         del given["ior"]  # canonical values spell the F0 both ways; the model takes one
     return registry.live_lobes(target, target.params_type.parse(given))

@@ -19,9 +19,10 @@ from typing import Any
 
 import numpy as np
 
+from lookdev.materials import registry
 from lookdev.materials.errors import LookdevError
 
-from .lobes import DEFAULTS, active_lobes, canonical, effective
+from .lobes import DEFAULTS, REGISTRY_MODEL, active_lobes, canonical, effective
 from .names import Slot
 
 CONTEXT_OUTPUT = {"universal": "surface", "mtlx": "mtlx:surface", "ri": "ri:surface"}
@@ -210,6 +211,27 @@ def loss_note(source: Source, context: str, mapped: set[str], extra: str = "") -
     if extra:
         parts.append(extra)
     return "; ".join(parts + source.notes)
+
+
+def lobe_coverage(source: Source, context: str) -> dict[str, str]:
+    """Each of the model's lobes in ``context``: ``"dead"`` (no weight: nothing written),
+    ``"written"`` (live, and the context carries it: a base lobe, or one of the
+    parameters that switch it on is mapped), or ``"lost"`` (live, and no switch of it is
+    expressible: :func:`loss_note` names them). No lobe is live and silently missing.
+    """
+    from .names import mapped_params
+
+    model = registry.MODELS[REGISTRY_MODEL[source.model]]
+    mapped = mapped_params(context, source.model)
+    out = {}
+    for lobe in model.lobes:
+        if not source.lobes[lobe.name]:
+            out[lobe.name] = "dead"
+        elif not lobe.switches or mapped & set(lobe.switches):
+            out[lobe.name] = "written"
+        else:
+            out[lobe.name] = "lost"
+    return out
 
 
 def same_or_eq(a: Any, b: Any) -> bool:
