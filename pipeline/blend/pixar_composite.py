@@ -52,23 +52,18 @@ import numpy as np
 
 from lookdev.materials.pixar import PixarParams, lobe_weights
 from lookdev.materials.pixar_lobes import CONE_MIN_DEG, LN_10
-from lookdev.materials.pixar_scatter import LOBES, PREFIX
+from lookdev.materials.pixar_scatter import LOBES, PIXAR_LOBES, PREFIX
 
 from .errors import BlendError
 
 BLUR = {"reflection": 0, "specular": 1, "diffuse": 2}
 """Smits' order of blurring: reflection/refraction < specular < diffuse."""
-REFLECTED = {"reflection": "reflection", "specular": "specular", "diffuse": "diffuse"}
-TRANSMITTED = {"reflection": "reflection_t", "specular": "specular_t", "diffuse": "diffuse_t"}
-TYPE_OF = {
-    "diffuse": "diffuse",
-    "specular": "specular",
-    "reflection": "reflection",
-    "diffuse_t": "diffuse",
-    "specular_t": "specular",
-    "reflection_t": "reflection",
-}
-GROUP = {lobe: "diffuse" if TYPE_OF[lobe] == "diffuse" else "highlight" for lobe in LOBES}
+# Smits' lobe types, their reflected and transmitted lobes and the normal each is shaded
+# with, as the model's registry declares them (lookdev.materials.pixar_scatter.PIXAR_LOBES).
+TYPE_OF = {lobe.name: lobe.family for lobe in PIXAR_LOBES}
+REFLECTED = {lobe.family: lobe.name for lobe in PIXAR_LOBES if not lobe.transmits}
+TRANSMITTED = {lobe.family: lobe.name for lobe in PIXAR_LOBES if lobe.transmits}
+GROUP = {lobe.name: "highlight" if lobe.highlight else "diffuse" for lobe in PIXAR_LOBES}
 FLAT = np.array([0.0, 0.0, 1.0])
 """The geometric normal in the shading frame."""
 
