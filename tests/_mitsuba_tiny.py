@@ -58,4 +58,3 @@ def _sample(xp, p, wo, u):
 
 LOBES = (Lobe("diffuse", "diffuse"), Lobe("diff_trans", "diffuse", transmits=True))
 TINY = Model("tiny_test", TinyParams, _prepare, _eval, _pdf, _sample, lobes=LOBES)
-MODEL = TINY  # what lookdev.pipeline.export.mitsuba.scene.model_for looks up

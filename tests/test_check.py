@@ -95,7 +95,8 @@ def test_check_json_reports_every_built_model(cli):
     result = cli("check", "--json")
     data = json.loads(result.out)
     assert result.code == 0, data
-    assert {"sheen", "pixar"} <= set(data["models"])
+    assert set(data) == {"models", "seconds"}  # every model is in the registry: none missing
+    assert set(data["models"]) == set(registry.MODELS)
     for name, m in data["models"].items():
         assert m["cases"] > 10_000, name
         found = (m["exception"], m["nan"], m["inf"], m["negative"], m["energy_gain"])
@@ -103,6 +104,13 @@ def test_check_json_reports_every_built_model(cli):
         assert m["worst"]["kind"] == "max_albedo"
         assert m["worst"]["value"] <= 1.0 + m["allowance"] + 0.05
     print(f"\nlookdev check --json: {data['seconds']} s")
+
+
+def test_models_named_come_from_the_registry(broken_registered):
+    assert stability_cases.models_named() == registry.MODELS
+    assert stability_cases.models_named(["broken"]) == {"broken": MODEL}
+    with pytest.raises(stability_cases.CheckError, match="velvet"):
+        stability_cases.models_named(["velvet"])
 
 
 def test_check_prints_a_table_per_model(cli):

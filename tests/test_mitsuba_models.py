@@ -64,13 +64,9 @@ GLOBAL_MIN_ALPHA = 0.1  # narrower peaks need the zoomed chart (tests/_mitsuba_c
 
 
 def _case_params(model_name, values):
-    from lookdev.pipeline.export.mitsuba.plugin import MitsubaExportError
-    from lookdev.pipeline.export.mitsuba.scene import model_for
+    from lookdev.materials.registry import model_named
 
-    try:
-        model = model_for(model_name)
-    except MitsubaExportError as exc:
-        pytest.skip(str(exc))
+    model = model_named(model_name)
     return model, model.params_type.parse(values)
 
 
@@ -224,9 +220,8 @@ def test_traverse_exposes_numbers_and_colours_not_switches(mi):
 
 
 def test_a_black_colour_prunes_its_lobe_on_both_backends(mi):
-    from lookdev.pipeline.export.mitsuba.depth import lobes_for
-    from lookdev.pipeline.export.mitsuba.scene import flatten
+    from lookdev.pipeline.blend import BlendedMaterial
 
     _, params = _case_params("sheen", {"color": [0.0, 0.0, 0.0]})
-    assert lobes_for(flatten(params)) == ()
+    assert BlendedMaterial.of_params(params).live_lobes == ()
     assert mi.load_dict(_plugin(mi, params)).flags() == 0

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from types import SimpleNamespace
-
 import numpy as np
 import pytest
 
@@ -24,15 +22,12 @@ def mi():
 
 
 def _blended(model="disney", normal=FLAT, specular=TILTED, **constants):
-    """A BlendedMaterial-shaped object (the blending engine's interface)."""
+    """A uniform BlendedMaterial under two normal maps (4 × 4 texels)."""
+    from lookdev.pipeline.blend import BlendedMaterial
+
     values = {"base_color": (0.6, 0.3, 0.2), "roughness": 0.3} | constants
-    return SimpleNamespace(
-        name="bumpy",
-        model=model,
-        constants=values,
-        maps={},
-        normal_map=normal,
-        specular_normal_map=specular,
+    return BlendedMaterial(
+        "bumpy", model, (4, 4), values, normal_map=normal, specular_normal_map=specular
     )
 
 
@@ -118,15 +113,17 @@ def test_equal_normals_need_no_split(mi):
 
 
 def test_pixar_layered_weights_split_by_lobe_group(mi):
+    from lookdev.pipeline.blend import BlendedMaterial
+
     weights = {"diffN": (0.5, 0.4, 0.3), "diffG": (0.2, 0.2, 0.2), "specN": (0.04,) * 3}
     weights |= {"specG": (0.3,) * 3, "reflN": (0.02,) * 3, "reflG": (0.5,) * 3}
     d = _bsdf(
-        SimpleNamespace(
-            name="layered",
-            model="pixar",
+        BlendedMaterial(
+            "layered",
+            "pixar",
+            (4, 4),
+            weights | {"specular_cone": 12.0, "reflection_cone": 1.0},
             representation="lobe_weights",
-            constants=weights | {"specular_cone": 12.0, "reflection_cone": 1.0},
-            maps={},
             normal_map=FLAT,
             specular_normal_map=TILTED,
         )

@@ -33,18 +33,15 @@ def m(mi, monkeypatch):
     return scene
 
 
-def _blended(name="tiled", **maps):
-    """A BlendedMaterial-shaped object (the blending engine's interface)."""
-    from types import SimpleNamespace
+def _blended(name="tiled", constants=None, **maps):
+    """A BlendedMaterial of the tiny model: ``constants`` (default a grey base colour)
+    and ``maps``, as the blending engine returns them."""
+    from lookdev.pipeline.blend import BlendedMaterial
 
-    return SimpleNamespace(
-        name=name,
-        model="tiny_test",
-        constants={"base_color": (0.5, 0.5, 0.5)},
-        maps=maps,
-        normal_map=None,
-        specular_normal_map=None,
-    )
+    h, w = next(iter(maps.values())).shape[:2] if maps else (1, 1)
+    if constants is None:
+        constants = {"base_color": (0.5, 0.5, 0.5)}
+    return BlendedMaterial(name, "tiny_test", (w, h), dict(constants), maps=dict(maps))
 
 
 def _render(mi, scene, seed=0):
@@ -63,17 +60,26 @@ def test_given_parameters_only(mi, m):
     assert m.bsdf_dict(TinyParams()) == {"type": "lookdev_tiny_test"}
 
 
-def test_bad_parameters_are_one_line_errors(m):
-    with pytest.raises(LookdevError, match="translucency"):
-        m.bsdf_dict(_bad())
+def test_bad_parameters_are_one_line_errors(mi, m):
+    """A hub's constants are not validated again on export; the plugin validates them when
+    Mitsuba loads it; a constant or map the model does not take is refused on export."""
+    with pytest.raises(LookdevError, match="roughnes") as info:
+        m.bsdf_dict(_blended("bad", {"roughnes": 0.5}))
+    assert "\n" not in str(info.value)
+    foreign_map = _blended(roughnes=np.zeros((2, 2), np.float32))
+    with pytest.raises(LookdevError, match="roughnes") as info:
+        m.scene_dict(foreign_map)  # before the depth rule runs the model on it
+    assert "\n" not in str(info.value)
+    d = m.bsdf_dict(_blended("bad", {"translucency": 2.0}))
+    with pytest.raises(Exception, match="translucency"):
+        mi.load_dict(d)
 
 
-def _bad():
-    from types import SimpleNamespace
+def test_a_library_material_must_be_blended_first(m):
+    from lookdev.library import load_material
 
-    return SimpleNamespace(
-        name="bad", model="tiny_test", constants={"translucency": 2.0}, maps={}, normal_map=None
-    )
+    with pytest.raises(LookdevError, match="blended material"):
+        m.bsdf_dict(load_material("gold"))
 
 
 def test_maps_become_bitmaps_in_memory_and_in_files(mi, m, tmp_path):
@@ -121,8 +127,7 @@ def test_max_depth_follows_the_material(m):
     assert depth.max_depth_for(dark) == depth.DEPTH_DARK
     assert depth.max_depth_for(TinyParams()) == depth.DEPTH_BRIGHT  # ρ = 0.8
     assert depth.max_depth_for(TinyParams(translucency=0.5)) == depth.DEPTH_THIN_DIFFUSE
-    zero = _blended(translucency=np.zeros((4, 4), np.float32))
-    zero.constants = {"base_color": (0.1, 0.1, 0.1)}
+    zero = _blended(constants={"base_color": (0.1, 0.1, 0.1)}, translucency=np.zeros((4, 4)))
     assert depth.max_depth_for(zero) == depth.DEPTH_DARK
     some = np.zeros((4, 4), np.float32)
     some[3, 3] = 0.01  # one texel transmits: the whole material needs the longer paths
@@ -133,12 +138,10 @@ def test_albedo_for_is_the_normal_incidence_albedo_anywhere(m):
     """Tiny model at normal view: albedo ρ(1 + cos 0)/2 = ρ, the largest channel and texel."""
     from lookdev.pipeline.export.mitsuba import depth
 
-    assert depth.albedo_for(m.flatten(TinyParams(base_color=(0.3, 0.7, 0.2)))) == pytest.approx(
-        0.7, rel=1e-6
-    )
+    assert depth.albedo_for(TinyParams(base_color=(0.3, 0.7, 0.2))) == pytest.approx(0.7, rel=1e-6)
     color = np.full((8, 8, 3), 0.2, np.float32)
     color[5, 6] = (0.1, 0.9, 0.3)  # one bright texel among 64: sampled, so it counts
-    assert depth.albedo_for(m.flatten(_blended(base_color=color))) == pytest.approx(0.9, rel=1e-6)
+    assert depth.albedo_for(_blended(base_color=color)) == pytest.approx(0.9, rel=1e-6)
 
 
 def test_force_all_lobes_is_passed_to_the_plugin(mi, m):
@@ -213,8 +216,9 @@ def _principled_vs_plugin(mi, m, params, n=4096, seed=0):
     """Max relative difference of principled and our plugin on random direction pairs."""
     import drjit as dr
 
-    flat = m.flatten(params)
-    fast = m.principled_equivalent(flat)
+    from lookdev.pipeline.blend import BlendedMaterial
+
+    fast = m.principled_equivalent(BlendedMaterial.of_params(params))
     assert fast is not None
     ours = mi.load_dict(m.bsdf_dict(params, allow_principled=False))
     theirs = mi.load_dict(fast)
@@ -245,9 +249,10 @@ def test_principled_fast_path_equals_our_metal(mi, m, disney, roughness, anisotr
 
 def test_fast_path_only_where_measured(m, disney):
     from lookdev.materials.params import DisneyParams
+    from lookdev.pipeline.blend import BlendedMaterial
 
     def fast(**kw):
-        return m.principled_equivalent(m.flatten(DisneyParams(**kw)))
+        return m.principled_equivalent(BlendedMaterial.of_params(DisneyParams(**kw)))
 
     assert fast(metallic=1.0, roughness=0.3) == {
         "type": "principled",
@@ -324,17 +329,17 @@ def test_forcing_all_lobes_traces_more_and_renders_the_same(mi, m, disney):
 
 
 def test_every_builtin_preset_becomes_a_bsdf(mi, m, disney):
-    """Each built-in preset exports (layered ones blended at 32²) and Mitsuba loads it."""
+    """Each built-in preset exports (blended at 32²) and Mitsuba loads it."""
     from lookdev.library import Library
+    from lookdev.pipeline.blend import blend
     from lookdev.pipeline.export.mitsuba import depth
 
     library = Library(use_env=False)
     for name in library.names():
-        material = library.load(name)
-        flat = m.flatten(material, 32)
-        bsdf = mi.load_dict(m.bsdf_dict(flat))
+        hub = blend(library.load(name), 32)
+        bsdf = mi.load_dict(m.bsdf_dict(hub))
         assert bsdf.flags() != 0, name
-        assert depth.max_depth_for(flat) in (4, 6, 10, 16), name
+        assert depth.max_depth_for(hub) in (4, 6, 10, 16), name
 
 
 def test_cli_exports_a_layered_preset_with_its_maps(mi, cli, disney, tmp_path):
@@ -397,9 +402,10 @@ import sys, numpy as np, mitsuba as mi
 mi.set_variant("scalar_rgb")
 import lookdev.pipeline.export.mitsuba as m
 from lookdev.library import load_material
+from lookdev.pipeline.blend import blend
 m.register_plugins()
 for name in sys.argv[1:]:
-    scene = m.scene_dict(load_material(name), resolution=(4, 4), spp=2)
+    scene = m.scene_dict(blend(load_material(name), 16), resolution=(4, 4), spp=2)
     print(name, float(np.mean(np.array(mi.render(mi.load_dict(scene))))))
 """
 

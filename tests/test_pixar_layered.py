@@ -312,7 +312,8 @@ def test_mitsuba_renders_a_one_layer_stack_as_the_preset(mi):
     params = P(surface_color=(0.8, 0.5, 0.2), roughness=0.3, clear=0.4, back=0.2, metallic=0.3)
     stacked = layered(layer(plain("only", params)), name="only")
     b_plain = mi.load_dict(bsdf_dict(params))
-    stack_dict = bsdf_dict(stacked, resolution=2)
+    stacked = blend(stacked, 2)
+    stack_dict = bsdf_dict(stacked)
     assert stack_dict["type"] == "lookdev_pixar_layered"
     b_stack = mi.load_dict(stack_dict)
     ctx = mi.BSDFContext()
@@ -325,7 +326,7 @@ def test_mitsuba_renders_a_one_layer_stack_as_the_preset(mi):
             np.testing.assert_allclose(b, a, rtol=2e-5, atol=1e-7)
     images = []
     for material in (params, stacked):
-        scene = mi.load_dict(scene_dict(material, resolution=(16, 16), spp=4, map_resolution=2))
+        scene = mi.load_dict(scene_dict(material, resolution=(16, 16), spp=4))
         images.append(np.array(mi.render(scene, seed=3)))
     np.testing.assert_allclose(images[1], images[0], rtol=1e-4, atol=1e-5)
 
@@ -356,15 +357,16 @@ def test_white_furnace_sphere_shows_the_composites_albedo(mi):
 @pytest.mark.parametrize("name", LAYERED_PRESETS)
 def test_builtin_layered_pixar_presets_become_bsdfs(mi, name):
     from lookdev.pipeline.export.mitsuba.depth import max_depth_for
-    from lookdev.pipeline.export.mitsuba.scene import bsdf_dict, flatten
+    from lookdev.pipeline.export.mitsuba.scene import bsdf_dict, plugin_inputs
 
-    flat = flatten(Library(use_env=False).load(name), 16)
-    assert flat.model == "pixar_layered"
+    hub = blend(Library(use_env=False).load(name), 16)
+    assert hub.bsdf_model is LAYERED_MODEL
     # Highlight weights do not change with the view: their grazing copies are left out.
-    assert not {"specN_grazing", "reflN_grazing"} & {*flat.maps, *flat.constants}
-    bsdf = mi.load_dict(bsdf_dict(flat))
+    constants, maps = plugin_inputs(hub)
+    assert not {"specN_grazing", "reflN_grazing"} & {*maps, *constants}
+    bsdf = mi.load_dict(bsdf_dict(hub))
     assert bsdf.flags() & mi.BSDFFlags.GlossyReflection
-    assert max_depth_for(flat) in (4, 6)
+    assert max_depth_for(hub) in (4, 6)
 
 
 # -- the commands ---------------------------------------------------------------------------
@@ -378,10 +380,8 @@ def test_proof_of_a_layered_pixar_preset(cli, tmp_path):
 
 
 def test_plot_of_a_layered_pixar_preset(cli, tmp_path):
-    from lookdev.pipeline.analysis.plots import subject_for
-
-    subject = subject_for("pixar_painted_metal")
-    assert subject.model is LAYERED_MODEL and subject.maps
+    hub = blend(Library(use_env=False).load("pixar_painted_metal"), 64)
+    assert hub.bsdf_model is LAYERED_MODEL and hub.maps
     for view in ("albedo", "sphere"):
         r = cli("plot", "pixar_painted_metal", "--view", view, "-o", str(tmp_path / f"{view}.png"))
         assert r.code == 0, r.err

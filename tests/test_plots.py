@@ -9,8 +9,11 @@ import numpy as np
 import pytest
 from _lambert import LAMBERT, PHONG, LambertParams, PhongParams
 
+from lookdev.library import load_material
+from lookdev.materials import registry
 from lookdev.pipeline.analysis import plots as P
 from lookdev.pipeline.analysis import sphere as S
+from lookdev.pipeline.blend import BlendedMaterial, blend
 
 RHO = np.array([0.8, 0.5, 0.2])
 
@@ -167,13 +170,15 @@ def test_mirror_like_sphere_reflects_the_environment_without_bias():
 
 # -- figures -------------------------------------------------------------------------
 @pytest.mark.parametrize("view", P.VIEWS)
-def test_every_view_draws_several_materials_labelled(tmp_path, view):
-    subjects = [
-        P.Subject("lambert", LAMBERT, LambertParams()),
-        P.Subject("phong", PHONG, PhongParams()),
+def test_every_view_draws_several_materials_labelled(tmp_path, view, monkeypatch):
+    monkeypatch.setitem(registry.MODELS, "lambert", LAMBERT)
+    monkeypatch.setitem(registry.MODELS, "phong", PHONG)
+    hubs = [
+        BlendedMaterial.of_params(LambertParams(), name="lambert"),
+        BlendedMaterial.of_params(PhongParams(), name="phong"),
     ]
     env = np.ones((8, 16, 3)) if view == "sphere" else None
-    fig = P.figure(subjects, view, environment=env, resolution=24)
+    fig = P.figure(hubs, view, environment=env, resolution=24)
     titles = [ax.get_title() for ax in fig.axes]
     assert any("lambert" in t for t in titles) and any("phong" in t for t in titles)
     out = P.save_figure(fig, tmp_path / f"{view}.png")
@@ -182,13 +187,6 @@ def test_every_view_draws_several_materials_labelled(tmp_path, view):
 
 
 # -- lookdev plot ----------------------------------------------------------------------
-def _needs_disney() -> None:
-    try:
-        P.model_named("disney")
-    except P.PlotError:
-        pytest.skip("the disney model has not landed yet")
-
-
 def test_cli_rejects_an_unknown_output_format_in_one_line(cli, tmp_path):
     res = cli("plot", "gold", "-o", str(tmp_path / "a.jpg"))
     assert res.code == 2
@@ -203,14 +201,12 @@ def test_cli_names_a_missing_preset(cli, tmp_path):
 
 
 def test_cli_ibl_only_with_sphere(cli, tmp_path):
-    _needs_disney()
     res = cli("plot", "gold", "--view", "slice", "--ibl", "studio", "-o", str(tmp_path / "a.png"))
     assert res.code == 2 and "--ibl" in res.err
 
 
 @pytest.mark.parametrize("view", P.VIEWS)
 def test_cli_plots_presets_side_by_side(cli, tmp_path, view):
-    _needs_disney()
     out = tmp_path / f"{view}.png"
     ibl = ["--ibl", "studio"] if view == "sphere" else []
     res = cli(
@@ -236,15 +232,14 @@ def test_cli_plots_presets_side_by_side(cli, tmp_path, view):
 
 
 # -- the shipped models, checked the same way -----------------------------------------
-def _preset(name: str) -> P.Subject:
-    _needs_disney()
-    return P.subject_for(name)
+def _preset(name: str) -> BlendedMaterial:
+    return blend(load_material(name), 16)
 
 
 def test_metal_with_roughness_0_2_slice_peaks_at_theta_h_zero():
     gold = _preset("gold")
     assert gold.params.metallic == 1.0 and gold.params.roughness == 0.2
-    _, td, f = P.brdf_slice(gold.model, gold.params, n=90)
+    _, td, f = P.brdf_slice(gold.bsdf_model, gold.params, n=90)
     for c in range(3):
         assert np.all(np.argmax(f[:, :, c], axis=1) == 0)  # every θd row, every channel
 
@@ -252,7 +247,7 @@ def test_metal_with_roughness_0_2_slice_peaks_at_theta_h_zero():
 @pytest.mark.parametrize("incidence", [0.0, 30.0, 60.0])
 def test_metal_polar_peak_is_at_the_mirror_direction(incidence):
     gold = _preset("gold")
-    theta_o, lum = P.polar_curves(gold.model, gold.params, [incidence], n=1441)
+    theta_o, lum = P.polar_curves(gold.bsdf_model, gold.params, [incidence], n=1441)
     # G and 1/cos θo lean the peak of f a little past the mirror direction, growing to
     # grazing (0.2° at 60°); the mirror direction itself is the D peak.
     assert math.degrees(theta_o[np.argmax(lum[0])]) == pytest.approx(incidence, abs=0.3)
@@ -263,8 +258,8 @@ def test_disney_albedo_sampler_and_quadrature_agree_on_a_rough_material():
 
     plaster = _preset("plaster")
     theta = np.radians([0.0, 30.0, 60.0, 80.0])
-    q = albedo_quadrature(plaster.model, plaster.params, theta, n_mu=128, n_phi=128)
-    mc = albedo_monte_carlo(plaster.model, plaster.params, theta, n_samples=8192)
+    q = albedo_quadrature(plaster.bsdf_model, plaster.params, theta, n_mu=128, n_phi=128)
+    mc = albedo_monte_carlo(plaster.bsdf_model, plaster.params, theta, n_samples=8192)
     assert np.all(np.abs(mc.albedo - q.albedo) <= 5 * mc.stderr + 1e-3)
 
 
@@ -281,19 +276,14 @@ def test_sheen_albedo_table_agrees_with_quadrature(r):
     np.testing.assert_allclose(t[:, 1] / t[:, 0], 0.5)  # F scales the table per channel
 
 
-def test_layered_preset_is_plotted_at_its_centre_texel():
-    _needs_disney()
-    from lookdev.library import load_material
-    from lookdev.pipeline.blend import blend
-
-    subject = P.subject_for("rusty_iron")
-    blended = blend(load_material("rusty_iron"), P.MAP_RESOLUTION)
-    assert blended.maps, "rusty_iron should vary across the surface"
-    n = P.MAP_RESOLUTION // 2
-    assert subject.label == "rusty_iron"
-    assert subject.params == blended.params_at(n, n)
-    assert subject.maps.keys() == blended.maps.keys()
-    assert subject.model is P.model_named(blended.model)
+def test_layered_preset_is_plotted_at_its_centre_texel(tmp_path):
+    hub = blend(load_material("rusty_iron"), 32)
+    assert hub.maps, "rusty_iron should vary across the surface"
+    assert hub.name == "rusty_iron"
+    assert hub.bsdf_model is registry.model_named("disney")
+    assert hub.centre_params.model_dump() == hub.params_at(16, 16).model_dump()
+    fig = P.figure([hub], "albedo", resolution=16)
+    assert [ax.get_title() for ax in fig.axes] == ["rusty_iron\n(centre texel)"]
 
 
 LAMBERTIAN_PRESET = """\
@@ -308,23 +298,21 @@ roughness = 1.0
 
 @pytest.fixture
 def lambertian_preset(tmp_path):
-    try:
-        P.model_named("pixar")
-    except P.PlotError:
-        pytest.skip("the pixar model has not landed yet")
     path = tmp_path / "matte.toml"
     path.write_text(LAMBERTIAN_PRESET)
-    return P.subject_for(str(path))
+    return blend(load_material(str(path)), 16)
 
 
 def test_lambertian_preset_views_match_closed_forms(lambertian_preset):
     s = lambertian_preset
     (curve,) = P.albedo_curves(s)  # what the albedo view draws
     np.testing.assert_allclose(curve.albedo, np.tile(RHO, (len(curve.theta), 1)), rtol=1e-12)
-    _, lum = P.polar_curves(s.model, s.params, [0, 60, 89])
+    _, lum = P.polar_curves(s.bsdf_model, s.params, [0, 60, 89])
     np.testing.assert_allclose(lum, RHO @ S.REC709_Y / math.pi, rtol=1e-12)
     light = np.array([-1.0, 1.0, 1.0]) / math.sqrt(3.0)
-    img = S.point_light_sphere(s.model, s.params, resolution=32, light=tuple(light), irradiance=1.0)
+    img = S.point_light_sphere(
+        s.bsdf_model, s.params, resolution=32, light=tuple(light), irradiance=1.0
+    )
     n, inside = S.sphere_normals(32)
     expected = np.clip(n @ light, 0, None)[..., None] * RHO / math.pi * inside[..., None]
     np.testing.assert_allclose(img, expected, atol=1e-15)
@@ -333,15 +321,12 @@ def test_lambertian_preset_views_match_closed_forms(lambertian_preset):
 @pytest.mark.parametrize("model_name", ["disney", "pixar", "sheen"])
 @pytest.mark.parametrize("roughness", [0.0, 1.0])
 def test_views_of_every_model_are_finite_at_the_roughness_edges(model_name, roughness):
-    try:
-        model = P.model_named(model_name)
-    except P.PlotError:
-        pytest.skip(f"the {model_name} model has not landed yet")
+    model = registry.model_named(model_name)
     params = model.params_type().replace(roughness=roughness)
     with np.errstate(all="raise"):  # the views themselves must not over/underflow
         _, _, f = P.brdf_slice(model, params, n=24)
         _, lum = P.polar_curves(model, params, [0, 89.5], n=91)
-        (curve, *_) = P.albedo_curves(P.Subject(model_name, model, params), n_theta=10)
+        (curve, *_) = P.albedo_curves(BlendedMaterial.of_params(params), n_theta=10)
         img = S.point_light_sphere(model, params, resolution=16)
     for a in (f, lum, curve.albedo, curve.stderr, img):
         assert np.all(np.isfinite(a)) and np.all(a >= 0)

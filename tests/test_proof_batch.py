@@ -33,8 +33,9 @@ def mitsuba():
 @pytest.fixture(scope="module")
 def gold():
     from lookdev.library import load_material
+    from lookdev.pipeline.blend import blend
 
-    return load_material("gold")
+    return blend(load_material("gold"), 16)
 
 
 def _table(mitsuba, bsdf=DIFFUSE, resolution=(32, 16)):
@@ -106,9 +107,10 @@ from lookdev.pipeline.variant import use_mitsuba
 use_mitsuba()
 import mitsuba as mi
 from lookdev.library import load_material
+from lookdev.pipeline.blend import blend
 from lookdev.pipeline.proof import ibl, turntable
 for name in sys.argv[1:]:
-    bsdf, depth = turntable.material_bsdf(load_material(name))
+    bsdf, depth = turntable.material_bsdf(blend(load_material(name), 64))
     table = turntable.Turntable(bsdf, ibl.load("studio", 64).pixels, (16, 8), depth)
     for frame in turntable.frames(2, 2):
         table.set_frame(frame)

@@ -320,13 +320,21 @@ def test_the_chromium_check_itself_sees_broken_images_and_console_errors(tmp_pat
 
 @needs_chromium
 def test_page_opens_in_chromium_without_errors_or_broken_images(batch, tmp_path):
-    index = R.write_report(batch)
+    from lookdev.library import load_material
+    from lookdev.pipeline.blend import blend
+
+    # Plots for the blended materials given (gold); chalk is not among them: no plots.
+    index = R.write_report(batch, materials={"gold": blend(load_material("gold"), 16)})
     seen = open_in_chromium(index, tmp_path / "profile")
     shot = batch / "report" / "screenshot.png"
     shot.write_bytes(seen["screenshot"])
     for problem in ("console", "exceptions", "log", "failed", "remote", "broken"):
         assert not seen[problem], (problem, seen[problem])
-    assert len(seen["images"]) >= 13  # a contact sheet and 12 frames, plus any plots
+    # a contact sheet, 12 frames and gold's plots
+    assert len(seen["images"]) == 13 + len(R.PLOT_VIEWS)
+    assert sorted(p.name for p in (batch / "report" / "plots").iterdir()) == sorted(
+        f"gold_{view}.png" for view in R.PLOT_VIEWS
+    )
     assert shot.read_bytes()[:4] == b"\x89PNG"
 
 

@@ -253,6 +253,9 @@ def scene_dict(
 
     hub = as_hub(material)
     _ensure_variant()
+    # The BSDF first: it refuses inputs the model does not take in one line, before the
+    # depth rule runs the model's prepare on them.
+    bsdf = bsdf_dict(hub, texture_dir, force_all_lobes=force_all_lobes)
     width, height = resolution
     distance = 4.0
     fov = 2.0 * math.degrees(math.asin(1.0 / distance)) * 1.15  # the ball fills ~87%
@@ -280,10 +283,7 @@ def scene_dict(
             "sampler": {"type": "independent", "sample_count": int(spp)},
         },
         "environment": emitter,
-        "ball": {
-            "type": "sphere",
-            "bsdf": bsdf_dict(hub, texture_dir, force_all_lobes=force_all_lobes),
-        },
+        "ball": {"type": "sphere", "bsdf": bsdf},
     }
 
 
