@@ -33,23 +33,16 @@ def best_time(fn: Callable[[], Any], *, repeat: int = 3, min_time: float = 0.0) 
 
 
 def _register() -> None:
-    from lookdev.pipeline.analysis import (
-        bench_blend,
-        bench_depth,
-        bench_eval,
-        bench_library,
-        bench_proof,
-        bench_usd,
-        error_bench,
-    )
+    from lookdev.pipeline.bench import blend, depth, error, library, proof, usd
+    from lookdev.pipeline.bench import eval as eval_
 
-    app.command("blend")(bench_blend.command)
-    app.command("depth")(bench_depth.command)
-    app.command("error")(error_bench.command)
-    app.command("eval")(bench_eval.command)
-    app.command("library")(bench_library.command)
-    app.command("proof")(bench_proof.command)
-    app.command("usd")(bench_usd.command)
+    app.command("blend")(blend.command)
+    app.command("depth")(depth.command)
+    app.command("error")(error.command)
+    app.command("eval")(eval_.command)
+    app.command("library")(library.command)
+    app.command("proof")(proof.command)
+    app.command("usd")(usd.command)
 
 
 _register()

@@ -23,8 +23,7 @@ from typing import Any
 import numpy as np
 
 from lookdev.materials.bsdf import Model, evaluate
-
-from .albedo import albedo_monte_carlo, albedo_quadrature, albedo_tabulated
+from lookdev.pipeline.analysis.albedo import albedo_monte_carlo, albedo_quadrature, albedo_tabulated
 
 
 @dataclass(frozen=True)
@@ -175,7 +174,7 @@ def bench_lambda(
     """The Λ fit, and the projected-area integral at a ladder of Gauss-Legendre nodes,
     against that integral converged (:func:`lookdev.pipeline.analysis.sheen_fit.
     lambda_integrated`, Heitz 2014: 1 + Λ(ω) = ∫ ⟨ω·m⟩ D(m) dm / cos θ)."""
-    from .sheen_fit import lambda_integrated
+    from lookdev.pipeline.analysis.sheen_fit import lambda_integrated
 
     rows = []
     n_eval = len(LAMBDA_COS)

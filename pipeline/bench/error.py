@@ -172,7 +172,7 @@ def run(
     """Measure every asked item now. ``render``/``models`` override what is discovered."""
     report = Report()
     if models is None:
-        from .stability_cases import available_models
+        from lookdev.pipeline.analysis.stability_cases import available_models
 
         models, missing = available_models()
         report.skipped.update({f"model {name}": why for name, why in missing.items()})
@@ -273,7 +273,7 @@ def plot_error_vs_time(report: Report, path: Path) -> Path:
     marker per method, each legend beside its panel."""
     from matplotlib.lines import Line2D
 
-    from .plots import plt, save_figure
+    from lookdev.pipeline.analysis.plots import plt, save_figure
 
     items = [i for i in ITEMS if any(r.item == i and r.error > 0 for r in report.rows)]
     rows_n = max(1, (len(items) + 1) // 2)

@@ -270,7 +270,7 @@ def peak_rss(case: str, folder: Path, resolution: int) -> dict[str, int]:
 
 
 _CHILD = (
-    "import sys; from lookdev.pipeline.analysis.bench_blend import child_peak; "
+    "import sys; from lookdev.pipeline.bench.blend import child_peak; "
     "child_peak(sys.argv[1], sys.argv[2], int(sys.argv[3]))"
 )
 
