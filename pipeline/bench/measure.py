@@ -25,6 +25,8 @@ import numpy as np
 from lookdev.materials.bsdf import Model, evaluate
 from lookdev.pipeline.analysis.albedo import albedo_monte_carlo, albedo_quadrature, albedo_tabulated
 
+from .timing import best_time
+
 
 @dataclass(frozen=True)
 class Row:
@@ -52,8 +54,6 @@ class Row:
 
 def timed(fn: Callable[[], Any], repeat: int = 3) -> tuple[Any, float]:
     """(result, best wall time of ``repeat`` calls after a warm-up)."""
-    from lookdev.pipeline.cli.bench import best_time
-
     result = fn()
     return result, best_time(fn, repeat=repeat, min_time=2.0)
 
