@@ -7,8 +7,9 @@
 """
 
 from .bake import bake
-from .engine import BlendedMaterial, blend
+from .engine import blend
 from .errors import BlendError, TextureError
 from .masks import MaskSampler
+from .result import BlendedMaterial
 
 __all__ = ["BlendError", "BlendedMaterial", "MaskSampler", "TextureError", "bake", "blend"]

@@ -18,6 +18,7 @@ from lookdev.materials.pixar_scatter import LOBES, PREFIX
 
 from .masks import MaskSampler
 from .pixar_composite import GROUP, Lobes, Part, composite, layer_lobes, unit
+from .result import TILE_TEXELS, BlendedMaterial
 from .stack import Entry, prune_stack
 
 VIEWS = {"": 1.0, "_grazing": 0.0}
@@ -56,8 +57,6 @@ def blend_stack(
     ``normal_map`` and ``specular_normal_map``: the inputs of
     :data:`lookdev.materials.pixar.LAYERED_MODEL`.
     """
-    from .engine import BlendedMaterial
-
     resolution = (sampler.width, sampler.height)
     if not layered:
         params = entries[0].params
@@ -92,8 +91,6 @@ def blend_stack(
 
 def _outputs(top_first: list[Entry], sampler: MaskSampler, progress, mode: str):
     """Every output array, (H, W[, 3]), composited tile by tile."""
-    from .engine import TILE_TEXELS
-
     height, width = sampler.height, sampler.width
     rows_per_tile = max(1, TILE_TEXELS // width)
     out: dict[str, np.ndarray] = {}
