@@ -7,7 +7,8 @@
 
 from .depth import max_depth_for
 from .plugin import MitsubaExportError, register_model
-from .scene import bsdf_dict, register_plugins, scene_dict
+from .scene import bsdf_dict, register_plugins
+from .sphere_scene import scene_dict
 from .xml import export_scene, write_xml
 
 __all__ = [

@@ -5,8 +5,8 @@
 uniform parameters as constants and varying ones as ``bitmap`` textures. Mitsuba's
 built-in ``principled`` replaces it only where the two were measured equal (see
 :func:`principled_equivalent`). :func:`.depth.max_depth_for` sizes the path tracer to what
-the material needs and :func:`scene_dict` is the small export scene (one sphere under an
-environment) that ``lookdev export mitsuba`` writes.
+the material needs and :func:`.sphere_scene.scene_dict` is the small export scene (one
+sphere under an environment) that ``lookdev export mitsuba`` writes.
 
 Texture orientation: Mitsuba's bitmap puts an image's row 0 at v = 0, and a blended map's
 texel (0, 0) is UV (0, 0), so maps go to Mitsuba row for row, in memory and in EXR files.
@@ -15,7 +15,6 @@ texel (0, 0) is UV (0, 0), so maps go to Mitsuba row for row, in memory and in E
 from __future__ import annotations
 
 import importlib
-import math
 import os
 import tempfile
 from collections.abc import Mapping
@@ -323,63 +322,6 @@ def write_exr(data: np.ndarray, path: Path) -> Path:
         if os.path.exists(tmp):
             os.unlink(tmp)
     return path
-
-
-def scene_dict(
-    material: Any,
-    *,
-    resolution: tuple[int, int] = (256, 256),
-    spp: int = 64,
-    environment: str | Path | None = None,
-    texture_dir: str | Path | None = None,
-    force_all_lobes: bool = False,
-    max_depth: int | None = None,
-    map_resolution: int = DEFAULT_MAP_RESOLUTION,
-) -> dict[str, Any]:
-    """A minimal scene: the material on a unit sphere, framed, under an environment.
-
-    ``environment`` is a lat-long image (``envmap``); without one, a constant white sky
-    (the white-furnace set-up). The integrator depth follows the material; the film
-    holds RGB only (no alpha, no AOVs).
-    """
-    import mitsuba as mi
-
-    from .depth import max_depth_for  # depth builds on this module's flatten
-
-    flat = flatten(material, map_resolution)
-    _ensure_variant()
-    width, height = resolution
-    distance = 4.0
-    fov = 2.0 * math.degrees(math.asin(1.0 / distance)) * 1.15  # the ball fills ~87%
-    emitter: dict[str, Any]
-    if environment is None:
-        emitter = {"type": "constant", "radiance": {"type": "rgb", "value": [1.0, 1.0, 1.0]}}
-    else:
-        emitter = {"type": "envmap", "filename": str(environment)}
-    return {
-        "type": "scene",
-        "integrator": {"type": "path", "max_depth": max_depth or max_depth_for(flat)},
-        "sensor": {
-            "type": "perspective",
-            "fov": fov,
-            "to_world": mi.ScalarTransform4f().look_at(
-                origin=[0.0, 0.0, distance], target=[0.0, 0.0, 0.0], up=[0.0, 1.0, 0.0]
-            ),
-            "film": {
-                "type": "hdrfilm",
-                "width": int(width),
-                "height": int(height),
-                "pixel_format": "rgb",
-                "rfilter": {"type": "gaussian"},
-            },
-            "sampler": {"type": "independent", "sample_count": int(spp)},
-        },
-        "environment": emitter,
-        "ball": {
-            "type": "sphere",
-            "bsdf": bsdf_dict(flat, texture_dir, force_all_lobes=force_all_lobes),
-        },
-    }
 
 
 def uses_our_plugins(tree: Mapping[str, Any]) -> bool:

@@ -1,6 +1,6 @@
 """Mitsuba scene dictionaries as scene XML files a user can open (``mi.load_file``).
 
-The dictionary is the one ``mi.load_dict`` takes (:func:`.scene.scene_dict`); each nested
+The dictionary is the one ``mi.load_dict`` takes (:func:`.sphere_scene.scene_dict`); each nested
 plugin becomes an element named after its object type, each value a typed property.
 When the scene uses our Python BSDF plugins, the first line of the file says how to make
 Mitsuba know them. Files are written to a temporary name and renamed, so a failed export
@@ -17,7 +17,8 @@ from pathlib import Path
 from typing import Any
 
 from .plugin import PLUGIN_PREFIX, MitsubaExportError
-from .scene import scene_dict, uses_our_plugins
+from .scene import uses_our_plugins
+from .sphere_scene import scene_dict
 
 LOAD_HINT = (
     " lookdev BSDF plugins: in Python, run import lookdev.pipeline.export.mitsuba as m; "
