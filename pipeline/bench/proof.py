@@ -35,12 +35,6 @@ from typing import Any
 
 import numpy as np
 
-from lookdev.materials.errors import LookdevError
-
-
-class BenchProofError(LookdevError):
-    """The proof benchmark cannot run as asked."""
-
 
 @dataclass(frozen=True)
 class Settings:
