@@ -36,7 +36,6 @@ from typing import Any
 
 import numpy as np
 
-PI = math.pi
 INV_PI = 1.0 / math.pi
 
 

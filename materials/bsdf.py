@@ -42,7 +42,8 @@ class Lobe:
 
     ``params`` are the parameters that act through this lobe alone (or only through lobes
     listed with them): where every lobe naming a parameter is dead, the parameter has no
-    effect. ``switches`` are those of them that turn it on. Parameters no lobe names (``base_color``, ``roughness`` …) are always live.
+    effect; ``switches`` are those of them that turn it on. Parameters no lobe names
+    (``base_color``, ``roughness`` …) are always live.
     Whether the lobe is live is never decided here but by the model's own ``prepare``
     (:func:`lookdev.materials.registry.live_lobes`), the one rule every consumer asks.
     """

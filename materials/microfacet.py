@@ -90,15 +90,20 @@ def gtr_sample_sin2(xp: Any, gamma: float, a2: Any, xi: Any) -> Any:
     """sin²θh = 1 − cos²θh of :func:`gtr_sample_cos2`, without the cancellation.
 
     cos²θh = expm1(L r)/expm1(L) (L = log α²), so sin²θh = e^{L r}·expm1(L s)/expm1(L)
-    with s = 1 − r = −log1p(ξ·expm1(−t))/t (series ξ(1 − u t/2)). Near the peak of a
-    sharp lobe (α = 10⁻³, ξ → 0) 1 − cos² loses every digit in float32; this keeps them.
+    with s = 1 − r = −log(a)/t, a = 1 + ξ·expm1(−t) = u + ξ·e^{−t} (series ξ(1 − u t/2)).
+    Near the peak of a sharp lobe (α = 10⁻³, ξ → 0) 1 − cos² loses every digit in float32;
+    this keeps them. log a is taken as log1p(ξ·expm1(−t)) where a ≥ ½ and as log(u + ξ·e^{−t})
+    where a < ½ (only at γ > 1, t > 0: a sum of two positive terms, no cancellation): near
+    ξ = 1, 1 + ξ·expm1(−t) would cancel to e^{−t} and lose the digits of s → 1 instead.
     """
     log_a2 = xp.log(a2)
     t = (1.0 - gamma) * log_a2
     u = 1.0 - xi
     small = xp.abs(t) < _SERIES
     safe = xp.select(small, 1.0, t)
-    s = xp.select(small, xi * (1.0 - 0.5 * u * t), -xp.log1p(xi * xp.expm1(-safe)) / safe)
+    x = xi * xp.expm1(-safe)
+    log_a = xp.select(x >= -0.5, xp.log1p(x), xp.log(u + xi * xp.exp(-safe)))
+    s = xp.select(small, xi * (1.0 - 0.5 * u * t), -log_a / safe)
     s = xp.clip(s, 0.0, 1.0)  # float32 at γ > 1, α → 0: log1p(−1) = −∞ where s → 1
     sin2 = xp.exp(log_a2 * (1.0 - s)) * s * exprel(xp, log_a2 * s) / exprel(xp, log_a2)
     return xp.clip(sin2, 0.0, 1.0)

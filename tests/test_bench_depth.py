@@ -1,4 +1,4 @@
-"""``lookdev bench depth`` (pipeline/analysis/bench_depth.py), at tiny settings."""
+"""``lookdev bench depth`` (pipeline/bench/depth.py), at tiny settings."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from lookdev.pipeline.analysis import bench_depth
+from lookdev.pipeline.bench import depth as bench_depth
 
 pytestmark = pytest.mark.render
 

@@ -243,7 +243,7 @@ def test_layer_lobes_match_the_model_weights():
 
 
 def test_tiles_match_one_pass(monkeypatch):
-    from lookdev.pipeline.blend import engine
+    from lookdev.pipeline.blend import pixar as pixar_path
 
     stack = layered(
         layer(pixar("c", CLAY)),
@@ -251,7 +251,7 @@ def test_tiles_match_one_pass(monkeypatch):
         layer(pixar("c2", CLAY.replace(roughness=0.2)), NoiseMask(seed=5)),
     )
     whole = blend(stack, (20, 16))
-    monkeypatch.setattr(engine, "TILE_TEXELS", 20 * 3)  # 3 rows a tile, the last one 1 row
+    monkeypatch.setattr(pixar_path, "TILE_TEXELS", 20 * 3)  # 3 rows a tile, the last one 1 row
     tiled = blend(stack, (20, 16))
     assert whole.maps.keys() == tiled.maps.keys() and whole.maps["diffN"].shape == (16, 20, 3)
     for name in whole.maps:

@@ -429,7 +429,7 @@ def test_agrees_with_mitsuba_principled_where_the_models_coincide(mitsuba):
     # Measured max relative differences (float32 Mitsuba vs float64 ours): metals 1.5e-6 to
     # 5.7e-6, retro-reflective diffuse 4.6e-7, subsurface (Mitsuba's "flatness") 6.2e-7,
     # untinted sheen 9.1e-7, dielectric given by ior 2.2e-6.
-    from lookdev.pipeline.analysis.bench_eval import agreement
+    from lookdev.pipeline.bench.eval import agreement
 
     for case, diff in agreement().items():
         assert diff < 2e-5, case
@@ -445,7 +445,7 @@ def test_solid_glass_is_mitsubas_roughdielectric(mitsuba, roughness):
     # An independent BTDF: white glass given by ior is Walter's rough dielectric, both
     # sides, radiance mode. Measured max relative difference (float32 Mitsuba): reflection
     # 7e-6..1.5e-5, transmission 4e-5..1.1e-4.
-    from lookdev.pipeline.analysis.bench_eval import mitsuba_eval, relative_difference
+    from lookdev.pipeline.bench.eval import mitsuba_eval, relative_difference
 
     p = DisneyParams(base_color=WHITE, spec_trans=1.0, ior=1.5, roughness=roughness)
     ref = mitsuba.load_dict(
@@ -466,7 +466,7 @@ def test_solid_glass_is_mitsubas_roughdielectric(mitsuba, roughness):
 
 def test_differs_from_principled_by_design_schlick_vs_exact_fresnel(mitsuba):
     # specular given: Burley's Schlick F; Mitsuba always uses the exact dielectric Fresnel.
-    from lookdev.pipeline.analysis.bench_eval import (
+    from lookdev.pipeline.bench.eval import (
         mitsuba_eval,
         principled_dict,
         relative_difference,
@@ -482,7 +482,7 @@ def test_differs_from_principled_by_design_schlick_vs_exact_fresnel(mitsuba):
 
 
 def test_differs_from_principled_by_design_clearcoat_keeps_its_microfacet_denominator(mitsuba):
-    from lookdev.pipeline.analysis.bench_eval import mitsuba_eval, principled_dict
+    from lookdev.pipeline.bench.eval import mitsuba_eval, principled_dict
 
     p = DisneyParams(clearcoat=1.0, clearcoat_gloss=0.4, roughness=0.5)
     wi, wo = _pairs()
@@ -496,7 +496,7 @@ def test_differs_from_principled_by_design_clearcoat_keeps_its_microfacet_denomi
 
 
 def test_differs_from_principled_by_design_tint_luminance_weights(mitsuba):
-    from lookdev.pipeline.analysis.bench_eval import mitsuba_eval, principled_dict
+    from lookdev.pipeline.bench.eval import mitsuba_eval, principled_dict
 
     base = (0.2, 0.5, 0.7)
     p = DisneyParams(base_color=base, specular=0.0, sheen=1.0, sheen_tint=1.0)
@@ -534,7 +534,7 @@ def test_drjit_backend_equals_numpy_float32(mitsuba, params):
     import drjit as dr
 
     from lookdev.materials.arrays import DrJitOps
-    from lookdev.pipeline.analysis.bench_eval import _vectors, relative_difference
+    from lookdev.pipeline.bench.eval import _vectors, relative_difference
 
     xp = DrJitOps.for_mitsuba()
     wi, wo = _dirs(2048, 30), _dirs(2048, 31)

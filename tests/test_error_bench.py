@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from _lambert import LAMBERT, PHONG
 
-from lookdev.pipeline.analysis import error_bench as E
-from lookdev.pipeline.analysis import measure as M
+from lookdev.pipeline.bench import error as E
+from lookdev.pipeline.bench import measure as M
 
 TINY = E.Settings(
     render_ladder=(1, 4, 16),

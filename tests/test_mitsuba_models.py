@@ -177,7 +177,7 @@ FURNACE_CASES = [
 def test_white_furnace_sphere_matches_numpy_albedo(mi, model_name, values):
     """Single scattering on a convex sphere under a white sky: radiance = albedo(θ)."""
     from lookdev.pipeline.analysis.albedo import albedo_monte_carlo
-    from lookdev.pipeline.export.mitsuba.scene import scene_dict
+    from lookdev.pipeline.export.mitsuba import scene_dict
 
     model, params = _case_params(model_name, values)
     scene = scene_dict(params, resolution=(32, 32), spp=512, max_depth=2)

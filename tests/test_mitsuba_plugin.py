@@ -163,11 +163,11 @@ def test_unknown_parameter_is_one_line_error(mi, tiny):
 def test_furnace_view_angles_off_centre(mi, monkeypatch):
     """The pixel-angle helper, checked where the tiny model's albedo ρ(1 + cos θ)/2 varies."""
     from lookdev.materials import registry
-    from lookdev.pipeline.export.mitsuba import scene as export
+    from lookdev.pipeline.export.mitsuba.scene import scene_dict
 
     monkeypatch.setitem(registry.MODELS, "tiny_test", TINY)
     params = TinyParams(base_color=(0.8, 0.5, 0.2))
-    scene = export.scene_dict(params, resolution=(32, 32), spp=512, max_depth=2)
+    scene = scene_dict(params, resolution=(32, 32), spp=512, max_depth=2)
     image = np.array(mi.render(mi.load_dict(scene), seed=2))
     rows, cols = np.mgrid[15:17, 24:26]
     theta = _pixel_view_angles(scene, rows, cols)

@@ -7,6 +7,7 @@ import pytest
 from _mitsuba_tiny import TinyParams
 
 from lookdev.materials.errors import LookdevError
+from lookdev.pipeline.export.mitsuba.scene import scene_dict
 
 pytestmark = pytest.mark.render
 
@@ -153,7 +154,7 @@ def test_force_all_lobes_is_passed_to_the_plugin(mi, m):
 def test_white_furnace_sphere_shows_the_model(mi, m):
     """Centre of a sphere under a constant white sky, single scattering: its albedo."""
     params = TinyParams(base_color=(0.8, 0.5, 0.2))
-    scene = m.scene_dict(params, resolution=(32, 32), spp=256, max_depth=2)
+    scene = scene_dict(params, resolution=(32, 32), spp=256, max_depth=2)
     image = _render(mi, scene)
     centre = image[14:18, 14:18].reshape(-1, 3)
     # Tiny model at normal view: albedo = ρ · (0.5 + 0.5·1) = ρ.
@@ -175,7 +176,7 @@ def test_xml_loads_and_renders_like_the_dict(mi, m, tmp_path):
     assert 'value="scene_textures/tiled_translucency.exr"' in text
     assert sorted(p.name for p in path.parent.iterdir()) == ["scene.xml", "scene_textures"]
     loaded = mi.load_file(str(path))
-    same = m.scene_dict(blended, resolution=(16, 16), spp=8)
+    same = scene_dict(blended, resolution=(16, 16), spp=8)
     np.testing.assert_allclose(_render(mi, loaded), _render(mi, same), rtol=1e-5, atol=1e-6)
 
 
@@ -201,7 +202,7 @@ def test_unwritable_folder_is_one_line_and_leaves_nothing(mi, m, tmp_path):
 def test_in_memory_textures_cannot_go_to_xml(mi, m):
     from lookdev.pipeline.export.mitsuba import xml
 
-    scene = m.scene_dict(_blended(translucency=np.ones((2, 2), np.float32)))
+    scene = scene_dict(_blended(translucency=np.ones((2, 2), np.float32)))
     with pytest.raises(LookdevError, match="texture folder"):
         xml.to_xml(scene)
 
@@ -322,7 +323,7 @@ def test_forcing_all_lobes_traces_more_and_renders_the_same(mi, m, disney):
     assert forced.flags() & mi.BSDFFlags.Transmission
     images = []
     for force in (False, True):
-        scene = m.scene_dict(metal, resolution=(16, 16), spp=16, force_all_lobes=force)
+        scene = scene_dict(metal, resolution=(16, 16), spp=16, force_all_lobes=force)
         scene["ball"]["bsdf"] = m.bsdf_dict(metal, allow_principled=False, force_all_lobes=force)
         images.append(_render(mi, scene, seed=3))
     np.testing.assert_allclose(images[0], images[1], rtol=1e-4, atol=1e-5)
@@ -385,15 +386,15 @@ def test_normal_maps_wrap_our_bsdf(mi, m, tmp_path):
     np.testing.assert_allclose(
         np.array(d["normalmap"]["data"]), [0.5, 0.5, 1.0] * np.ones((4, 4, 1))
     )
-    scenes = [m.scene_dict(b, resolution=(16, 16), spp=64) for b in (plain, bumped)]
+    scenes = [scene_dict(b, resolution=(16, 16), spp=64) for b in (plain, bumped)]
     a, b = (_render(mi, s, seed=4) for s in scenes)
     np.testing.assert_allclose(a.mean(), b.mean(), rtol=0.01)
     tilted = _blended()
     tilted.normal_map = np.broadcast_to(np.array([0.6, 0.0, 0.8], np.float32), (4, 4, 3)).copy()
     assert (
-        abs(_render(mi, m.scene_dict(tilted, resolution=(16, 16), spp=64)).mean() - a.mean()) > 0.01
+        abs(_render(mi, scene_dict(tilted, resolution=(16, 16), spp=64)).mean() - a.mean()) > 0.01
     )
-    text = xml.to_xml(m.scene_dict(bumped, texture_dir=tmp_path), relative_to=tmp_path)
+    text = xml.to_xml(scene_dict(bumped, texture_dir=tmp_path), relative_to=tmp_path)
     assert '<bsdf type="normalmap"' in text and "tiled_normal.exr" in text
 
 

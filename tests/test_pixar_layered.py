@@ -307,7 +307,7 @@ def test_mitsuba_renders_a_one_layer_stack_as_the_preset(mi):
     """Plugin eval/pdf and a tiny render of the blended one-layer stack equal the preset's."""
     from _mitsuba_helpers import interaction
 
-    from lookdev.pipeline.export.mitsuba.scene import bsdf_dict, scene_dict
+    from lookdev.pipeline.export.mitsuba import bsdf_dict, scene_dict
 
     params = P(surface_color=(0.8, 0.5, 0.2), roughness=0.3, clear=0.4, back=0.2, metallic=0.3)
     stacked = layered(layer(plain("only", params)), name="only")
@@ -337,7 +337,7 @@ def test_white_furnace_sphere_shows_the_composites_albedo(mi):
     from _mitsuba_helpers import pixel_view_angles
 
     from lookdev.pipeline.analysis.albedo import albedo_monte_carlo
-    from lookdev.pipeline.export.mitsuba.scene import scene_dict
+    from lookdev.pipeline.export.mitsuba import scene_dict
 
     stack = layered(
         layer(plain("clay", CLAY)), layer(plain("glaze", GLAZE), ConstantMask(value=0.6))

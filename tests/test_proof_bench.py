@@ -46,7 +46,7 @@ def test_bench_proof_table_names_the_floor_and_the_frame_sizes(cli, tmp_path, mo
 
 
 def test_interleaved_keeps_each_cases_fastest_round():
-    from lookdev.pipeline.analysis.bench_proof import Timing, interleaved
+    from lookdev.pipeline.bench.proof import Timing, interleaved
 
     wall = iter([9.0, 5.0, 3.0, 4.0, 2.0, 6.0])  # warm-up a, b; then a, b; a, b
     calls = []

@@ -33,7 +33,7 @@ def test_the_floor_creates_exactly_the_specs_the_exporter_authors():
     """The floor is only a bound if it makes the same specs as the fast path, all of them."""
     from pathlib import Path
 
-    from lookdev.pipeline.analysis.bench_usd import (
+    from lookdev.pipeline.bench.usd import (
         author_fast,
         author_floor,
         bench_specs,

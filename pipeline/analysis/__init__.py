@@ -1,1 +1,1 @@
-"""Analysis: stability sweeps, albedo, plots, error against run time."""
+"""Analysis: stability sweeps, albedo, plots, reports (benchmarks: ``lookdev.pipeline.bench``)."""

@@ -29,8 +29,8 @@ from typing import Any
 import numpy as np
 import OpenImageIO as oiio
 
-from .engine import BlendedMaterial
 from .errors import BlendError
+from .result import BlendedMaterial
 
 SCHEMA = "lookdev.blend/1"
 

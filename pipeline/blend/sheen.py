@@ -23,8 +23,8 @@ from lookdev.materials import disney as disney_model
 from lookdev.materials import sheen
 from lookdev.materials.arrays import NumpyOps
 
-from .engine import BlendedMaterial
 from .errors import BlendError
+from .result import BlendedMaterial
 
 
 def base_scale(blended: BlendedMaterial, cos_theta: float = 1.0) -> Any:

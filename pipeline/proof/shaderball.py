@@ -94,12 +94,6 @@ def lathe(r: np.ndarray, y: np.ndarray, segments: int = 96) -> MeshData:
     )
 
 
-def rotation_y(degrees: float) -> np.ndarray:
-    """3×3 rotation about +y (right-handed: +z turns towards +x)."""
-    a = math.radians(degrees)
-    return np.array([[math.cos(a), 0, math.sin(a)], [0, 1, 0], [-math.sin(a), 0, math.cos(a)]])
-
-
 def rotation_x(degrees: float) -> np.ndarray:
     """3×3 rotation about +x (right-handed: +y turns towards +z)."""
     a = math.radians(degrees)

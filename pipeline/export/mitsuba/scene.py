@@ -1,12 +1,12 @@
 """Materials as Mitsuba BSDF dictionaries and minimal scenes (issue 7).
 
-:func:`bsdf_dict` turns a preset's material (or a blended one) into the dictionary
+:func:`bsdf_dict` turns a blended material (the hub, or a model's parameters) into the dictionary
 ``mi.load_dict`` takes: our own plugin (:mod:`.plugin`) for the material's model, with
 uniform parameters as constants and varying ones as ``bitmap`` textures. Mitsuba's
 built-in ``principled`` replaces it only where the two were measured equal (see
 :func:`principled_equivalent`). :func:`.depth.max_depth_for` sizes the path tracer to what
-the material needs and :func:`scene_dict` is the small export scene (one sphere under an
-environment) that ``lookdev export mitsuba`` writes.
+the material needs and :func:`.scene.scene_dict` is the small export scene (one
+sphere under an environment) that ``lookdev export mitsuba`` writes.
 
 Texture orientation: Mitsuba's bitmap puts an image's row 0 at v = 0, and a blended map's
 texel (0, 0) is UV (0, 0), so maps go to Mitsuba row for row, in memory and in EXR files.

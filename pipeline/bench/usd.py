@@ -25,11 +25,11 @@ reference.
 from __future__ import annotations
 
 import tempfile
+import time
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Any
 
 import numpy as np
-import typer
 
 from lookdev.materials.params import DisneyParams
 from lookdev.pipeline.export.usd.network import (
@@ -50,43 +50,11 @@ from lookdev.pipeline.export.usd.writer import (
     value_types,
 )
 
-
-def command(
-    materials: Annotated[
-        int, typer.Option("--materials", "-n", min=1, max=100_000, help="Materials per stage.")
-    ] = 1000,
-    repeat: Annotated[int, typer.Option(min=1, max=20, help="Timed runs; the best counts.")] = 3,
-    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
-) -> None:
-    """Export N materials into one stage: Sdf-level authoring vs the naive Usd API.
-
-    Both author identical networks (UsdPreviewSurface, MaterialX and RenderMan contexts)
-    in the same run; the ratio of materials per second is the figure (target ≥ 5×).
-    """
-    from lookdev.pipeline.cli.common import console, print_json, table
-
-    result = run(materials, repeat=repeat)
-    if as_json:
-        print_json(result)
-        return
-    rows = [[k, v] for k, v in result.items()]
-    console.print(table(f"bench usd ({materials} materials)", ["measure", "value"], rows))
-    ratio, bound = result["ratio_fast_to_naive"], result["ratio_bound"]
-    above_floor = result["fast_s"] / result["floor_empty_specs_s"]
-    console.print(
-        f"fast path {ratio:.2f}× the naive reference (target ≥ 5×: "
-        f"{'met' if ratio >= 5 else 'missed'}); creating the same specs empty, which no "
-        f"Python authoring can beat, is {bound:.2f}× it; the fast path takes "
-        f"{above_floor:.1f}× that floor to also set values, connections and metadata"
-    )
+from .timing import best_time
 
 
 def run(count: int, *, repeat: int = 3) -> dict[str, Any]:
     """Every figure of the benchmark (see module doc)."""
-    import time
-
-    from lookdev.pipeline.cli.bench import best_time
-
     t0 = time.perf_counter()
     specs = bench_specs(count)
     build_s = time.perf_counter() - t0

@@ -23,8 +23,9 @@ from typing import Any
 import numpy as np
 
 from lookdev.materials.bsdf import Model, evaluate
+from lookdev.pipeline.analysis.albedo import albedo_monte_carlo, albedo_quadrature, albedo_tabulated
 
-from .albedo import albedo_monte_carlo, albedo_quadrature, albedo_tabulated
+from .timing import best_time
 
 
 @dataclass(frozen=True)
@@ -53,8 +54,6 @@ class Row:
 
 def timed(fn: Callable[[], Any], repeat: int = 3) -> tuple[Any, float]:
     """(result, best wall time of ``repeat`` calls after a warm-up)."""
-    from lookdev.pipeline.cli.bench import best_time
-
     result = fn()
     return result, best_time(fn, repeat=repeat, min_time=2.0)
 
@@ -175,7 +174,7 @@ def bench_lambda(
     """The Λ fit, and the projected-area integral at a ladder of Gauss-Legendre nodes,
     against that integral converged (:func:`lookdev.pipeline.analysis.sheen_fit.
     lambda_integrated`, Heitz 2014: 1 + Λ(ω) = ∫ ⟨ω·m⟩ D(m) dm / cos θ)."""
-    from .sheen_fit import lambda_integrated
+    from lookdev.pipeline.analysis.sheen_fit import lambda_integrated
 
     rows = []
     n_eval = len(LAMBDA_COS)

@@ -33,11 +33,10 @@ import tempfile
 import time
 import tracemalloc
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Any
 
 import numpy as np
 import OpenImageIO as oiio
-import typer
 
 from lookdev.materials.layers import TextureMask
 from lookdev.materials.params import DisneyParams
@@ -46,34 +45,6 @@ from lookdev.pipeline.blend.disney import SCALARS
 
 LAYERS = 4
 PRUNING_PRESET = "rusty_car_paint"
-
-
-def command(
-    resolution: Annotated[
-        int, typer.Option("--resolution", "-r", min=16, max=8192, help="Texels per side.")
-    ] = 2048,
-    repeat: Annotated[int, typer.Option(min=1, max=20, help="Timed runs; the best counts.")] = 3,
-    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
-) -> None:
-    """Blend 4 texture-masked Disney layers into all parameter maps vs a numpy copy.
-
-    Reports the time against the memory-bandwidth bound measured in the same run
-    (target ≤ 4×), peak memory against the output size (target < 2×: numpy's traced peak,
-    and the resident peak of a child process, OpenImageIO's buffers included, for this
-    stack and for large float EXR masks driving one map), and what pruning saved on a
-    preset where it applies. The target column says met or missed.
-    """
-    from lookdev.pipeline.cli.common import console, print_json, table
-
-    with tempfile.TemporaryDirectory(prefix="lookdev-bench-blend-") as tmp:
-        result = run(resolution, Path(tmp), repeat=repeat)
-    if as_json:
-        print_json(result)
-        return
-    rows = [[k, v, verdict(k, v)] for k, v in result.items() if not isinstance(v, dict)]
-    for name, saving in result["pruning"].items():
-        rows += [[f"pruning {name}: {k}", v, ""] for k, v in saving.items()]
-    console.print(table(f"bench blend ({resolution}²)", ["measure", "value", "target"], rows))
 
 
 TARGETS = {
@@ -103,8 +74,14 @@ def met(name: str, value: float) -> bool:
     return value <= bound if name.startswith("ratio") else value < bound
 
 
-def run(resolution: int, folder: Path, *, repeat: int = 3) -> dict[str, Any]:
-    """Every figure of the benchmark (see module doc) as one flat-ish dict."""
+def run(resolution: int, folder: Path | None = None, *, repeat: int = 3) -> dict[str, Any]:
+    """Every figure of the benchmark (see module doc) as one flat-ish dict.
+
+    The masks are written into ``folder``, by default a temporary folder removed after.
+    """
+    if folder is None:
+        with tempfile.TemporaryDirectory(prefix="lookdev-bench-blend-") as tmp:
+            return run(resolution, Path(tmp), repeat=repeat)
     material = bench_material(folder, resolution)
     images: dict = {}
     out = blend(material, resolution, images=images)
@@ -270,7 +247,7 @@ def peak_rss(case: str, folder: Path, resolution: int) -> dict[str, int]:
 
 
 _CHILD = (
-    "import sys; from lookdev.pipeline.analysis.bench_blend import child_peak; "
+    "import sys; from lookdev.pipeline.bench.blend import child_peak; "
     "child_peak(sys.argv[1], sys.argv[2], int(sys.argv[3]))"
 )
 

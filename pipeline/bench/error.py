@@ -20,14 +20,12 @@ from __future__ import annotations
 
 import json
 import platform
-import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Any
 
 import numpy as np
-import typer
 
 from lookdev.materials.bsdf import Model
 from lookdev.materials.errors import LookdevError
@@ -270,7 +268,7 @@ def plot_error_vs_time(report: Report, path: Path) -> Path:
     marker per method, each legend beside its panel."""
     from matplotlib.lines import Line2D
 
-    from .plots import plt, save_figure
+    from lookdev.pipeline.analysis.plots import plt, save_figure
 
     items = [i for i in ITEMS if any(r.item == i and r.error > 0 for r in report.rows)]
     rows_n = max(1, (len(items) + 1) // 2)
@@ -329,77 +327,3 @@ ERROR_NAMES = {
     "lambda": "relative RMS error",
     "precision": "max relative error of float32",
 }
-TABLE_COLUMNS = ["case", "method", "setting", "error", "ms/call", "ns/eval", "× faster", "against"]
-
-
-def _table_row(r: Row) -> list[str]:
-    return [
-        r.case,
-        r.method,
-        r.setting,
-        f"{r.error:.3g}",
-        f"{r.seconds * 1e3:.3g}",
-        f"{r.seconds_per_evaluation * 1e9:.3g}",
-        f"{r.speedup:.3g}" if r.reference_seconds else "",
-        r.reference,
-    ]
-
-
-def command(
-    out_dir: Annotated[
-        Path,
-        typer.Option(
-            "--output", "-o", help="Folder for error_bench.json and .png.", file_okay=False
-        ),
-    ] = Path("error_bench"),
-    item: Annotated[
-        list[str] | None,
-        typer.Option("--item", "-i", help=f"Measure only these items: {', '.join(ITEMS)}."),
-    ] = None,
-    quick: Annotated[bool, typer.Option("--quick", help="Short ladders (CI, tests).")] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
-) -> None:
-    """Error against run time of every approximation lookdev makes, measured now.
-
-    Proof renders (relMSE vs spp and time), directional albedo (quadrature, Monte Carlo,
-    table), the Conty-Kulla Λ fit vs numerical integration, and float32 vs float64
-    evaluation of every model. Writes a table, error_bench.json and a log-log plot.
-    """
-    from rich.progress import Progress
-
-    from lookdev.pipeline.cli.common import console, print_json, table
-
-    items = tuple(item or ITEMS)
-    unknown = [i for i in items if i not in ITEMS]
-    if unknown:
-        raise BenchError(f"unknown item {unknown[0]!r}; allowed {', '.join(ITEMS)}", field="--item")
-    settings = Settings.quick() if quick else Settings()
-    start = time.perf_counter()
-    with Progress(console=console, transient=True, disable=as_json) as bar:
-        task = bar.add_task("measuring", total=None)
-        report = run(
-            settings,
-            items,
-            progress=lambda name, done, total: bar.update(
-                task, description=name, completed=done, total=total
-            ),
-        )
-    paths = write_outputs(report, settings, out_dir)
-    if as_json:
-        print_json({**report.to_json(settings), "outputs": {k: str(v) for k, v in paths.items()}})
-        return
-    for item in ITEMS:
-        rows = [r for r in report.rows if r.item == item]
-        if rows:
-            console.print(
-                table(
-                    f"{item}: {ERROR_NAMES[item]} against time",
-                    TABLE_COLUMNS,
-                    [_table_row(r) for r in rows],
-                )
-            )
-    for what, why in report.skipped.items():
-        console.print(f"[yellow]skipped[/] {what}: {why}")
-    console.print(
-        f"wrote {paths['json']} and {paths['plot']} in {time.perf_counter() - start:.1f} s"
-    )

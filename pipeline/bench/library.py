@@ -6,8 +6,9 @@ over the same freshly generated library, best of a few runs each, page cache war
 
 ============  =======================================================================
 read          open and read every preset file (paths known in advance: the floor)
-list          ``presets list`` end to end, output to /dev/null (the target's ratio)
-list --json   the same with ``--json``
+list          what ``presets list`` does, through the library API: ``Library.entries()``
+              and a text row per preset, written to /dev/null (the target's ratio)
+list --json   the same with a JSON document per preset
 entries       ``Library.entries()`` alone: the search-path walk and the headers
 cold          ``Library.entries()`` with no index yet (the first listing of a library)
 ============  =======================================================================
@@ -18,17 +19,16 @@ now: files changed in the last seconds are re-read on purpose (see ``library.ind
 
 from __future__ import annotations
 
-import contextlib
+import json
 import os
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Annotated, Any
-
-import typer
+from typing import Any
 
 from lookdev.library import Library
-from lookdev.library.index import INDEX_NAME
+from lookdev.library.index import INDEX_NAME, Header
 
 TARGET_RATIO = 2.0
 MODELS = ("disney", "disney", "disney", "layered")
@@ -76,7 +76,6 @@ def measure(folder: Path, paths: list[Path], *, repeat: int = 3) -> dict[str, fl
     The candidates and the baseline take turns within each round, so a burst of load
     from other processes slows all of them rather than skewing one ratio.
     """
-    from lookdev.pipeline.cli.presets import list_
 
     def read() -> None:
         for p in paths:
@@ -87,8 +86,8 @@ def measure(folder: Path, paths: list[Path], *, repeat: int = 3) -> dict[str, fl
         Library([folder], use_env=False).entries()
 
     def command(as_json: bool) -> None:
-        with open(os.devnull, "w") as null, contextlib.redirect_stdout(null):
-            list_(tag=None, model=None, library=[folder], as_json=as_json)
+        with open(os.devnull, "w") as null:
+            null.write(listing(Library([folder]), as_json=as_json))
 
     def cold() -> None:
         (folder / INDEX_NAME).unlink(missing_ok=True)
@@ -130,36 +129,48 @@ def report(n: int, times: dict[str, float]) -> dict[str, Any]:
     }
 
 
-def command(
-    n: Annotated[int, typer.Option("--n", min=1, help="Presets in the generated library.")] = 10000,
-    repeat: Annotated[int, typer.Option("--repeat", min=1, help="Runs per timing (best).")] = 5,
-    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
-) -> None:
-    """Time `presets list` over N generated presets against reading their bytes (target ≤ 2x).
+def listing(lib: Library, *, as_json: bool = False) -> str:
+    """What ``presets list`` writes for ``lib``, as near as the library API gives it: a
+    text row (or with ``as_json`` a JSON document) per preset that parses."""
+    shown = [h for h in lib.entries() if not h.error]
+    if as_json:
+        lines = ",\n".join("  " + json.dumps(_header_doc(h)) for h in shown)
+        return f"[\n{lines}\n]\n"
+    rows = (
+        "  ".join((h.name, h.model or "?", ", ".join(h.tags), h.library, h.description))
+        for h in shown
+    )
+    return "\n".join(rows) + "\n"
 
-    Example: lookdev bench library --n 10000
-    """
-    from rich.progress import Progress
 
-    from lookdev.pipeline.cli.common import console, print_json, table
+def _header_doc(h: Header) -> dict[str, Any]:
+    return {
+        "name": h.name,
+        "model": h.model,
+        "description": h.description,
+        "tags": list(h.tags),
+        "extends": h.extends,
+        "file": h.file,
+        "library": h.library,
+    }
 
+
+def run(
+    n: int, *, repeat: int = 5, progress: Callable[[str, int], None] | None = None
+) -> dict[str, Any]:
+    """Every figure of the benchmark (module doc) over a library of ``n`` generated presets,
+    written into a temporary folder; ``progress(what, presets_done)`` follows the writing."""
     with tempfile.TemporaryDirectory(prefix="lookdev-bench-library-") as tmp:
         folder = Path(tmp)
-        with Progress(console=console, transient=True, disable=as_json) as bar:
-            task = bar.add_task(f"writing {n} presets", total=n)
-            paths = build_library(folder, n, progress=lambda: bar.advance(task))
-            bar.update(task, description="timing", completed=n)
-            result = report(n, measure(folder, paths, repeat=repeat))
-    if as_json:
-        print_json(result)
-        return
-    rows = [
-        ["read bytes (baseline)", result["read_s"], 1.0],
-        ["presets list", result["list_s"], result["ratio_list_to_read"]],
-        ["presets list --json", result["list_json_s"], result["ratio_list_json_to_read"]],
-        ["Library.entries()", result["entries_s"], result["ratio_entries_to_read"]],
-        ["first listing (no index)", result["cold_s"], result["ratio_cold_to_read"]],
-    ]
-    console.print(table(f"library of {n} presets", ["what", "seconds", "× read"], rows))
-    verdict = "meets" if result["meets_target"] else "MISSES"
-    console.print(f"presets list {verdict} the target of ≤ {TARGET_RATIO:g}× reading the bytes")
+        done = 0
+
+        def step() -> None:
+            nonlocal done
+            done += 1
+            if progress is not None:
+                progress(f"writing {n} presets", done)
+
+        paths = build_library(folder, n, progress=step)
+        if progress is not None:
+            progress("timing", n)
+        return report(n, measure(folder, paths, repeat=repeat))
