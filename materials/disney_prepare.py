@@ -14,7 +14,11 @@ from . import microfacet as mf
 from .params import SPECULAR_F0_SCALE, DisneyParams
 
 INV_PI = 1.0 / math.pi
-LUMINANCE = (0.3, 0.6, 0.1)  # Burley's tint weights (Schutte's (0.3, 0.6, 1.0) is a typo)
+TINT_WEIGHTS = (0.3, 0.6, 0.1)
+"""Burley's tint luminance, from the Disney BRDF Explorer's ``disney.brdf``:
+``float Cdlum = .3*Cdlin[0] + .6*Cdlin[1] + .1*Cdlin[2]; // luminance approx.``
+(Schutte's seed prints (0.3, 0.6, 1.0): a typo). Part of the model, a rough hue normaliser;
+not Rec.709 Y (:data:`lookdev.materials.colour.REC709_LUMINANCE`), which measures pixels."""
 CLEARCOAT_F0 = 0.04  # IOR 1.5 polyurethane (Burley §5.4)
 SCHLICK_MEAN = 1.0 / 21.0  # ∫ (1 − μ)⁵ 2μ dμ: hemispherical mean of the Schlick weight
 SHEEN_ALBEDO_GUESS = 0.1  # rough albedo of sheen 1, only used to weight sampling
@@ -24,7 +28,8 @@ LOBES = ("diffuse", "diff_trans", "sheen", "specular", "clearcoat", "spec_trans"
 
 # -- parameters --------------------------------------------------------------------------
 def luminance(c: Any) -> Any:
-    return LUMINANCE[0] * c[0] + LUMINANCE[1] * c[1] + LUMINANCE[2] * c[2]
+    """Burley's tint luminance of a channel-first colour (:data:`TINT_WEIGHTS`)."""
+    return TINT_WEIGHTS[0] * c[0] + TINT_WEIGHTS[1] * c[1] + TINT_WEIGHTS[2] * c[2]
 
 
 def tint_color(xp: Any, base: Any) -> Any:

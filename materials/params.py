@@ -27,18 +27,10 @@ from pydantic import (
     model_validator,
 )
 
+from .colour import srgb_decode
 from .errors import ParameterError
 
 SPECULAR_F0_SCALE = 0.08  # Burley §5.4: specular 0..1 ↦ F0 0..0.08
-
-
-def srgb_to_linear(v: float) -> float:
-    """IEC 61966-2-1 sRGB decoding of one channel in 0..1.
-
-    >>> round(srgb_to_linear(0.5), 6)
-    0.214041
-    """
-    return v / 12.92 if v <= 0.04045 else ((v + 0.055) / 1.055) ** 2.4
 
 
 _HEX = re.compile(r"^#?([0-9a-fA-F]{6})$")
@@ -51,7 +43,7 @@ def parse_color(value: Any) -> Any:
         if not m:
             raise ValueError(f"colour {value!r} is neither '#rrggbb' nor [r, g, b]")
         h = m.group(1)
-        return tuple(srgb_to_linear(int(h[i : i + 2], 16) / 255.0) for i in (0, 2, 4))
+        return tuple(srgb_decode(int(h[i : i + 2], 16) / 255.0) for i in (0, 2, 4))
     if isinstance(value, int | float) and not isinstance(value, bool):
         return (float(value),) * 3
     return value

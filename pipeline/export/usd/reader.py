@@ -17,6 +17,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from lookdev.materials.colour import luminance
+
 from .lobes import DEFAULTS, active_lobes, effective
 from .names import SURFACE_IDS, ior_to_specular, specular_to_ior, table_for
 from .network import (
@@ -177,9 +179,6 @@ def _imported(spec: MaterialSpec) -> Imported | None:
     return result
 
 
-REC709_Y = (0.2126, 0.7152, 0.0722)  # luminance weights of linear Rec.709
-
-
 def _specular_workflow(surface: Node, values: dict[str, Any], result: Imported) -> None:
     """A foreign UsdPreviewSurface in its specular workflow: its specular colour is an F0.
 
@@ -193,7 +192,7 @@ def _specular_workflow(surface: Node, values: dict[str, Any], result: Imported) 
     if isinstance(colour, Connection):
         result.loss.append("universal: specularColor is a texture; its mean is unknown")
         return
-    f0 = sum(w * c for w, c in zip(REC709_Y, colour, strict=True))
+    f0 = luminance(colour)
     values["metallic"] = 0.0
     values["specular"] = min(f0 / 0.08, 12.5)
     values["ior"] = specular_to_ior(values["specular"])
