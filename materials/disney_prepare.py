@@ -11,7 +11,8 @@ from typing import Any
 
 from . import fresnel as fr
 from . import microfacet as mf
-from .params import SPECULAR_F0_SCALE, DisneyParams
+from .fresnel import SPECULAR_F0_SCALE
+from .params import DisneyParams
 
 INV_PI = 1.0 / math.pi
 TINT_WEIGHTS = (0.3, 0.6, 0.1)
@@ -49,8 +50,7 @@ def _eta(xp: Any, params: DisneyParams, maps: dict[str, Any]) -> Any:
     if "ior" in maps:
         return xp.scalar(maps["ior"])
     if "specular" in maps and not params.uses_ior:
-        r = xp.sqrt(xp.minimum(SPECULAR_F0_SCALE * xp.scalar(maps["specular"]), 0.999999))
-        return (1.0 + r) / (1.0 - r)
+        return fr.specular_to_ior(xp.scalar(maps["specular"]), xp)
     return params.effective_ior
 
 
@@ -69,7 +69,7 @@ def _fresnel_terms(xp, p, base, tint, w_d, w_g, eta) -> tuple[Any, Any, Any]:
     metallic, spec_tint = p["metallic"], p["specular_tint"]
     tinted = mix(1.0, tint, spec_tint)
     if p["uses_ior"]:
-        a = metallic * base + w_d * spec_tint * fr.schlick_f0(eta) * tint
+        a = metallic * base + w_d * spec_tint * fr.ior_to_f0(eta) * tint
         b = metallic + w_d * spec_tint
         return a, b, w_d * (1.0 - spec_tint) + w_g
     a = metallic * base + w_d * (SPECULAR_F0_SCALE * p["specular"]) * tinted
@@ -149,7 +149,7 @@ def lobe_odds(xp: Any, pr: dict[str, Any]) -> tuple[dict[str, Any], dict[str, An
     Estimates: diffuse ρ·lum(base), Schlick lobes F0 + (1 − F0)/21, glass 1 − F0 split
     by 1/η² inside. Sheen is sampled like the diffuse, by the cosine.
     """
-    f0 = fr.schlick_f0(pr["eta"])
+    f0 = fr.ior_to_f0(pr["eta"])
     lum_a = luminance(pr["spec_a"])
     lum_t = luminance(pr["trans_color"])
     est = {

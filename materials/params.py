@@ -14,7 +14,6 @@ taken as sRGB-encoded and decoded once, here.
 
 from __future__ import annotations
 
-import math
 import re
 from typing import Annotated, Any, Literal
 
@@ -29,9 +28,7 @@ from pydantic import (
 
 from .colour import srgb_decode
 from .errors import ParameterError
-
-SPECULAR_F0_SCALE = 0.08  # Burley §5.4: specular 0..1 ↦ F0 0..0.08
-
+from .fresnel import SPECULAR_F0_SCALE, ior_to_specular, specular_to_ior
 
 _HEX = re.compile(r"^#?([0-9a-fA-F]{6})$")
 
@@ -191,15 +188,14 @@ class DisneyParams(Params):
         """IOR whose normal-incidence reflectance is ``0.08 · specular`` (Burley §5.4)."""
         if self.ior is not None:
             return self.ior
-        r = math.sqrt(min(SPECULAR_F0_SCALE * self.specular, 1.0 - 1e-7))
-        return (1.0 + r) / (1.0 - r)
+        return specular_to_ior(self.specular)
 
     @property
     def effective_specular(self) -> float:
         """``specular`` whose F0 equals the Fresnel reflectance of ``ior`` at normal incidence."""
         if self.ior is None:
             return self.specular
-        return ((self.ior - 1.0) / (self.ior + 1.0)) ** 2 / SPECULAR_F0_SCALE
+        return ior_to_specular(self.ior)
 
 
 _SCHEMAS: dict[str, type[Params]] = {"DisneyParams": DisneyParams}

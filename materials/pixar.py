@@ -43,6 +43,7 @@ from pydantic import BeforeValidator, Field, create_model
 from . import pixar_lobes as lobes
 from .arrays import NumpyOps
 from .bsdf import Model, density, draw, evaluate
+from .fresnel import f0_to_ior
 from .params import Color, Params, parse_color, register_schema
 from .pixar_lobes import LN_10
 from .pixar_scatter import at_view, prepared, scatter_eval, scatter_pdf, scatter_sample
@@ -99,8 +100,7 @@ class PixarParams(Params):
         """The IOR: given, or the one whose normal reflectance is the dielectric nRefl."""
         if self.ior is not None:
             return self.ior
-        f0 = min(DIELECTRIC_REFL * self.normal_fresnel, 1.0 - 1e-6) ** 0.5
-        return (1.0 + f0) / (1.0 - f0)
+        return f0_to_ior(DIELECTRIC_REFL * self.normal_fresnel)
 
 
 GRAZING = "_grazing"

@@ -18,9 +18,10 @@ from pathlib import Path
 from typing import Any
 
 from lookdev.materials.colour import luminance
+from lookdev.materials.fresnel import SPECULAR_F0_SCALE, ior_to_specular, specular_to_ior
 
 from .lobes import DEFAULTS, active_lobes, effective
-from .names import SURFACE_IDS, ior_to_specular, specular_to_ior, table_for
+from .names import SURFACE_IDS, table_for
 from .network import (
     CONTEXT_OUTPUT,
     F0_KEYS,
@@ -194,7 +195,7 @@ def _specular_workflow(surface: Node, values: dict[str, Any], result: Imported) 
         return
     f0 = luminance(colour)
     values["metallic"] = 0.0
-    values["specular"] = min(f0 / 0.08, 12.5)
+    values["specular"] = min(f0, 1.0) / SPECULAR_F0_SCALE  # F0 ≤ 1: specular ≤ 12.5
     values["ior"] = specular_to_ior(values["specular"])
     if max(colour) - min(colour) > 1e-6:
         result.loss.append(
