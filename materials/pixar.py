@@ -45,7 +45,7 @@ from .arrays import NumpyOps
 from .bsdf import Model, density, draw, evaluate
 from .fresnel import f0_to_ior
 from .params import Color, Params, parse_color, register_schema
-from .pixar_lobes import LN_10
+from .pixar_lobes import LN_10, reflection_cone, specular_cone
 from .pixar_scatter import at_view, prepared, scatter_eval, scatter_pdf, scatter_sample
 
 DIELECTRIC_REFL = 0.05  # Smits' default normal reflectance of a dielectric
@@ -313,8 +313,10 @@ def as_lobe_weights(params: PixarParams) -> Any:
         if g is not None:
             data[name + GRAZING] = tuple(np.asarray(g, dtype=float).ravel())
     r = params.roughness
-    data["specular_cone"] = data["specular_t_cone"] = (30.0 * r + 5.0) * params.specular_cone_scale
-    data["reflection_cone"] = data["reflection_t_cone"] = 10.0 * r * params.reflection_cone_scale
+    data["specular_cone"] = data["specular_t_cone"] = specular_cone(r, params.specular_cone_scale)
+    data["reflection_cone"] = data["reflection_t_cone"] = reflection_cone(
+        r, params.reflection_cone_scale
+    )
     data["specular_falloff"] = data["specular_t_falloff"] = r * LN_10
     data["ior"] = params.eta
     return PixarLobeWeights.parse(data, where="as_lobe_weights")

@@ -1,4 +1,4 @@
-"""Formulas with one home each (issue 12), tested at their edges: specular ↔ IOR."""
+"""Formulas with one home each (issue 12), tested at their edges: specular ↔ IOR, cones."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from lookdev.materials import pixar_lobes as pl
 from lookdev.materials.arrays import NumpyOps
 from lookdev.materials.fresnel import (
     ETA_MAX,
@@ -18,7 +19,8 @@ from lookdev.materials.fresnel import (
     specular_to_ior,
 )
 from lookdev.materials.params import DisneyParams
-from lookdev.materials.pixar import PixarParams
+from lookdev.materials.pixar import PixarParams, as_lobe_weights
+from lookdev.materials.pixar_lobes import reflection_cone, specular_cone
 
 SPECULAR_CEILING = DisneyParams.model_fields["specular"].metadata[-1].le
 
@@ -67,3 +69,37 @@ def test_every_spelling_uses_the_one_conversion():
     assert PixarParams(normal_fresnel=0.8).eta == f0_to_ior(0.04)
     assert PixarParams(normal_fresnel=20.0).eta == ETA_MAX
     assert math.isfinite(PixarParams(normal_fresnel=20.0).eta)
+
+
+# -- Smits' cone angles --------------------------------------------------------------------
+def test_cone_angles_at_their_ends():
+    """Seed: specular 5°..35° over roughness, reflection 0 (epsilon)..10°, times the scales."""
+    assert specular_cone(0.0) == 5.0 and specular_cone(1.0) == 35.0
+    assert reflection_cone(0.0) == 0.0 and reflection_cone(1.0) == 10.0
+    assert specular_cone(1.0, 2.5) == 87.5 and reflection_cone(1.0, 0.0) == 0.0
+    r = np.linspace(0.0, 1.0, 5)
+    np.testing.assert_array_equal(specular_cone(r), 30.0 * r + 5.0)
+
+
+def test_powers_are_the_cones_through_cone_power():
+    xp = NumpyOps()
+    for r in (0.0, 0.3, 1.0):
+        assert pl.power_specular(xp, r, 1.5) == pl.cone_power(
+            xp, r * pl.LN_10, specular_cone(r, 1.5)
+        )
+        assert pl.power_reflection(xp, r) == pl.cone_power(xp, pl.LN_10, reflection_cone(r))
+    # roughness 0: the reflection cone is 0°, floored where the lobe is evaluated
+    assert pl.power_reflection(xp, 0.0) == pl.cone_power(xp, pl.LN_10, pl.CONE_MIN_DEG)
+
+
+def test_plain_materials_and_blend_layers_carry_the_same_cones():
+    from lookdev.pipeline.blend.pixar_composite import layer_lobes
+
+    p = PixarParams(roughness=0.4, specular_cone_scale=1.5, reflection_cone_scale=0.5)
+    w = as_lobe_weights(p)
+    lobes = layer_lobes(p, 1.0)
+    assert w.specular_cone == w.specular_t_cone == lobes["specular"].cone == specular_cone(0.4, 1.5)
+    assert w.reflection_cone == lobes["reflection"].cone == reflection_cone(0.4, 0.5)
+    # the blend floors a 0° reflection cone (energy-weighted averaging), the material does not
+    assert as_lobe_weights(PixarParams(roughness=0.0)).reflection_cone == 0.0
+    assert layer_lobes(PixarParams(roughness=0.0), 1.0)["reflection"].cone == pl.CONE_MIN_DEG
