@@ -1,4 +1,4 @@
-"""Formulas with one home each (issue 12), tested at their edges: specular ↔ IOR, cones."""
+"""One home each (issue 12), tested at the edges: specular ↔ IOR, cones, one-line errors."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ import pytest
 
 from lookdev.materials import pixar_lobes as pl
 from lookdev.materials.arrays import NumpyOps
+from lookdev.materials.errors import LookdevError, ParameterError
 from lookdev.materials.fresnel import (
     ETA_MAX,
     F0_MAX,
@@ -103,3 +104,48 @@ def test_plain_materials_and_blend_layers_carry_the_same_cones():
     # the blend floors a 0° reflection cone (energy-weighted averaging), the material does not
     assert as_lobe_weights(PixarParams(roughness=0.0)).reflection_cone == 0.0
     assert layer_lobes(PixarParams(roughness=0.0), 1.0)["reflection"].cone == pl.CONE_MIN_DEG
+
+
+# -- pydantic errors as one line -------------------------------------------------------------
+def _message(fn, *args, **kw):
+    with pytest.raises(LookdevError) as info:
+        fn(*args, **kw)
+    return info.value
+
+
+def test_parameters_presets_and_layers_format_errors_the_same_way():
+    from lookdev.library.preset import check_params, parse_preset
+
+    direct = _message(DisneyParams.parse, {"roughness": 2.0}, where="a.toml")
+    checked = _message(check_params, "disney", {"roughness": 2.0}, where="a.toml")
+    text = (
+        b'name = "a"\nmodel = "layered"\n[[layers]]\nmodel = "disney"\nparams = {roughness = 2.0}\n'
+    )
+    layered = _message(parse_preset, text, where="a.toml", stem="a")
+    assert str(direct) == "a.toml: roughness: 2.0 is out of range; allowed [0, 1]"
+    assert str(checked) == "a.toml: params.roughness: 2.0 is out of range; allowed [0, 1]"
+    assert str(layered) == "a.toml: layers[0].params.roughness: 2.0 is out of range; allowed [0, 1]"
+    assert isinstance(direct, ParameterError) and isinstance(checked, ParameterError)
+
+
+def test_one_line_edges():
+    channel = _message(DisneyParams.parse, {"base_color": [0.1, 0.2, 3.0]})
+    assert channel.field == "base_color[2]" and channel.message.endswith("allowed [0, 1]")
+    nan = _message(DisneyParams.parse, {"roughness": float("nan")})
+    assert nan.message == "nan is not a finite number"
+    long = _message(DisneyParams.parse, {"roughness": "x" * 500})
+    assert "x" * 60 not in long.message and "...)" in long.message
+    unknown = _message(DisneyParams.parse, {"roughnes": 0.5})
+    assert unknown.message.startswith("unknown field; allowed: base_color, subsurface, metallic")
+    both = _message(DisneyParams.parse, {"specular": 0.5, "ior": 1.5})
+    assert both.field is None and "not both" in both.message
+
+
+def test_ibl_definitions_use_the_same_formatter(tmp_path, monkeypatch):
+    from lookdev.pipeline.proof import ibl
+
+    (tmp_path / "bad.toml").write_text('name = "bad"\n[sun]\nazimuth = 0\nelevation = 120\n')
+    monkeypatch.setattr(ibl, "definitions_folder", lambda: tmp_path)
+    err = _message(ibl.resolve, "bad")
+    assert isinstance(err, ibl.IblError)
+    assert str(err) == f"{tmp_path / 'bad.toml'}: sun.elevation: 120 is out of range; allowed ≤ 90"

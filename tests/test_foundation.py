@@ -45,12 +45,12 @@ def test_disney_defaults_are_burleys():
         ({"roughness": -0.1}, "roughness", "[0, 1]"),
         ({"roughness": math.nan}, "roughness", "finite"),
         ({"metallic": math.inf}, "metallic", "finite"),
-        ({"base_color": [0.5, -1, 0.5]}, "base_color", "[0, 1]"),
+        ({"base_color": [0.5, -1, 0.5]}, "base_color[1]", "[0, 1]"),
         ({"specular": 13.0}, "specular", "[0, 12.5]"),
         ({"ior": 0.9}, "ior", "[1, 10]"),
         ({"sheen": -1}, "sheen", "[0, ∞]"),
         ({"specular": 0.5, "ior": 1.5}, None, "not both"),
-        ({"glossiness": 1}, "glossiness", "unknown parameter"),
+        ({"glossiness": 1}, "glossiness", "unknown field; allowed: base_color, subsurface"),
     ],
 )
 def test_bad_parameters_name_field_and_range(data, field, allowed):

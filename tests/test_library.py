@@ -165,7 +165,7 @@ def test_builtin_files_validate_against_the_generated_json_schema():
         (
             'name = "a"\nmodel = "layered"\n[[layers]]\npreset = "gold"\nmask = 1.5\n',
             "layers[0].mask.constant.value",
-            "less than or equal to 1",
+            "1.5 is out of range; allowed [0, 1]",
         ),
     ],
 )
