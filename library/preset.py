@@ -27,9 +27,9 @@ import tomli_w
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from lookdev.materials import registry
-from lookdev.materials.errors import ParameterError
+from lookdev.materials.errors import ParameterError, one_line, register_schema, short_repr
 from lookdev.materials.layers import ConstantMask, LayerSpec
-from lookdev.materials.params import Params, parameter_error
+from lookdev.materials.params import Params
 
 from .errors import PresetError
 
@@ -54,13 +54,14 @@ def check_name(name: str, *, field: str | None = "name") -> str:
     """
     if not isinstance(name, str) or not NAME_RE.fullmatch(name):
         raise PresetError(
-            f"preset name {_short(name)} is not allowed; use 1-100 letters, digits, '_' or '-' "
+            f"preset name {short_repr(name)} is not allowed; use 1-100 letters, digits, '_' or '-' "
             "(no path separators, no '..')",
             field=field,
         )
     return name
 
 
+@register_schema
 class PresetFile(BaseModel):
     """The fields of one preset file, as written (before ``extends`` is resolved)."""
 
@@ -88,7 +89,7 @@ class PresetFile(BaseModel):
     def _safe_name(cls, value: str | None) -> str | None:
         if value is not None and not NAME_RE.fullmatch(value):
             raise ValueError(
-                f"{_short(value)} is not a preset name; use 1-100 letters, digits, '_' or '-'"
+                f"{short_repr(value)} is not a preset name; use 1-100 letters, digits, '_' or '-'"
             )
         return value
 
@@ -166,41 +167,14 @@ def check_params(model: str, params: dict[str, Any], *, where: str | None, prefi
     try:
         return MODELS[model].model_validate(data, strict=True)
     except ValidationError as exc:
-        err = parameter_error(exc)
-        field = f"{prefix}.{err.field}" if err.field else prefix
-        raise ParameterError(err.message, where=where, field=field) from None
+        raise one_line(exc, ParameterError, where=where, prefix=prefix) from None
 
 
 def _validate(doc: dict[str, Any], *, where: str) -> PresetFile:
     try:
         return PresetFile.model_validate(doc)
     except ValidationError as exc:
-        raise _one_line(exc, where=where) from None
-
-
-def _one_line(exc: ValidationError, *, where: str) -> PresetError:
-    """The first pydantic error of a preset file as one line: field and what is allowed."""
-    err = exc.errors(include_url=False)[0]
-    loc = err["loc"]
-    field = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in loc).lstrip(".") or None
-    kind = err["type"]
-    if kind == "extra_forbidden" and len(loc) == 1:
-        allowed = ", ".join(PresetFile.model_fields)
-        msg = f"unknown field; allowed: {allowed}"
-    elif kind == "extra_forbidden":
-        msg = "unknown field"
-    elif kind == "missing":
-        msg = "required field is missing"
-    elif kind == "value_error":
-        msg = str((err.get("ctx") or {}).get("error", err["msg"]))
-    else:
-        msg = f"{err['msg']} (got {_short(err.get('input'))})"
-    return PresetError(msg, where=where, field=field)
-
-
-def _short(value: Any, limit: int = 60) -> str:
-    text = repr(value)
-    return text if len(text) <= limit else text[: limit - 3] + "..."
+        raise one_line(exc, PresetError, where=where) from None
 
 
 def dump_preset(preset: PresetFile) -> str:

@@ -12,10 +12,15 @@ from typing import Any
 from . import fresnel as fr
 from . import microfacet as mf
 from .bsdf import Lobe
-from .params import SPECULAR_F0_SCALE, DisneyParams
+from .fresnel import SPECULAR_F0_SCALE
+from .params import DisneyParams
 
 INV_PI = 1.0 / math.pi
-LUMINANCE = (0.3, 0.6, 0.1)  # Burley's tint weights (Schutte's (0.3, 0.6, 1.0) is a typo)
+TINT_WEIGHTS = (0.3, 0.6, 0.1)
+"""Burley's tint luminance, from the Disney BRDF Explorer's ``disney.brdf``:
+``float Cdlum = .3*Cdlin[0] + .6*Cdlin[1] + .1*Cdlin[2]; // luminance approx.``
+(Schutte's seed prints (0.3, 0.6, 1.0): a typo). Part of the model, a rough hue normaliser;
+not Rec.709 Y (:data:`lookdev.materials.colour.REC709_LUMINANCE`), which measures pixels."""
 CLEARCOAT_F0 = 0.04  # IOR 1.5 polyurethane (Burley §5.4)
 SCHLICK_MEAN = 1.0 / 21.0  # ∫ (1 − μ)⁵ 2μ dμ: hemispherical mean of the Schlick weight
 SHEEN_ALBEDO_GUESS = 0.1  # rough albedo of sheen 1, only used to weight sampling
@@ -52,7 +57,8 @@ LOBES = tuple(lobe.name for lobe in DISNEY_LOBES)
 
 # -- parameters --------------------------------------------------------------------------
 def luminance(c: Any) -> Any:
-    return LUMINANCE[0] * c[0] + LUMINANCE[1] * c[1] + LUMINANCE[2] * c[2]
+    """Burley's tint luminance of a channel-first colour (:data:`TINT_WEIGHTS`)."""
+    return TINT_WEIGHTS[0] * c[0] + TINT_WEIGHTS[1] * c[1] + TINT_WEIGHTS[2] * c[2]
 
 
 def tint_color(xp: Any, base: Any) -> Any:
@@ -72,8 +78,7 @@ def _eta(xp: Any, params: DisneyParams, maps: dict[str, Any]) -> Any:
     if "ior" in maps:
         return xp.scalar(maps["ior"])
     if "specular" in maps and not params.uses_ior:
-        r = xp.sqrt(xp.minimum(SPECULAR_F0_SCALE * xp.scalar(maps["specular"]), 0.999999))
-        return (1.0 + r) / (1.0 - r)
+        return fr.specular_to_ior(xp.scalar(maps["specular"]), xp)
     return params.effective_ior
 
 
@@ -92,7 +97,7 @@ def _fresnel_terms(xp, p, base, tint, w_d, w_g, eta) -> tuple[Any, Any, Any]:
     metallic, spec_tint = p["metallic"], p["specular_tint"]
     tinted = mix(1.0, tint, spec_tint)
     if p["uses_ior"]:
-        a = metallic * base + w_d * spec_tint * fr.schlick_f0(eta) * tint
+        a = metallic * base + w_d * spec_tint * fr.ior_to_f0(eta) * tint
         b = metallic + w_d * spec_tint
         return a, b, w_d * (1.0 - spec_tint) + w_g
     a = metallic * base + w_d * (SPECULAR_F0_SCALE * p["specular"]) * tinted
@@ -172,7 +177,7 @@ def lobe_odds(xp: Any, pr: dict[str, Any]) -> tuple[dict[str, Any], dict[str, An
     Estimates: diffuse ρ·lum(base), Schlick lobes F0 + (1 − F0)/21, glass 1 − F0 split
     by 1/η² inside. Sheen is sampled like the diffuse, by the cosine.
     """
-    f0 = fr.schlick_f0(pr["eta"])
+    f0 = fr.ior_to_f0(pr["eta"])
     lum_a = luminance(pr["spec_a"])
     lum_t = luminance(pr["trans_color"])
     est = {

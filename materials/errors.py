@@ -7,6 +7,10 @@ allowed, so the CLI can print it as it is and exit with code 2.
 
 from __future__ import annotations
 
+from typing import Any, TypeVar
+
+from pydantic import BaseModel, ValidationError
+
 
 class LookdevError(Exception):
     """Root of every error lookdev raises on bad input.
@@ -28,3 +32,116 @@ class LookdevError(Exception):
 
 class ParameterError(LookdevError, ValueError):
     """A material parameter is missing, of the wrong type, or outside its allowed range."""
+
+
+E = TypeVar("E", bound=LookdevError)
+M = TypeVar("M", bound=BaseModel)
+
+
+# -- pydantic's ValidationError as one line --------------------------------------------------
+_SCHEMAS: dict[str, type[BaseModel]] = {}
+
+
+def register_schema(cls: type[M]) -> type[M]:
+    """Make a schema's fields and ranges known to :func:`one_line` (``allowed [lo, hi]``).
+
+    Keyed like pydantic's ``ValidationError.title``: the schema's ``title``, else its name.
+    """
+    _SCHEMAS[cls.model_config.get("title") or cls.__name__] = cls
+    return cls
+
+
+def one_line(
+    exc: ValidationError,
+    error: type[E] = ParameterError,
+    *,
+    where: str | None = None,
+    prefix: str | None = None,
+) -> E:
+    """The first error of ``exc`` as one ``error``: "where: field: message (what is allowed)".
+
+    The one formatter of pydantic errors (parameters, layers, preset files, IBL definitions).
+    ``field`` is the error's location, ``a.b[0]``, under ``prefix``; the message says the
+    value and its allowed range, that a field is unknown (and, at the top of a registered
+    schema, which are allowed), missing, not finite, or what the validator said.
+
+    >>> from pydantic import Field
+    >>> class P(BaseModel):
+    ...     spp: int = Field(64, ge=1, le=4096)
+    >>> try:
+    ...     P.model_validate({"spp": 0})
+    ... except ValidationError as exc:
+    ...     print(one_line(exc, where="proof.toml", prefix="render"))
+    proof.toml: render.spp: 0 is out of range; allowed ≥ 1
+
+    (With ``P`` registered the range reads ``allowed [1, 4096]``.)
+    """
+    err = exc.errors(include_url=False)[0]
+    loc = err["loc"]
+    path = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in loc).lstrip(".")
+    field = ".".join(p for p in (prefix, path) if p) or None
+    ctx = err.get("ctx") or {}
+    kind = err["type"]
+    given = short_repr(err.get("input"))
+    if kind in ("greater_than_equal", "less_than_equal", "greater_than", "less_than"):
+        msg = f"{given} is out of range; allowed {_range_text(exc, err)}"
+    elif kind == "extra_forbidden":
+        schema = _SCHEMAS.get(exc.title)
+        known = len(loc) == 1 and schema is not None
+        msg = "unknown field" + (f"; allowed: {', '.join(schema.model_fields)}" if known else "")
+    elif kind == "missing":
+        msg = "required field is missing"
+    elif kind == "finite_number":
+        msg = f"{given} is not a finite number"
+    elif kind == "value_error":
+        msg = str(ctx.get("error", err["msg"]))
+    else:
+        msg = f"{err['msg']} (got {given})"
+    return error(msg, where=where, field=field)
+
+
+def short_repr(value: Any, limit: int = 60) -> str:
+    """``repr(value)``, cut to ``limit`` characters with ``...`` (a message stays one line).
+
+    >>> short_repr("x" * 100, 10)
+    "'xxxxxx..."
+    """
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _range_text(exc: ValidationError, err: dict[str, Any]) -> str:
+    """``[lo, hi]`` of the offending field, or the violated bound alone when the field's
+    schema is not known here (a nested model that did not call :func:`register_schema`)."""
+    ctx = err.get("ctx") or {}
+    loc = err["loc"]
+    if loc and isinstance(loc[-1], int):
+        lo, hi = 0.0, 1.0  # a colour channel
+    else:
+        field = next((p for p in reversed(loc) if isinstance(p, str)), None)
+        lo, hi = _bounds(exc.title, field)
+    if lo is None and hi is None:
+        bound = next((f"{op} {ctx[k]:g}" for k, op in _OPS if k in ctx), "")
+        return bound or "a smaller or larger value"
+    lo_text = "-∞" if lo is None else f"{float(lo):g}"
+    hi_text = "∞" if hi is None else f"{float(hi):g}"
+    return f"[{lo_text}, {hi_text}]"
+
+
+_OPS = (("ge", "≥"), ("gt", ">"), ("le", "≤"), ("lt", "<"))
+
+
+def _bounds(model_name: str, field: str | None) -> tuple[float | None, float | None]:
+    """The (ge, le) bounds declared on ``field`` of the schema ``model_name``, else of the
+    first registered schema that declares that field; (None, None) when none does."""
+    named = _SCHEMAS.get(model_name)
+    for cls in [named] * (named is not None) + list(_SCHEMAS.values()):
+        if field not in cls.model_fields:
+            continue
+        lo = hi = None
+        for m in cls.model_fields[field].metadata:
+            lo = getattr(m, "ge", None) if getattr(m, "ge", None) is not None else lo
+            hi = getattr(m, "le", None) if getattr(m, "le", None) is not None else hi
+        if lo is not None or hi is not None:
+            return lo, hi
+    return None, None

@@ -14,7 +14,6 @@ taken as sRGB-encoded and decoded once, here.
 
 from __future__ import annotations
 
-import math
 import re
 from typing import Annotated, Any, Literal
 
@@ -27,19 +26,10 @@ from pydantic import (
     model_validator,
 )
 
-from .errors import ParameterError
-
-SPECULAR_F0_SCALE = 0.08  # Burley §5.4: specular 0..1 ↦ F0 0..0.08
-
-
-def srgb_to_linear(v: float) -> float:
-    """IEC 61966-2-1 sRGB decoding of one channel in 0..1.
-
-    >>> round(srgb_to_linear(0.5), 6)
-    0.214041
-    """
-    return v / 12.92 if v <= 0.04045 else ((v + 0.055) / 1.055) ** 2.4
-
+from .colour import srgb_decode
+from .errors import ParameterError as ParameterError  # re-exported
+from .errors import one_line, register_schema
+from .fresnel import SPECULAR_F0_SCALE, ior_to_specular, specular_to_ior
 
 _HEX = re.compile(r"^#?([0-9a-fA-F]{6})$")
 
@@ -51,7 +41,7 @@ def parse_color(value: Any) -> Any:
         if not m:
             raise ValueError(f"colour {value!r} is neither '#rrggbb' nor [r, g, b]")
         h = m.group(1)
-        return tuple(srgb_to_linear(int(h[i : i + 2], 16) / 255.0) for i in (0, 2, 4))
+        return tuple(srgb_decode(int(h[i : i + 2], 16) / 255.0) for i in (0, 2, 4))
     if isinstance(value, int | float) and not isinstance(value, bool):
         return (float(value),) * 3
     return value
@@ -76,7 +66,7 @@ class Params(BaseModel):
         try:
             return cls.model_validate(data)
         except ValidationError as exc:
-            raise parameter_error(exc, where=where) from None
+            raise one_line(exc, where=where) from None
 
     def replace(self, **changes: Any):
         """A validated copy with some parameters changed."""
@@ -85,63 +75,7 @@ class Params(BaseModel):
         return type(self).parse(data)
 
 
-def parameter_error(exc: ValidationError, *, where: str | None = None) -> ParameterError:
-    """The first pydantic error as one line: field, value, what is allowed."""
-    err = exc.errors(include_url=False)[0]
-    loc = ".".join(str(p) for p in err["loc"] if not isinstance(p, int)) or None
-    ctx = err.get("ctx") or {}
-    kind = err["type"]
-    given = err.get("input")
-    if kind in ("greater_than_equal", "less_than_equal", "greater_than", "less_than"):
-        msg = f"{given!r} is out of range; allowed {_range_text(exc, err)}"
-    elif kind == "extra_forbidden":
-        msg = "unknown parameter"
-    elif kind == "finite_number":
-        msg = f"{given!r} is not a finite number"
-    elif kind == "value_error":
-        msg = str(ctx.get("error", err["msg"]))
-    else:
-        msg = f"{err['msg']} (got {given!r})"
-    return ParameterError(msg, where=where, field=loc)
-
-
-def _range_text(exc: ValidationError, err: dict[str, Any]) -> str:
-    """``[lo, hi]`` of the offending field, or the violated bound alone when the field's
-    schema is not known here (a nested model that did not call :func:`register_schema`)."""
-    ctx = err.get("ctx") or {}
-    loc = err["loc"]
-    if loc and isinstance(loc[-1], int):
-        lo, hi = 0.0, 1.0  # a colour channel
-    else:
-        field = next((p for p in reversed(loc) if isinstance(p, str)), None)
-        lo, hi = _bounds(exc.title, field)
-    if lo is None and hi is None:
-        bound = next((f"{op} {ctx[k]:g}" for k, op in _OPS if k in ctx), "")
-        return bound or "a smaller or larger value"
-    lo_text = "-∞" if lo is None else f"{float(lo):g}"
-    hi_text = "∞" if hi is None else f"{float(hi):g}"
-    return f"[{lo_text}, {hi_text}]"
-
-
-_OPS = (("ge", "≥"), ("gt", ">"), ("le", "≤"), ("lt", "<"))
-
-
-def _bounds(model_name: str, field: str | None) -> tuple[float | None, float | None]:
-    """The (ge, le) bounds declared on ``field`` of the schema ``model_name``, else of the
-    first registered schema that declares that field; (None, None) when none does."""
-    named = _SCHEMAS.get(model_name)
-    for cls in [named] * (named is not None) + list(_SCHEMAS.values()):
-        if field not in cls.model_fields:
-            continue
-        lo = hi = None
-        for m in cls.model_fields[field].metadata:
-            lo = getattr(m, "ge", None) if getattr(m, "ge", None) is not None else lo
-            hi = getattr(m, "le", None) if getattr(m, "le", None) is not None else hi
-        if lo is not None or hi is not None:
-            return lo, hi
-    return None, None
-
-
+@register_schema
 class DisneyParams(Params):
     """Burley 2012 (+ 2014 addenda) principled BRDF and the 2015 BSDF extension.
 
@@ -199,21 +133,11 @@ class DisneyParams(Params):
         """IOR whose normal-incidence reflectance is ``0.08 · specular`` (Burley §5.4)."""
         if self.ior is not None:
             return self.ior
-        r = math.sqrt(min(SPECULAR_F0_SCALE * self.specular, 1.0 - 1e-7))
-        return (1.0 + r) / (1.0 - r)
+        return specular_to_ior(self.specular)
 
     @property
     def effective_specular(self) -> float:
         """``specular`` whose F0 equals the Fresnel reflectance of ``ior`` at normal incidence."""
         if self.ior is None:
             return self.specular
-        return ((self.ior - 1.0) / (self.ior + 1.0)) ** 2 / SPECULAR_F0_SCALE
-
-
-_SCHEMAS: dict[str, type[Params]] = {"DisneyParams": DisneyParams}
-
-
-def register_schema(cls: type[Params]) -> type[Params]:
-    """Make a parameter schema's ranges known to the one-line error messages."""
-    _SCHEMAS[cls.__name__] = cls
-    return cls
+        return ior_to_specular(self.ior)

@@ -44,8 +44,9 @@ from pydantic import BeforeValidator, Field, create_model
 from . import pixar_lobes as lobes
 from .arrays import NumpyOps
 from .bsdf import Model, density, draw, evaluate
+from .fresnel import f0_to_ior
 from .params import Color, Params, parse_color, register_schema
-from .pixar_lobes import LN_10
+from .pixar_lobes import LN_10, reflection_cone, specular_cone
 from .pixar_scatter import (
     PIXAR_LOBES,
     PREFIX,
@@ -108,8 +109,7 @@ class PixarParams(Params):
         """The IOR: given, or the one whose normal reflectance is the dielectric nRefl."""
         if self.ior is not None:
             return self.ior
-        f0 = min(DIELECTRIC_REFL * self.normal_fresnel, 1.0 - 1e-6) ** 0.5
-        return (1.0 + f0) / (1.0 - f0)
+        return f0_to_ior(DIELECTRIC_REFL * self.normal_fresnel)
 
 
 GRAZING = "_grazing"
@@ -336,8 +336,10 @@ def as_lobe_weights(params: PixarParams) -> Any:
         if g is not None:
             data[name + GRAZING] = tuple(np.asarray(g, dtype=float).ravel())
     r = params.roughness
-    data["specular_cone"] = data["specular_t_cone"] = (30.0 * r + 5.0) * params.specular_cone_scale
-    data["reflection_cone"] = data["reflection_t_cone"] = 10.0 * r * params.reflection_cone_scale
+    data["specular_cone"] = data["specular_t_cone"] = specular_cone(r, params.specular_cone_scale)
+    data["reflection_cone"] = data["reflection_t_cone"] = reflection_cone(
+        r, params.reflection_cone_scale
+    )
     data["specular_falloff"] = data["specular_t_falloff"] = r * LN_10
     data["ior"] = params.eta
     return PixarLobeWeights.parse(data, where="as_lobe_weights")

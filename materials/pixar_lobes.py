@@ -47,6 +47,32 @@ def p_diffuse(xp: Any, cos_u: Any, cos_v: Any, norm_refl: Any, grazing_refl: Any
     return frn_blend(xp, a, b, cos_u) * frn_blend(xp, a, b, cos_v) * INV_PI
 
 
+def specular_cone(r: Any, scale: Any = 1.0) -> Any:
+    """Smits' specular cone angle in degrees, (30 r + 5)° × ``specular_cone_scale``.
+
+    His powerS falls to 10 % at ``Sin[(30 r + 5) Degree]``: "cone angle … goes from 5
+    degrees to 35 degrees based on roughness" (seed, PSpecular). Arithmetic only, so
+    floats and either backend's arrays.
+
+    >>> specular_cone(0.0), specular_cone(1.0), specular_cone(0.5, 2.0)
+    (5.0, 35.0, 40.0)
+    """
+    return (30.0 * r + 5.0) * scale
+
+
+def reflection_cone(r: Any, scale: Any = 1.0) -> Any:
+    """Smits' reflection cone angle in degrees, 10 r° × ``reflection_cone_scale``.
+
+    "The reflection cone angle goes between 0 (or epsilon in practice) and 10 degrees"
+    (seed, powerR). 0 at roughness 0 here; :func:`cone_power` floors it at
+    :data:`CONE_MIN_DEG` where a lobe is evaluated.
+
+    >>> reflection_cone(0.0), reflection_cone(1.0), reflection_cone(0.5, 2.0)
+    (0.0, 10.0, 10.0)
+    """
+    return (10.0 * r) * scale
+
+
 def cone_power(xp: Any, falloff_log: Any, cone_deg: Any) -> Any:
     """−log(falloff)/sin²(cone): the exponent at which the lobe falls to ``falloff``."""
     s = xp.sin(xp.maximum(cone_deg, CONE_MIN_DEG) * DEG)
@@ -55,12 +81,12 @@ def cone_power(xp: Any, falloff_log: Any, cone_deg: Any) -> Any:
 
 def power_specular(xp: Any, r: Any, cone_scale: Any = 1.0) -> Any:
     """powerS[r] = −Log[0.1^r] / Sin[(30 r + 5)°]² (0 at r = 0: a flat, unused lobe)."""
-    return cone_power(xp, r * LN_10, (30.0 * r + 5.0) * cone_scale)
+    return cone_power(xp, r * LN_10, specular_cone(r, cone_scale))
 
 
 def power_reflection(xp: Any, r: Any, cone_scale: Any = 1.0) -> Any:
     """powerR[r] = −Log[0.1] / Sin[(10 r)°]², with the cone floored at CONE_MIN_DEG."""
-    return cone_power(xp, LN_10, (10.0 * r) * cone_scale)
+    return cone_power(xp, LN_10, reflection_cone(r, cone_scale))
 
 
 def _floored(xp: Any, p: Any) -> Any:

@@ -10,8 +10,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from lookdev.materials.arrays import NumpyOps, from_channel_first, to_channel_first
+from lookdev.materials.colour import srgb_decode
 from lookdev.materials.errors import LookdevError, ParameterError
-from lookdev.materials.params import DisneyParams, srgb_to_linear
+from lookdev.materials.params import DisneyParams
 
 
 def test_version_and_help(cli):
@@ -44,12 +45,12 @@ def test_disney_defaults_are_burleys():
         ({"roughness": -0.1}, "roughness", "[0, 1]"),
         ({"roughness": math.nan}, "roughness", "finite"),
         ({"metallic": math.inf}, "metallic", "finite"),
-        ({"base_color": [0.5, -1, 0.5]}, "base_color", "[0, 1]"),
+        ({"base_color": [0.5, -1, 0.5]}, "base_color[1]", "[0, 1]"),
         ({"specular": 13.0}, "specular", "[0, 12.5]"),
         ({"ior": 0.9}, "ior", "[1, 10]"),
         ({"sheen": -1}, "sheen", "[0, ∞]"),
         ({"specular": 0.5, "ior": 1.5}, None, "not both"),
-        ({"glossiness": 1}, "glossiness", "unknown parameter"),
+        ({"glossiness": 1}, "glossiness", "unknown field; allowed: base_color, subsurface"),
     ],
 )
 def test_bad_parameters_name_field_and_range(data, field, allowed):
@@ -64,7 +65,7 @@ def test_bad_parameters_name_field_and_range(data, field, allowed):
 def test_colours_decode_srgb_once():
     assert DisneyParams(base_color="#ffffff").base_color == (1.0, 1.0, 1.0)
     c = DisneyParams(base_color="#808080").base_color
-    assert c[0] == pytest.approx(srgb_to_linear(128 / 255))
+    assert c[0] == pytest.approx(srgb_decode(128 / 255))
     assert DisneyParams(base_color=[0.1, 0.2, 0.3]).base_color == (0.1, 0.2, 0.3)
 
 

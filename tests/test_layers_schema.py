@@ -115,7 +115,7 @@ def test_json_schema_has_a_discriminated_union_and_descriptions():
         ({"preset": "a", "mask": {"kind": "noise", "scale": 0}}, "mask.noise.scale", "range"),
         ({"preset": "a", "mask": {"kind": "max", "inputs": []}}, "mask.max.inputs", "at least"),
         ({"preset": "a", "mask": {"kind": "constant", "value": float("nan")}}, None, "finite"),
-        ({"preset": "a", "opacity": 1}, "opacity", "unknown parameter"),
+        ({"preset": "a", "opacity": 1}, "opacity", "unknown field; allowed: name, preset"),
     ],
 )
 def test_bad_layers_are_one_line_errors_naming_the_field(data, field, words):

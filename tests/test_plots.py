@@ -11,6 +11,7 @@ from _lambert import LAMBERT, PHONG, LambertParams, PhongParams
 
 from lookdev.library import load_material
 from lookdev.materials import registry
+from lookdev.materials.colour import luminance
 from lookdev.pipeline.analysis import plots as P
 from lookdev.pipeline.analysis import sphere as S
 from lookdev.pipeline.blend import BlendedMaterial, blend
@@ -56,10 +57,24 @@ def test_slice_isolines_are_the_incidence_angle_of_both_directions():
     np.testing.assert_allclose(wo[..., 2], wi[..., 2], atol=1e-12)  # φd = 90°: θl = θv
 
 
-def test_exposure_and_srgb_curve():
-    np.testing.assert_allclose(P.to_display(np.array([0.25]), exposure=2), [1.0])
-    assert P.to_display(np.array([0.5]), exposure=0)[0] == pytest.approx(0.735357, abs=1e-6)
-    assert P.to_display(np.array([-1.0, np.inf]))[0] == 0.0
+def test_slices_and_spheres_are_shown_through_the_proofs_view_transform(monkeypatch):
+    import matplotlib.pyplot as plt
+
+    from lookdev.pipeline.proof import tonemap
+
+    seen, original = [], tonemap.view
+
+    def view(rgb, exposure=0.0):
+        seen.append((np.shape(rgb), exposure))
+        return original(rgb, exposure)
+
+    monkeypatch.setattr(P.tonemap, "view", view)
+    fig, (a, b) = plt.subplots(1, 2)
+    monkeypatch.setitem(registry.MODELS, "lambert", LAMBERT)
+    P.draw_slice(a, BlendedMaterial.of_params(LambertParams(), "lambert"), exposure=1.5, n=8)
+    P.draw_sphere(b, np.full((4, 4, 3), 0.5), -1.0, "sphere")
+    plt.close(fig)
+    assert seen == [((8, 8, 3), 1.5), ((4, 4, 3), -1.0)]
 
 
 # -- polar ---------------------------------------------------------------------------
@@ -71,7 +86,7 @@ def test_polar_peak_is_at_the_mirror_direction(incidence):
 
 def test_lambert_polar_is_rho_over_pi_luminance_everywhere():
     _, lum = P.polar_curves(LAMBERT, LambertParams(base_color=tuple(RHO)), [0, 45, 89.9])
-    np.testing.assert_allclose(lum, RHO @ S.REC709_Y / math.pi, rtol=1e-12)
+    np.testing.assert_allclose(lum, luminance(RHO) / math.pi, rtol=1e-12)
 
 
 # -- sphere --------------------------------------------------------------------------
@@ -308,7 +323,7 @@ def test_lambertian_preset_views_match_closed_forms(lambertian_preset):
     (curve,) = P.albedo_curves(s)  # what the albedo view draws
     np.testing.assert_allclose(curve.albedo, np.tile(RHO, (len(curve.theta), 1)), rtol=1e-12)
     _, lum = P.polar_curves(s.bsdf_model, s.params, [0, 60, 89])
-    np.testing.assert_allclose(lum, RHO @ S.REC709_Y / math.pi, rtol=1e-12)
+    np.testing.assert_allclose(lum, luminance(RHO) / math.pi, rtol=1e-12)
     light = np.array([-1.0, 1.0, 1.0]) / math.sqrt(3.0)
     img = S.point_light_sphere(
         s.bsdf_model, s.params, resolution=32, light=tuple(light), irradiance=1.0

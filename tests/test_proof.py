@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from lookdev.materials.colour import srgb_encode
 from lookdev.pipeline.proof import contact, shaderball, tonemap
 
 MODULES = ["ibl", "tonemap", "contact", "shaderball", "turntable", "batch"]
@@ -55,10 +56,27 @@ def test_view_is_the_identity_below_the_knee_and_rolls_off_above():
 def test_a_hot_saturated_highlight_stays_saturated():
     """Burley §6.2: clipping "forces the core to always go to white"; this must not."""
     hot_red = np.array([200.0, 20.0, 2.0])
-    clipped = tonemap.srgb_oetf(np.clip(hot_red, 0, 1))
+    clipped = srgb_encode(np.clip(hot_red, 0, 1))
     viewed = tonemap.view(hot_red)
     assert clipped.min() == pytest.approx(1.0)  # clipping: white
     assert viewed[0] > 0.99 and viewed[2] < 0.5  # ours: still red
+
+
+@pytest.mark.parametrize(
+    ("grey", "shown"),
+    [
+        (0.0, 0.0),  # black stays black
+        (0.5, srgb_encode(0.5)),  # below the knee: the sRGB encoding alone
+        (1.0, srgb_encode(float(tonemap.shoulder(1.0)))),  # 1 rolls off: no clipping
+        (1e30, srgb_encode(1.0)),  # huge: tends to white, never above it
+        (-3.0, 0.0),  # negative: black
+        (float("nan"), 0.0),  # NaN: black, not NaN
+    ],
+)
+def test_view_at_its_edges(grey, shown):
+    out = tonemap.view(np.full((1, 3), grey))
+    assert np.isfinite(out).all()
+    np.testing.assert_allclose(out, np.full((1, 3), shown), rtol=1e-12, atol=1e-15)
 
 
 def test_view_survives_nan_inf_and_negative_pixels():

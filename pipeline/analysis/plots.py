@@ -8,7 +8,8 @@ centre texel in the other views.
 
 * ``slice``  — f(θh, θd) at φd = 90° (Burley Fig. 3): θh to the right (left edge = the
   specular peak), θd up (top edge = the Fresnel peak, bottom edge = retro-reflection),
-  shown with an exposure control and the sRGB transfer curve.
+  shown with an exposure control through the proofs' view transform
+  (:func:`lookdev.pipeline.proof.tonemap.view`).
 * ``albedo`` — directional albedo against incidence angle per channel (Fig. 11/12).
 * ``polar``  — f in the plane of incidence for several incidence angles; the light comes
   from the left, the mirror direction is on the right.
@@ -30,11 +31,13 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from lookdev.materials.bsdf import Model, evaluate  # noqa: E402
+from lookdev.materials.colour import luminance  # noqa: E402
 from lookdev.materials.errors import LookdevError  # noqa: E402
 from lookdev.pipeline.blend.result import BlendedMaterial  # noqa: E402
+from lookdev.pipeline.proof import tonemap  # noqa: E402
 
 from .albedo import albedo_monte_carlo, albedo_tabulated  # noqa: E402
-from .sphere import REC709_Y, ibl_sphere, point_light_sphere  # noqa: E402
+from .sphere import ibl_sphere, point_light_sphere  # noqa: E402
 
 VIEWS = ("slice", "albedo", "polar", "sphere")
 CHANNEL_COLOURS = ("#d62728", "#2ca02c", "#1f77b4")
@@ -92,16 +95,6 @@ def brdf_slice(model: Model, params: Any, n: int = 128, phi_d: float = math.pi /
     return theta, theta, np.where(below[..., None], 0.0, np.nan_to_num(f))
 
 
-def to_display(radiance: np.ndarray, exposure: float = 0.0) -> np.ndarray:
-    """Scene-linear values × 2^exposure, clipped and sRGB-encoded for display.
-
-    >>> to_display(np.array([0.0, 1.0, 4.0]), exposure=-2).round(4).tolist()
-    [0.0, 0.5371, 1.0]
-    """
-    x = np.clip(radiance * 2.0**exposure, 0.0, 1.0)
-    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
-
-
 def incidence_on_slice(theta_h: np.ndarray, theta_d: np.ndarray) -> np.ndarray:
     """θl (= θv) in degrees over the φd = 90° slice: cos θl = cos θh cos θd.
 
@@ -115,7 +108,7 @@ def incidence_on_slice(theta_h: np.ndarray, theta_d: np.ndarray) -> np.ndarray:
 
 def draw_slice(ax: Any, hub: BlendedMaterial, *, exposure: float = 0.0, n: int = 128) -> None:
     th, td, f = brdf_slice(hub.bsdf_model, hub.centre_params, n)
-    ax.imshow(to_display(f, exposure), origin="lower", extent=(0, 90, 0, 90))
+    ax.imshow(tonemap.view(f, exposure), origin="lower", extent=(0, 90, 0, 90))
     deg_h, deg_d = np.meshgrid(np.degrees(th), np.degrees(td))
     lines = ax.contour(
         deg_h,
@@ -215,7 +208,7 @@ def polar_curves(
     rows = []
     for ti in np.radians(np.asarray(incidence_deg, dtype=np.float64)):
         wi = np.array([-math.sin(ti), 0.0, math.cos(ti)])
-        rows.append(np.nan_to_num(evaluate(model, params, wi, wo)) @ REC709_Y)
+        rows.append(luminance(np.nan_to_num(evaluate(model, params, wi, wo))))
     return theta_o, np.array(rows)
 
 
@@ -259,7 +252,7 @@ def draw_polar(
 
 # -- sphere --------------------------------------------------------------------------
 def draw_sphere(ax: Any, image: np.ndarray, exposure: float, title: str) -> None:
-    ax.imshow(to_display(image, exposure))
+    ax.imshow(tonemap.view(image, exposure))
     ax.set_axis_off()
     ax.set_title(title, fontsize="small")
 

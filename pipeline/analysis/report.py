@@ -192,7 +192,7 @@ def web_image(src: Path, out_dir: Path, exposure: float = 0.0) -> Path:
         return src
     import OpenImageIO as oiio
 
-    from .plots import to_display
+    from lookdev.pipeline.proof.tonemap import to_8bit, view
 
     try:  # named after its place in the batch, so material/ibl/frame_000 stay apart
         parts = src.relative_to(out_dir.parent).with_suffix("").parts
@@ -206,7 +206,7 @@ def web_image(src: Path, out_dir: Path, exposure: float = 0.0) -> Path:
     if buf.has_error or pixels.ndim != 3:
         raise ReportError(f"cannot read frame: {buf.geterror()}", where=str(src))
     rgb = pixels[..., :3] if pixels.shape[-1] >= 3 else np.repeat(pixels[..., :1], 3, -1)
-    img = (to_display(rgb, exposure) * 255 + 0.5).astype(np.uint8)
+    img = to_8bit(view(rgb, exposure))
     dst.parent.mkdir(parents=True, exist_ok=True)
     out = oiio.ImageBuf(oiio.ImageSpec(img.shape[1], img.shape[0], 3, oiio.UINT8))
     out.set_pixels(oiio.ROI(), img)

@@ -23,8 +23,8 @@ from typing import Any
 import numpy as np
 
 from lookdev.materials.bsdf import Model, density, draw, evaluate
+from lookdev.materials.colour import luminance
 
-REC709_Y = np.array([0.2126, 0.7152, 0.0722])
 MARGIN = 1.08
 
 
@@ -138,7 +138,7 @@ class LatLong:
         self.edges = np.concatenate([[0.0], inner, [math.pi]])
         self.dphi = 2.0 * math.pi / w
         omega = self.dphi * (np.cos(self.edges[:-1]) - np.cos(self.edges[1:]))
-        weight = np.maximum(self.pixels @ REC709_Y, 0.0) * omega[:, None]
+        weight = np.maximum(luminance(self.pixels), 0.0) * omega[:, None]
         # A floor keeps every direction reachable, so MIS stays unbiased.
         weight = weight + 1e-3 * max(float(weight.sum() / omega.sum() / w), 1e-12) * omega[:, None]
         self.pmf = (weight / weight.sum()).reshape(-1)

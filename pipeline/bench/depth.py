@@ -19,9 +19,9 @@ from typing import Any
 
 import numpy as np
 
+from lookdev.materials.colour import luminance
 from lookdev.materials.errors import LookdevError
 
-REC709_Y = np.array([0.2126, 0.7152, 0.0722], dtype=np.float32)
 DEFAULT_PRESETS = ("plastic_matte", "gold", "leaf", "glass_thin", "glass_clear")
 """One preset per depth class: dark opaque, bright opaque, diffuse and glossy thin
 transmission, solid glass."""
@@ -96,7 +96,7 @@ def loss(image: np.ndarray, reference: np.ndarray) -> dict[str, float]:
     >>> {k: round(v, 3) for k, v in loss(img, ref).items()}
     {'mean_loss': 0.005, 'p99_pixel_loss': 0.005}
     """
-    y_img, y_ref = image @ REC709_Y, reference @ REC709_Y
+    y_img, y_ref = luminance(image), luminance(reference)
     pixel = (y_ref - y_img) / np.maximum(y_ref, 1e-3)
     return {
         "mean_loss": float(1.0 - y_img.mean() / max(float(y_ref.mean()), 1e-12)),

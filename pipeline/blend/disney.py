@@ -25,7 +25,8 @@ from typing import Any
 
 import numpy as np
 
-from lookdev.materials.params import SPECULAR_F0_SCALE, DisneyParams
+from lookdev.materials.fresnel import specular_to_ior
+from lookdev.materials.params import DisneyParams
 
 from .errors import BlendError
 
@@ -113,18 +114,8 @@ def spell_specular(stack: Sequence[DisneyParams], specular: Any) -> dict[str, An
         return {"specular": specular}
     if len(iors) == 1:
         return {"ior": iors.pop()}
-    return {"ior": specular_to_ior(specular)}
-
-
-def specular_to_ior(specular: Any) -> Any:
-    """IOR whose normal-incidence Fresnel is ``0.08 · specular`` (Burley §5.4).
-
-    >>> round(float(specular_to_ior(0.5)), 6)
-    1.5
-    """
-    r = np.sqrt(np.minimum(SPECULAR_F0_SCALE * np.asarray(specular), 1.0 - 1e-7))
-    out = (1.0 + r) / (1.0 - r)
-    return out.astype(np.float32) if np.ndim(out) else float(out)
+    ior = specular_to_ior(np.asarray(specular))
+    return {"ior": ior.astype(np.float32) if np.ndim(ior) else float(ior)}
 
 
 def assemble(

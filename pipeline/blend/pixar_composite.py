@@ -51,7 +51,7 @@ from typing import Any
 import numpy as np
 
 from lookdev.materials.pixar import PixarParams, lobe_weights
-from lookdev.materials.pixar_lobes import CONE_MIN_DEG, LN_10
+from lookdev.materials.pixar_lobes import CONE_MIN_DEG, LN_10, reflection_cone, specular_cone
 from lookdev.materials.pixar_scatter import LOBES, PIXAR_LOBES, PREFIX
 
 from .errors import BlendError
@@ -101,8 +101,8 @@ def layer_lobes(params: PixarParams, cos_view: float, normals: dict | None = Non
     """
     w = lobe_weights(params, cos_view)
     r = params.roughness
-    spec = (30.0 * r + 5.0) * params.specular_cone_scale
-    refl = max(10.0 * r * params.reflection_cone_scale, CONE_MIN_DEG)
+    spec = specular_cone(r, params.specular_cone_scale)
+    refl = max(reflection_cone(r, params.reflection_cone_scale), CONE_MIN_DEG)
     cone = {"diffuse": 0.0, "specular": spec, "reflection": refl}
     falloff = {"diffuse": LN_10, "specular": r * LN_10, "reflection": LN_10}
     normals = normals or {}

@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from lookdev.materials.errors import LookdevError
+from lookdev.materials.errors import LookdevError, one_line
 
 from .contact import ProofImageError, write_exr
 
@@ -145,9 +145,7 @@ def definition(name: str) -> IblDefinition:
     except tomllib.TOMLDecodeError as exc:
         raise IblError(f"not valid TOML ({exc})", where=str(path)) from None
     except ValidationError as exc:
-        err = exc.errors()[0]
-        field = ".".join(str(p) for p in err["loc"])
-        raise IblError(err["msg"], where=str(path), field=field) from None
+        raise one_line(exc, IblError, where=str(path)) from None
 
 
 # -- generation ----------------------------------------------------------------------------

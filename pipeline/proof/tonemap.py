@@ -1,4 +1,8 @@
-"""The proof view transform: scene-linear Rec.709 → display sRGB without hue shifts.
+"""The view transform: scene-linear Rec.709 → display sRGB without hue shifts.
+
+The one way lookdev shows scene-linear values: proofs and contact sheets, the plots'
+images (BRDF slices, spheres) and the review page's frame thumbnails all go through
+:func:`view`, so one material looks the same on every page.
 
 Burley 2012 §6.2: clipping highlights "introduces banding as each color channel clips at
 a different location, and forces the core to always go to white"; Disney's operator
@@ -7,12 +11,15 @@ preserving color and contrast". This one does that with a curve on the *maximum 
 identity below a knee, an exponential shoulder above it that approaches 1, and every
 pixel's RGB scaled by the same ratio ``curve(m)/m``. The ratios between channels (the hue
 and saturation) are kept exactly and no channel can exceed 1, so nothing clips. The sRGB
-OETF (IEC 61966-2-1) encodes the result for an 8-bit PNG.
+encoding (IEC 61966-2-1, :func:`lookdev.materials.colour.srgb_encode`) encodes the result
+for an 8-bit PNG.
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+from lookdev.materials.colour import srgb_encode
 
 DEFAULT_KNEE = 0.6
 
@@ -30,18 +37,11 @@ def shoulder(m: np.ndarray, knee: float = DEFAULT_KNEE) -> np.ndarray:
     return np.where(m <= knee, m, knee + (1.0 - knee) * -np.expm1(-over))
 
 
-def srgb_oetf(x: np.ndarray) -> np.ndarray:
-    """IEC 61966-2-1 encoding of linear values in [0, 1].
-
-    >>> [round(float(v), 4) for v in srgb_oetf(np.array([0.0, 0.0031308, 0.18, 1.0]))]
-    [0.0, 0.0404, 0.4614, 1.0]
-    """
-    x = np.clip(x, 0.0, 1.0)
-    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1.0 / 2.4) - 0.055)
-
-
 def view(rgb: np.ndarray, exposure: float = 0.0, knee: float = DEFAULT_KNEE) -> np.ndarray:
     """Display-referred sRGB (…, 3) in [0, 1] of scene-linear ``rgb`` at ``exposure`` stops.
+
+    NaN, infinite and negative values show black; the maximum channel rolls off through
+    :func:`shoulder` with every channel scaled by the same ratio; then sRGB encoding.
 
     >>> out = view(np.array([[8.0, 4.0, 2.0]]))
     >>> bool(out.max() <= 1.0), round(float(out[0, 0] / out[0, 1]), 3) > 1.0
@@ -51,7 +51,7 @@ def view(rgb: np.ndarray, exposure: float = 0.0, knee: float = DEFAULT_KNEE) -> 
     rgb = np.maximum(rgb, 0.0) * 2.0**exposure
     m = rgb.max(axis=-1, keepdims=True)
     scale = np.divide(shoulder(m, knee), m, out=np.ones_like(m), where=m > 0)
-    return srgb_oetf(rgb * scale)
+    return srgb_encode(rgb * scale)
 
 
 def to_8bit(display: np.ndarray) -> np.ndarray:

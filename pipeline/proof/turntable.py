@@ -22,9 +22,9 @@ from typing import Any, Literal
 
 import numpy as np
 
-from . import shaderball
+from lookdev.materials.colour import luminance
 
-REC709_Y = np.array([0.2126, 0.7152, 0.0722])
+from . import shaderball
 
 
 @dataclass(frozen=True)
@@ -175,7 +175,7 @@ def render_frame(table: Turntable, frame: Frame, spp: int, seed: int = 0) -> Ren
     a, b = table.render_halves(half, seed=seed)
     seconds = time.perf_counter() - t0
     image = 0.5 * (a + b)
-    diff = (a - b) @ REC709_Y
+    diff = luminance(a - b)
     rmse = math.sqrt(float(np.mean(diff.astype(np.float64) ** 2)) / 4.0)
-    mean = float(np.mean(image @ REC709_Y))
+    mean = float(np.mean(luminance(image)))
     return RenderedFrame(frame, image, seconds, rmse, rmse / mean if mean > 0 else None)

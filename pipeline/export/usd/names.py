@@ -73,25 +73,6 @@ def roughness_to_gloss(r: float) -> float:
     return min(1.0, max(0.0, (r * r - lo) / (hi - lo)))
 
 
-def specular_to_ior(specular: float) -> float:
-    """Burley §5.4: F0 = 0.08·specular, and F0 = ((ior - 1)/(ior + 1))² for a dielectric.
-
-    >>> round(specular_to_ior(0.5), 6)
-    1.5
-    """
-    r = math.sqrt(min(0.08 * specular, 1.0 - 1e-7))
-    return (1.0 + r) / (1.0 - r)
-
-
-def ior_to_specular(ior: float) -> float:
-    """Inverse of :func:`specular_to_ior`.
-
-    >>> round(ior_to_specular(1.5), 6)
-    0.5
-    """
-    return ((ior - 1.0) / (ior + 1.0)) ** 2 / 0.08
-
-
 def _one_minus(v):
     return 1.0 - v
 

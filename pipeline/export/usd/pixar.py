@@ -22,6 +22,7 @@ import math
 from typing import Any
 
 from lookdev.materials.arrays import NumpyOps
+from lookdev.materials.fresnel import ior_to_f0
 from lookdev.materials.pixar import (
     DIELECTRIC_REFL,
     PixarParams,
@@ -139,4 +140,4 @@ def ior_to_normal_fresnel(ior: float) -> float:
     >>> round(ior_to_normal_fresnel(1.5), 6)  # F0 0.04
     0.8
     """
-    return ((ior - 1.0) / (ior + 1.0)) ** 2 / DIELECTRIC_REFL
+    return ior_to_f0(ior) / DIELECTRIC_REFL

@@ -17,8 +17,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from lookdev.materials.colour import luminance
+from lookdev.materials.fresnel import SPECULAR_F0_SCALE, ior_to_specular, specular_to_ior
+
 from .lobes import DEFAULTS, active_lobes, effective
-from .names import SURFACE_IDS, ior_to_specular, specular_to_ior, table_for
+from .names import SURFACE_IDS, table_for
 from .network import (
     CONTEXT_OUTPUT,
     F0_KEYS,
@@ -177,9 +180,6 @@ def _imported(spec: MaterialSpec) -> Imported | None:
     return result
 
 
-REC709_Y = (0.2126, 0.7152, 0.0722)  # luminance weights of linear Rec.709
-
-
 def _specular_workflow(surface: Node, values: dict[str, Any], result: Imported) -> None:
     """A foreign UsdPreviewSurface in its specular workflow: its specular colour is an F0.
 
@@ -193,9 +193,9 @@ def _specular_workflow(surface: Node, values: dict[str, Any], result: Imported) 
     if isinstance(colour, Connection):
         result.loss.append("universal: specularColor is a texture; its mean is unknown")
         return
-    f0 = sum(w * c for w, c in zip(REC709_Y, colour, strict=True))
+    f0 = luminance(colour)
     values["metallic"] = 0.0
-    values["specular"] = min(f0 / 0.08, 12.5)
+    values["specular"] = min(f0, 1.0) / SPECULAR_F0_SCALE  # F0 ≤ 1: specular ≤ 12.5
     values["ior"] = specular_to_ior(values["specular"])
     if max(colour) - min(colour) > 1e-6:
         result.loss.append(

@@ -15,12 +15,12 @@ from typing import Any
 
 import numpy as np
 
+from lookdev.materials.fresnel import specular_to_ior
 from lookdev.materials.params import DisneyParams
 from lookdev.pipeline.blend.result import LOBE_WEIGHTS, BlendedMaterial
 
 from .live import live_stack
 from .lobes import DEFAULTS, canonical
-from .names import specular_to_ior
 from .network import ExportError, Image, Source, source_from_params
 
 SUPPORTED = ("disney", "pixar")  # layered Pixar: see weights_source
@@ -70,7 +70,7 @@ def baked_source(hub: BlendedMaterial, texture_dir: Path, scratch: Path) -> Sour
 
     maps = {name: image(name, array) for name, array in hub.maps.items()}
     if "specular" in maps:  # the universal surface reads the same F0 as an IOR
-        ior = np.vectorize(specular_to_ior, otypes=[np.float32])(maps["specular"].pixels)
+        ior = specular_to_ior(np.asarray(maps["specular"].pixels, np.float64)).astype(np.float32)
         maps["ior"] = Image(texture_dir / f"{hub.name}_ior.exr", ior, write=True)
     normal = None if hub.normal_map is None else image("normal_map", hub.normal_map)
     return Source(
