@@ -103,7 +103,7 @@ def test_single_layer_stack_blends_to_its_own_weights_exactly():
     for suffix, cos_view in (("", 1.0), ("_grazing", 0.0)):
         w = lobe_weights(GLAZE, cos_view)
         for name, value in w.items():
-            assert out.constants[name + suffix] == tuple(np.float32(value).tolist()), name
+            assert out.constants[name + suffix] == pytest.approx(tuple(value), rel=1e-12), name
 
 
 def test_presence_below_one_lets_light_through():

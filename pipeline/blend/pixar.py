@@ -134,6 +134,7 @@ def _ior(top_first: list[Entry], alphas: list[Any]) -> Any:
     eta: Any = 0.0
     remaining: Any = 1.0
     for entry, alpha in zip(top_first, alphas, strict=True):
+        alpha = np.asarray(alpha, dtype=np.float64)  # η ≈ 1 refracts by η − 1: keep digits
         eta = eta + alpha * remaining * entry.params.eta
         remaining = remaining * (1.0 - alpha)
     return eta + remaining * top_first[-1].params.eta
@@ -164,7 +165,11 @@ def _store(out, key, value, rows, n, width, height) -> None:
     rest RGB or xyz)."""
     channels = () if key.endswith(("_cone", "_falloff", "ior")) else (3,)
     if key not in out:
-        out[key] = np.empty((height, width, *channels), dtype=np.float32)
+        # One texel is a uniform result: its constants keep float64, as a plain preset's
+        # do (near η = 1 refraction turns float32 rounding of η into 4e-4 of f); maps are
+        # float32 like every map.
+        dtype = np.float64 if height * width == 1 else np.float32
+        out[key] = np.empty((height, width, *channels), dtype=dtype)
     out[key][rows] = np.broadcast_to(value, (n, width, *channels))
 
 
