@@ -10,6 +10,13 @@ from dataclasses import dataclass
 os.environ["COLUMNS"] = "240"
 
 import pytest
+from hypothesis import settings
+
+# Property tests draw the same examples on every run (CI must not be red one run in ten);
+# HYPOTHESIS_PROFILE=explore searches afresh, and keeps what fails, when hunting bugs.
+settings.register_profile("deterministic", derandomize=True, database=None)
+settings.register_profile("explore", max_examples=500)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "deterministic"))
 
 
 @dataclass
