@@ -62,6 +62,7 @@ __all__ = [
     "MitsubaExport",
     "Plot",
     "Stability",
+    "USD_CONTEXTS",
     "UsdExport",
     "bake",
     "blend",
@@ -442,6 +443,10 @@ def sample(
 
 
 # -- USD -----------------------------------------------------------------------------------------
+USD_CONTEXTS = ("universal", "mtlx", "ri")
+"""The render contexts :func:`export_usd` writes: UsdPreviewSurface, MaterialX, RenderMan."""
+
+
 @dataclass
 class UsdExport:
     """What :func:`export_usd` wrote.
@@ -472,7 +477,7 @@ class UsdExport:
 def export_usd(
     materials: Any,
     path: PathLike,
-    contexts: Sequence[str] = ("universal", "mtlx", "ri"),
+    contexts: Sequence[str] = USD_CONTEXTS,
     *,
     mtlx: PathLike | None = None,
     bake: bool = False,
@@ -526,7 +531,7 @@ def export_usd(
     from lookdev.pipeline.export.usd import export_materials
     from lookdev.pipeline.export.usd.network import CONTEXTS, ExportError
 
-    contexts = tuple(contexts)
+    contexts = (contexts,) if isinstance(contexts, str) else tuple(contexts) or USD_CONTEXTS
     for context in contexts:
         if context not in CONTEXTS:
             raise ExportError(
@@ -558,7 +563,7 @@ def export_usd(
         result.files[0],
         result.files,
         result.materials,
-        contexts or CONTEXTS,
+        contexts,
         result.images,
         result.losses,
     )
