@@ -738,7 +738,8 @@ def proof(
     ibl_width
         Every IBL is resampled to this width (× ½ high) so render kernels are reused.
     jobs
-        Local worker processes (default 1: each renders on every core).
+        Local worker processes (default 1: each renders on every core). They are spawned,
+        so a script calling :func:`proof` does so under ``if __name__ == "__main__":``.
     scheduler
         A Dask scheduler address (``tcp://host:8786``): run the proofs on that cluster.
     executor

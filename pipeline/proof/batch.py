@@ -381,13 +381,14 @@ def proof(
     per_job = settings.element_frames + settings.light_frames
     total = len(jobs) * per_job
     finished = 0
-    shown = 0
+    shown = -1
 
     def report(frames: int, doc: dict[str, Any] | None = None) -> None:
         nonlocal shown
-        shown = max(shown, frames)  # a finished job's count replaces its partial one
-        if progress is not None:
-            progress(Progress(shown, total, doc))
+        frames = max(shown, frames)  # a finished job's count replaces its partial one
+        if progress is not None and (doc is not None or frames != shown):
+            progress(Progress(frames, total, doc))
+        shown = frames
 
     def done(job: Job, doc: dict[str, Any]) -> None:
         nonlocal finished
