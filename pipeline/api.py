@@ -303,12 +303,9 @@ def _bsdf(material: Any, uv: Any, lead: tuple[int, ...]) -> tuple[Model, Any, di
         values = {k: v for k, v in material.constants.items() if k in fields}
         return model, model.params_type.parse(values, where=material.name), {}
     rows, cols = _texels(material, uv, lead)
-    base = material.params_at(0, 0)  # validated: the maps' values were on the way in
-    params = (
-        model.params_type.parse({k: v for k, v in base.items() if k in fields})
-        if (weights)
-        else base
-    )
+    params = material.params_at(0, 0)  # any texel: the maps below replace its values
+    if weights:  # a dict of the blend's values, some of them the blend's own records
+        params = model.params_type.parse({k: v for k, v in params.items() if k in fields})
     maps = {k: np.asarray(a)[rows, cols] for k, a in material.maps.items() if k in fields}
     return model, params, maps
 
