@@ -51,15 +51,13 @@ def blend(
 
       lookdev blend looks/old_door.toml -o maps/ --resolution 4096 --json
     """
-    from lookdev.library import Library, load_material
-    from lookdev.pipeline.blend import bake
-    from lookdev.pipeline.blend import blend as blend_material
+    from lookdev.pipeline import api
 
-    material = load_material(preset, Library(library))
+    material = api.load(preset, library)
     t0 = time.perf_counter()
     with _progress(resolution * resolution >= LARGE) as (blend_cb, bake_cb):
-        blended = blend_material(material, resolution, progress=blend_cb, layering=layering)
-        files = bake(blended, output, progress=bake_cb)
+        blended = api.blend(material, resolution, progress=blend_cb, layering=layering)
+        files = api.bake(blended, output, progress=bake_cb)
     seconds = time.perf_counter() - t0
     if as_json:
         print_json(_summary(blended, files, seconds))

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 from typing import Annotated
 
 import typer
@@ -41,9 +40,8 @@ def check(
 
     Exit code 0 when nothing was found, 1 when anything was.
     """
-    names = list(model) if model else None
-    total = stability.case_count(names)
-    started = time.perf_counter()
+    from lookdev.pipeline import api
+
     with Progress(
         TextColumn("[bold]{task.fields[model]}"),
         BarColumn(),
@@ -53,23 +51,17 @@ def check(
         transient=True,
         disable=json_out or not err_console.is_terminal,
     ) as bar:
-        task = bar.add_task("check", total=total, model="", case="")
+        task = bar.add_task("check", total=None, model="", case="")
 
-        def advance(name: str, label: str) -> None:
-            bar.update(task, advance=1, model=name, case=label)
+        def advance(done: int, total: int, name: str, label: str) -> None:
+            bar.update(task, completed=done, total=total, model=name, case=label)
 
-        reports = stability.run(names, advance)
-    seconds = time.perf_counter() - started
+        result = api.check(model, progress=advance)
     if json_out:
-        print_json(
-            {
-                "models": {name: r.to_json() for name, r in reports.items()},
-                "seconds": round(seconds, 3),
-            }
-        )
+        print_json(result.to_json())
     else:
-        _print(reports, seconds)
-    if any(r.failed for r in reports.values()):
+        _print(result.reports, result.seconds)
+    if result.failed:
         raise typer.Exit(1)
 
 

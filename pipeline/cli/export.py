@@ -7,36 +7,12 @@ from typing import Annotated
 
 import typer
 
-from lookdev.materials.errors import LookdevError
-
 from .common import console, print_json
 
 app = typer.Typer(
     help="Write presets for other tools: Mitsuba scenes, USD shading networks.",
     no_args_is_help=True,
 )
-
-
-class IBLNotFoundError(LookdevError):
-    """The environment light named for an export does not exist."""
-
-
-def _environment(name_or_path: str | None) -> Path | None:
-    """An IBL name (built-in, via the proof package) or an image file; None = white sky."""
-    if name_or_path is None:
-        return None
-    path = Path(name_or_path).expanduser()
-    if path.suffix.lower() in (".exr", ".hdr") or path.exists():
-        if not path.is_file():
-            raise IBLNotFoundError("no such environment image", where=str(path))
-        return path.resolve()
-    try:
-        from lookdev.pipeline.proof import ibl
-    except ImportError:
-        raise IBLNotFoundError(
-            "not an .exr/.hdr file, and built-in IBLs are not available", where=name_or_path
-        ) from None
-    return Path(ibl.resolve(name_or_path))
 
 
 @app.command("mitsuba")
@@ -90,36 +66,20 @@ def mitsuba(
 
       lookdev export mitsuba rusty_iron -o rust/scene.xml --ibl studio --spp 64
     """
-    from lookdev.library import Library, load_material
-    from lookdev.pipeline.blend import blend
-    from lookdev.pipeline.export.mitsuba import MitsubaExportError, export_scene
-    from lookdev.pipeline.export.mitsuba.scene import files_of, uses_our_plugins
+    from lookdev.pipeline import api
 
-    if min(resolution) < 1:
-        raise MitsubaExportError(
-            f"{resolution[0]} {resolution[1]}: width and height must be at least 1",
-            field="--resolution",
-        )
-    material = load_material(preset, Library(library or None))
-    env = _environment(environment)
-    with console.status(f"exporting {material.name}…", spinner="dots"):
-        scene = export_scene(
-            blend(material, map_resolution),
+    with console.status(f"exporting {preset}…", spinner="dots"):
+        result = api.export_mitsuba(
+            preset,
             output,
+            ibl=environment,
             resolution=resolution,
             spp=spp,
-            environment=env,
+            map_resolution=map_resolution,
             force_all_lobes=force_all_lobes,
+            library=library,
         )
-    bsdf = scene["ball"]["bsdf"]
-    summary = {
-        "preset": material.name,
-        "scene": str(output),
-        "bsdf": bsdf["bsdf"]["type"] if bsdf["type"] == "normalmap" else bsdf["type"],
-        "plugins": uses_our_plugins(scene),
-        "max_depth": scene["integrator"]["max_depth"],
-        "textures": [f for f in files_of(scene) if f != str(env)],
-    }
+    summary = result.to_json()
     if as_json:
         print_json(summary)
         return

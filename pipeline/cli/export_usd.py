@@ -2,8 +2,7 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
+from contextlib import contextmanager
 from enum import StrEnum
 from pathlib import Path
 from typing import Annotated
@@ -96,66 +95,53 @@ def export_usd(
 
       lookdev export usd rusty_iron -o rust.usdz --package
     """
-    from lookdev.library import Library, load_material
-    from lookdev.pipeline.blend import blend
-    from lookdev.pipeline.export.usd.network import CONTEXTS, ExportError
-    from lookdev.pipeline.export.usd.sources import source_for
-    from lookdev.pipeline.export.usd.writer import export_usd as write
+    from lookdev.pipeline import api
 
-    lib = Library(library or None)
-    names = list(dict.fromkeys(presets or []))  # a preset named twice is exported once
-    if all_presets:
-        names += [n for n in lib.names() if n not in names]
-    if not names:
-        raise ExportError("name at least one preset, or give --all", field="PRESETS")
-    contexts = tuple(c.value for c in context) if context else CONTEXTS
-    out = output.expanduser()
-    package = package or out.suffix == ".usdz"
-    with tempfile.TemporaryDirectory(prefix=".lookdev-bake-", dir=_existing(out)) as scratch:
-        textures = f"{out.stem}_textures"
-        texture_dir = Path(scratch, textures) if package else out.parent / textures
-        sources = []
-        for name in _progress(names, "reading presets", as_json):
-            hub = blend(load_material(name, lib), resolution)
-            sources.append(source_for(hub, texture_dir, scratch=Path(scratch), bake=bake_maps))
-        result = write(
-            sources,
-            out,
-            contexts=contexts,
-            mtlx_path=mtlx_file,
+    with _progress("reading presets", quiet=as_json) as progress:
+        result = api.export_usd(
+            presets or [],
+            output,
+            tuple(c.value for c in context) if context else api.USD_CONTEXTS,
+            mtlx=mtlx_file,
+            bake=bake_maps,
+            map_resolution=resolution,
             package=package,
-            split_dir=split,
-            workdir=Path(scratch),
+            split=split,
+            all_presets=all_presets,
+            library=library,
+            progress=progress,
         )
-    summary = {
-        "output": str(result.files[0]),
-        "files": [str(p) for p in result.files],
-        "materials": result.materials,
-        "contexts": list(contexts),
-        "textures": [str(p) for p in result.images],
-    }
     if as_json:
-        print_json(summary)
+        print_json(result.to_json())
         return
     console.print(
-        f"wrote [bold]{result.files[0]}[/]: {len(result.materials)} materials, "
-        f"contexts {', '.join(contexts)}, {len(result.images)} textures"
+        f"wrote [bold]{result.output}[/]: {len(result.materials)} materials, "
+        f"contexts {', '.join(result.contexts)}, {len(result.textures)} textures"
     )
     for extra in result.files[1:]:
         console.print(f"  {extra}", highlight=False)
 
 
-def _existing(out: Path) -> str:
-    """The output's folder if it exists (scratch space beside it), else the system temp."""
-    return str(out.parent) if out.parent.is_dir() and os.access(out.parent, os.W_OK) else None
+@contextmanager
+def _progress(label: str, quiet: bool):
+    """A transient bar once there are 8 or more presets to read; None when quiet."""
+    if quiet:
+        yield None
+        return
+    from rich.progress import Progress
 
+    with Progress(console=console, transient=True) as bar:
+        task = None
 
-def _progress(items: list[str], label: str, quiet: bool):
-    if quiet or len(items) < 8:
-        return items
-    from rich.progress import track
+        def advance(done: int, total: int, name: str) -> None:
+            nonlocal task
+            if total < 8:
+                return
+            if task is None:
+                task = bar.add_task(label, total=total)
+            bar.update(task, completed=done)
 
-    return track(items, description=label, console=console, transient=True)
+        yield advance
 
 
 @import_app.command("usd")

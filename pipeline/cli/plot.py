@@ -10,8 +10,6 @@ import typer
 
 from .common import console, print_json
 
-FORMATS = (".png", ".pdf", ".svg")
-
 
 class View(StrEnum):
     slice = "slice"
@@ -74,36 +72,19 @@ def plot(
 
       lookdev plot velvet --view sphere --ibl studio -o velvet.png --exposure -1
     """
-    # Imported here: matplotlib should not slow down every other command.
-    from lookdev.pipeline.analysis import plots
-    from lookdev.pipeline.analysis.plots import PlotError
+    from lookdev.pipeline import api
 
-    if output.suffix.lower() not in FORMATS:
-        raise PlotError(
-            f"cannot write {output.suffix or 'no extension'}; allowed {', '.join(FORMATS)}",
-            where=str(output),
-        )
-    from lookdev.library import Library, load_material
-    from lookdev.pipeline.blend import blend
-
-    lib = Library(library)
-    hubs = [blend(load_material(name, lib), plots.MAP_RESOLUTION) for name in presets]
-    environment = None
-    if ibl is not None:
-        if view is not View.sphere:
-            raise PlotError("--ibl only applies to --view sphere", field="--ibl")
-        environment = plots.load_environment(ibl)
-    with console.status(f"plotting {view.value} of {len(hubs)} material(s)"):
-        fig = plots.figure(
-            hubs,
-            view.value,
+    with console.status(f"plotting {view.value} of {len(presets)} material(s)"):
+        result = api.plot(
+            presets,
+            output,
+            view=view.value,
             exposure=exposure,
-            environment=environment,
-            ibl_name=ibl or "",
+            ibl=ibl,
             resolution=resolution,
+            library=library,
         )
-        plots.save_figure(fig, output)
     if as_json:
-        print_json({"output": str(output), "view": view.value, "materials": [h.name for h in hubs]})
+        print_json(result.to_json())
     else:
         console.print(f"wrote {output}")

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-import time
+from contextlib import ExitStack
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
 import typer
 from rich.progress import (
@@ -16,25 +16,9 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
+from lookdev.pipeline.api import REPRESENTATIVE, representative_presets  # noqa: F401 (moved)
+
 from .common import console, err_console, print_json, table
-
-REPRESENTATIVE = (
-    "gold",
-    "plastic_glossy",
-    "velvet",
-    "glass_clear",
-    "rusty_car_paint",
-    "pixar_paint_red",
-)
-"""The default subjects: a metal, a glossy plastic, cloth, glass, a layered material and a
-Pixar lobe-weight material."""
-
-
-def representative_presets(library: Any) -> list[str]:
-    """:data:`REPRESENTATIVE` as far as the library has them; else its first four."""
-    names = library.names()
-    chosen = [n for n in REPRESENTATIVE if n in names]
-    return chosen or names[:4]
 
 
 def proof(
@@ -130,48 +114,41 @@ def proof(
 
       lookdev proof copper --spp 256 --resolution 640 320 --scheduler tcp://farm:8786
     """
-    from lookdev.library import Library, load_material
-    from lookdev.pipeline.blend import blend
-    from lookdev.pipeline.proof import batch, ibl
+    from lookdev.pipeline import api
+    from lookdev.pipeline.proof import batch
 
-    lib = Library(library or None)
-    names = list(dict.fromkeys(presets or representative_presets(lib)))
-    materials = [blend(load_material(name, lib), batch.MAP_RESOLUTION) for name in names]
-    ibl_names = list(dict.fromkeys(ibls or ibl.builtin_names()))
-    environments = [ibl.load(name, ibl_width) for name in ibl_names]
-    if resolution[0] < 8 or resolution[1] < 8:
-        raise batch.ProofError(f"resolution {resolution} is below 8×8", field="--resolution")
-    batch.check_writable(output)
-    settings = batch.Settings(frames, light_frames, spp, tuple(resolution), exposure)
-    jobs = batch.make_jobs(materials, environments, output, settings)
+    with ExitStack() as stack:
+        bar, task = None, None
 
-    start = time.perf_counter()
-    per_job = frames + light_frames
-    with _progress() as bar, batch.executor_for(scheduler, workers) as executor:
-        task = bar.add_task("proofs", total=len(jobs) * per_job)
-        finished = 0
+        def show(p: batch.Progress) -> None:
+            nonlocal bar, task
+            if bar is None:  # once the batch runs: loading errors stay one line
+                bar = stack.enter_context(_progress())
+                task = bar.add_task("proofs", total=p.frames_total)
+            if p.finished is not None:
+                bar.console.print(
+                    f"  {p.finished['material']} × {p.finished['ibl']}: "
+                    f"{p.finished['rendered']} rendered, {p.finished['skipped']} already done",
+                    highlight=False,
+                )
+            bar.update(task, completed=p.frames_done, total=p.frames_total)
 
-        def done(job: batch.Job, doc: dict[str, Any]) -> None:
-            nonlocal finished
-            finished += 1
-            bar.console.print(
-                f"  {job.material.name} × {job.ibl}: {doc['rendered']} rendered, "
-                f"{doc['skipped']} already done",
-                highlight=False,
-            )
-
-        def tick(running: list[batch.Job]) -> None:
-            partial = sum(batch.frames_done(job) for job in running)
-            bar.update(task, completed=finished * per_job + partial)
-
-        in_flight = None if scheduler else workers or batch.default_workers()
-        results = batch.run_batch(jobs, executor, done, in_flight, tick)
-        bar.update(task, completed=len(jobs) * per_job)
-    doc = batch.summary(output, jobs, results, time.perf_counter() - start)
-    if report:
-        from lookdev.pipeline.analysis.report import write_report
-
-        doc["report"] = str(write_report(output, materials={m.name: m for m in materials}))
+        doc = api.proof(
+            presets,
+            ibls,
+            output,
+            frames=frames,
+            light_frames=light_frames,
+            spp=spp,
+            resolution=resolution,
+            exposure=exposure,
+            ibl_width=ibl_width,
+            jobs=workers,
+            scheduler=scheduler,
+            report=report,
+            library=library,
+            progress=show,
+        )
     if as_json:
         print_json(doc)
         return

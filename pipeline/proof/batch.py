@@ -27,6 +27,7 @@ import itertools
 import json
 import multiprocessing
 import os
+import time
 import traceback
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Executor, Future, ProcessPoolExecutor, wait
@@ -346,6 +347,70 @@ def _result(fut: Future, job: Job) -> dict[str, Any]:
             f"rendering failed ({type(exc).__name__}: {first}); traceback in {log}",
             where=f"{job.material.name} × {job.ibl}",
         ) from None
+
+
+@dataclass(frozen=True)
+class Progress:
+    """Where a batch is, for a progress bar: reported about twice a second and as each
+    proof finishes (``finished``: that proof's manifest, with ``rendered`` and
+    ``skipped`` frame counts)."""
+
+    frames_done: int
+    frames_total: int
+    finished: dict[str, Any] | None = None
+
+
+def proof(
+    materials: list[Any],
+    environments: list[Any],
+    out: Path,
+    settings: Settings,
+    *,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    executor: Executor | None = None,
+    progress: Callable[[Progress], None] | None = None,
+) -> dict[str, Any]:
+    """Proof every material under every environment into ``out``; the batch manifest.
+
+    Runs on ``executor`` when given, else on the Dask cluster at ``scheduler``, else on a
+    local pool of ``workers`` processes (:func:`executor_for`). Frames the manifests in
+    ``out`` vouch for are kept, so a second call resumes an interrupted batch.
+    """
+    check_writable(out)
+    jobs = make_jobs(materials, environments, out, settings)
+    start = time.perf_counter()
+    per_job = settings.element_frames + settings.light_frames
+    total = len(jobs) * per_job
+    finished = 0
+    shown = -1
+
+    def report(frames: int, doc: dict[str, Any] | None = None) -> None:
+        nonlocal shown
+        frames = max(shown, frames)  # a finished job's count replaces its partial one
+        if progress is not None and (doc is not None or frames != shown):
+            progress(Progress(frames, total, doc))
+        shown = frames
+
+    def done(job: Job, doc: dict[str, Any]) -> None:
+        nonlocal finished
+        finished += 1
+        report(finished * per_job, doc)
+
+    def tick(running: list[Job]) -> None:
+        report(finished * per_job + sum(frames_done(job) for job in running))
+
+    own = executor is None
+    with executor_for(scheduler, workers) if own else _given(executor) as pool:
+        in_flight = (workers or default_workers()) if own and not scheduler else None
+        results = run_batch(jobs, pool, done, in_flight, tick)
+        report(total)
+    return summary(out, jobs, results, time.perf_counter() - start)
+
+
+@contextmanager
+def _given(executor: Executor) -> Iterator[Executor]:
+    yield executor  # the caller's: not shut down here
 
 
 def summary(out: Path, jobs: list[Job], results: list[dict[str, Any]], seconds: float) -> dict:

@@ -1,1 +1,71 @@
-"""USD export (usd-core, UsdShade) and import."""
+"""USD export (usd-core, UsdShade) and import.
+
+:func:`export_materials` is the whole export of blended materials (what ``lookdev
+export usd`` and :func:`lookdev.export_usd` run); the modules beside this one build the
+networks (:mod:`.network`, one module per render context) and author them (:mod:`.writer`).
+Importing this package does not import ``pxr``: :func:`export_materials` does.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Callable, Iterable, Sequence
+from pathlib import Path
+from typing import Any
+
+__all__ = ["export_materials"]
+
+
+def export_materials(
+    materials: Iterable[Any],
+    out: str | Path,
+    *,
+    count: int | None = None,
+    contexts: Sequence[str] | None = None,
+    mtlx: str | Path | None = None,
+    bake: bool = False,
+    package: bool = False,
+    split: str | Path | None = None,
+    progress: Callable[[int, int, str], None] | None = None,
+):
+    """Write blended materials (:class:`~lookdev.pipeline.blend.BlendedMaterial`) as
+    UsdShade materials to ``out``.
+
+    ``materials`` may be a generator that blends each on demand (``count`` says how many,
+    for ``progress``), so only one material's maps are held at a time. Returns the
+    writer's :class:`.writer.ExportResult`: the files written, the material names, the
+    textures referenced and the loss notes per material and context.
+    ``progress(done, total, name)`` is called after each material's network source is
+    made (varying parameters are baked then). Maps are baked into a scratch folder beside
+    ``out`` and only copied into place when every file could be written.
+    """
+    from .network import CONTEXTS
+    from .sources import source_for
+    from .writer import export_usd as write
+
+    contexts = tuple(contexts) if contexts else CONTEXTS
+    out = Path(out).expanduser()
+    package = package or out.suffix == ".usdz"
+    with tempfile.TemporaryDirectory(prefix=".lookdev-bake-", dir=_existing(out)) as scratch:
+        textures = f"{out.stem}_textures"
+        texture_dir = Path(scratch, textures) if package else out.parent / textures
+        sources = []
+        for material in materials:
+            sources.append(source_for(material, texture_dir, scratch=Path(scratch), bake=bake))
+            if progress is not None:
+                progress(len(sources), count or len(sources), material.name)
+        return write(
+            sources,
+            out,
+            contexts=contexts,
+            mtlx_path=None if mtlx is None else Path(mtlx),
+            package=package,
+            split_dir=None if split is None else Path(split),
+            workdir=Path(scratch),
+        )
+
+
+def _existing(out: Path) -> str | None:
+    """The output's folder if it exists (scratch space beside it), else the system temp."""
+    return str(out.parent) if out.parent.is_dir() and os.access(out.parent, os.W_OK) else None

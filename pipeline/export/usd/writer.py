@@ -244,11 +244,24 @@ def check_images(images: list[Image]) -> None:
 
 @dataclass
 class ExportResult:
-    """What an export wrote: files in place, materials, images referenced."""
+    """What an export wrote: files in place, materials, images referenced, and per
+    material and render context what its surface could not express (``""``: nothing)."""
 
     files: list[Path]
     materials: list[str]
     images: list[Path]
+    losses: dict[str, dict[str, str]] = field(default_factory=dict)
+
+
+def losses_of(specs: list[MaterialSpec]) -> dict[str, dict[str, str]]:
+    """``{material: {context: note}}``: the loss notes the networks carry in customData."""
+    return {
+        spec.name: {
+            net.context: "; ".join(n.custom["loss"] for n in net.nodes if n.custom.get("loss"))
+            for net in spec.networks
+        }
+        for spec in specs
+    }
 
 
 def export_usd(
@@ -299,7 +312,7 @@ def export_usd(
     except BaseException:
         staging.abort()
         raise
-    return ExportResult(files, [s.name for s in specs], [i.path for i in images])
+    return ExportResult(files, [s.name for s in specs], [i.path for i in images], losses_of(specs))
 
 
 def _check_names(specs: list[MaterialSpec], out: Path) -> None:

@@ -1,0 +1,893 @@
+"""The Python API of lookdev: what ``import lookdev`` gives, and what the CLI calls.
+
+Each function here is one thing a command does, without the command: a TD in a notebook
+or in a DCC's Python loads, blends, evaluates, exports and proofs materials with it, and
+every ``lookdev`` command only parses its options, calls one of these and prints the
+result. Bad input raises the :class:`LookdevError` family, with the one-line message the
+CLI prints.
+
+=====================  ==========================================================
+:func:`load`           a preset (name or ``.toml`` file) resolved into a material
+:func:`blend`          a layered material blended into constants and maps
+:func:`bake`           a blend's varying maps written as EXR (and a JSON sidecar)
+:func:`evaluate`       f(wi, wo) without the cosine, numpy ``(..., 3)``
+:func:`sample`         ``(wi, weight, pdf)`` drawn for ``wo`` and uniforms ``u``
+:func:`pdf`            the density with which :func:`sample` draws ``wi``
+:func:`export_usd`     UsdShade materials, and what each render context lost
+:func:`export_mitsuba` a Mitsuba 3 scene of one material
+:func:`proof`          turntable proofs, materials × IBLs, resumable; the manifest
+:func:`plot`           BRDF-explorer views of materials, side by side
+:func:`check`          the stability sweep of every reflectance model
+:data:`models`         the reflectance models by name
+=====================  ==========================================================
+
+Materials are accepted in any form a step can use: a preset name or ``.toml`` path
+(loaded through ``library``), a :class:`~lookdev.library.Material`, or where it makes
+sense a :class:`~lookdev.pipeline.blend.BlendedMaterial`. ``library`` is a folder, a list
+of folders or a :class:`~lookdev.library.Library`; the folders are searched before
+``$LOOKDEV_LIBRARY_PATH`` and the built-in presets, as ``--library`` is by the CLI.
+
+>>> import lookdev
+>>> gold = lookdev.load("gold")
+>>> lookdev.evaluate(gold, [0.0, 0.0, 1.0], [0.0, 0.0, 1.0]).shape
+(3,)
+
+Heavy dependencies (Mitsuba, usd-core, matplotlib) are imported by the functions that
+need them, never by ``import lookdev``.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from concurrent.futures import Executor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from lookdev.materials.errors import LookdevError
+
+if TYPE_CHECKING:
+    from lookdev.library import Library, Material
+    from lookdev.materials.bsdf import Model
+    from lookdev.pipeline.blend import BlendedMaterial
+
+__all__ = [
+    "EVALUATE_RESOLUTION",
+    "REPRESENTATIVE",
+    "LookdevError",
+    "MaterialError",
+    "MitsubaExport",
+    "Plot",
+    "Stability",
+    "USD_CONTEXTS",
+    "UsdExport",
+    "bake",
+    "blend",
+    "check",
+    "evaluate",
+    "export_mitsuba",
+    "export_usd",
+    "hub",
+    "library_for",
+    "load",
+    "models",
+    "pdf",
+    "plot",
+    "proof",
+    "representative_presets",
+    "sample",
+]
+
+PathLike = str | os.PathLike
+
+
+class MaterialError(LookdevError):
+    """A material cannot be used the way a call asks (wrong kind, missing ``uv`` …)."""
+
+
+# -- the model registry ----------------------------------------------------------------------
+class _Models(Mapping):
+    """The model registry (:data:`lookdev.materials.registry.MODELS`) as a read-only
+    mapping name → :class:`lookdev.materials.bsdf.Model`, imported on first use so that
+    ``import lookdev`` stays light.
+
+    >>> import lookdev
+    >>> "disney" in lookdev.models, [lobe.name for lobe in lookdev.models["pixar"].lobes][:2]
+    (True, ['diffuse', 'specular'])
+    """
+
+    def _table(self) -> Mapping[str, Model]:
+        from lookdev.materials.registry import MODELS
+
+        return MODELS
+
+    def __getitem__(self, name: str) -> Model:
+        return self._table()[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._table())
+
+    def __len__(self) -> int:
+        return len(self._table())
+
+    def __repr__(self) -> str:
+        return f"<lookdev models: {', '.join(self)}>"
+
+
+models: Mapping[str, Model] = _Models()
+"""The reflectance models by name (``disney``, ``sheen``, ``pixar``, ``pixar_layered``)."""
+
+
+# -- presets -----------------------------------------------------------------------------------
+def library_for(library: Any = None) -> Library:
+    """A :class:`~lookdev.library.Library` searching ``library`` first.
+
+    ``library`` is None, a folder, a list of folders, or a ``Library`` (returned as is).
+    """
+    from lookdev.library import Library
+
+    if isinstance(library, Library):
+        return library
+    if library is None:
+        folders = None
+    elif isinstance(library, str | os.PathLike):
+        folders = [library]
+    else:
+        folders = list(library)
+    return Library(folders or None)
+
+
+def load(name_or_path: PathLike, library: Any = None) -> Material:
+    """Load a preset: a name looked up on the library path, or a ``.toml`` file.
+
+    Parameters
+    ----------
+    name_or_path
+        A preset name (``"gold"``), or the path of a preset file (a ``Path``, or a string
+        ending in ``.toml`` or containing a ``/``).
+    library
+        Folders searched before ``$LOOKDEV_LIBRARY_PATH`` and the built-in presets: a
+        folder, a list of folders, or a :class:`~lookdev.library.Library`.
+
+    Returns
+    -------
+    lookdev.library.Material
+        The resolved material (``extends`` followed, layers loaded, values validated).
+
+    Examples
+    --------
+    >>> import lookdev
+    >>> lookdev.load("gold").params.metallic
+    1.0
+    """
+    from lookdev.library import load_material
+
+    return load_material(name_or_path, library_for(library))
+
+
+def _material(material: Any, library: Any = None) -> Any:
+    """``material`` itself unless it names a preset, which is then loaded."""
+    if isinstance(material, str | os.PathLike):
+        return load(material, library)
+    return material
+
+
+def _materials(materials: Any, library: Any) -> list[Any]:
+    """One material or several, each loaded if named; a name given twice counts once."""
+    if isinstance(materials, str | os.PathLike) or hasattr(materials, "model"):
+        materials = [materials]
+    out, seen = [], set()
+    for m in materials:
+        key = os.fspath(m) if isinstance(m, str | os.PathLike) else id(m)
+        if key not in seen:
+            seen.add(key)
+            out.append(_material(m, library))
+    return out
+
+
+# -- blending ----------------------------------------------------------------------------------
+def blend(
+    material: Any,
+    resolution: int | tuple[int, int] = 1024,
+    *,
+    layering: str = "full",
+    prune: bool = True,
+    progress: Callable[[int, int], None] | None = None,
+    library: Any = None,
+) -> BlendedMaterial:
+    """Blend a material's layers into constants (where uniform) and maps (where not).
+
+    Parameters
+    ----------
+    material
+        A preset name or path, or a :class:`~lookdev.library.Material`.
+    resolution
+        Texels a side, or ``(width, height)``.
+    layering
+        Pixar stacks: ``"full"`` (light through a layer meets the ones below, Smits'
+        table) or ``"simple"`` (A over B).
+    prune
+        False turns off every saving (all layers, all parameters as maps).
+    progress
+        Called as ``progress(rows_done, rows_total)`` after each tile.
+    library
+        See :func:`load`.
+
+    Returns
+    -------
+    lookdev.pipeline.blend.BlendedMaterial
+        ``maps[name][row, col]`` is the texel centred on ``((col + ½)/W, (row + ½)/H)``;
+        ``params_at(row, col)`` the parameters there. A layered Pixar material blends to
+        Smits' lobe weights (``representation == "lobe_weights"``).
+
+    Examples
+    --------
+    >>> import lookdev
+    >>> b = lookdev.blend("rusty_iron", 16)
+    >>> b.resolution, sorted(b.maps)[:2]
+    ((16, 16), ['base_color', 'metallic'])
+    """
+    from lookdev.pipeline.blend import blend as blend_material
+
+    return blend_material(
+        _material(material, library), resolution, progress=progress, prune=prune, layering=layering
+    )
+
+
+def bake(
+    blended: BlendedMaterial,
+    folder: PathLike,
+    *,
+    progress: Callable[[int, int], None] | None = None,
+) -> dict[str, Path]:
+    """Write a blend's maps as EXR (``NAME_<param>.exr``) and the rest as ``NAME.json``.
+
+    Returns the files by parameter name, and the JSON under ``"sidecar"``. Files are
+    written top row = v 1, so UV (0, 0) is the bottom-left texel as a viewer shows it.
+    """
+    from lookdev.pipeline.blend import bake as bake_maps
+
+    return bake_maps(blended, Path(folder), progress=progress)
+
+
+# -- the BSDF ----------------------------------------------------------------------------------
+EVALUATE_RESOLUTION = 512
+"""Texels a side at which :func:`evaluate` and friends blend a layered material they are
+given unblended; blend it once with :func:`blend` to choose, and to save the time."""
+
+
+def hub(material: Any, resolution: int = EVALUATE_RESOLUTION, library: Any = None):
+    """``material`` as the blended material every consumer takes: a blend or a model's
+    parameters as they are, a preset (name, path or Material) blended at ``resolution``."""
+    from lookdev.materials.params import Params
+    from lookdev.pipeline.blend import BlendedMaterial
+
+    material = _material(material, library)
+    if isinstance(material, BlendedMaterial | Params):
+        from lookdev.pipeline.blend.result import as_hub
+
+        return as_hub(material)
+    if not hasattr(material, "layers"):
+        raise MaterialError(
+            f"cannot use a {type(material).__name__}; give a preset name, a "
+            "Material, a blended material or a model's parameters"
+        )
+    return blend(material, resolution)
+
+
+def _bsdf(material: Any, uv: Any, lead: tuple[int, ...]) -> tuple[Model, Any, dict[str, Any]]:
+    """(model, parameters, per-element maps) for evaluating ``material`` at ``uv``."""
+    blended = hub(material)
+    model = blended.bsdf_model
+    if blended.maps and uv is None:
+        raise MaterialError(
+            f"parameters vary across the surface ({', '.join(sorted(blended.maps))}); "
+            "pass uv= to say where to evaluate",
+            where=blended.name,
+        )
+    if uv is None:
+        return model, blended.params, {}
+    rows, cols = _texels(blended, uv, lead)
+    maps = {k: np.asarray(a)[rows, cols] for k, a in blended.maps.items()}
+    return model, blended.params, maps
+
+
+def _texels(blended: Any, uv: Any, lead: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """Row and column of the texel under each ``uv`` (nearest texel, repeating)."""
+    uv = np.broadcast_to(np.asarray(uv, dtype=np.float64), (*lead, 2))
+    if not np.isfinite(uv).all():
+        raise MaterialError("uv holds NaN or infinite values", where=blended.name, field="uv")
+    width, height = blended.resolution
+    cols = np.floor(uv[..., 0] * width).astype(np.intp) % width
+    rows = np.floor(uv[..., 1] * height).astype(np.intp) % height
+    return rows, cols
+
+
+def _lead(uv: Any, **vectors: Any) -> tuple[int, ...]:
+    """The broadcast leading shape of direction arrays (…, 3) and ``uv`` (…, 2)."""
+    shapes = []
+    for name, v in vectors.items():
+        shape = np.shape(v)
+        if not shape or shape[-1] != 3:
+            raise MaterialError(f"expected shape (..., 3), got {shape}", field=name)
+        shapes.append(shape[:-1])
+    if uv is not None:
+        shape = np.shape(uv)
+        if not shape or shape[-1] != 2:
+            raise MaterialError(f"expected shape (..., 2), got {shape}", field="uv")
+        shapes.append(shape[:-1])
+    try:
+        return np.broadcast_shapes(*shapes)
+    except ValueError:
+        raise MaterialError(
+            "shapes do not broadcast: "
+            + ", ".join(f"{k} {np.shape(v)}" for k, v in vectors.items())
+            + ("" if uv is None else f", uv {np.shape(uv)}")
+        ) from None
+
+
+def _full(v: Any, lead: tuple[int, ...], dtype: Any) -> np.ndarray:
+    return np.broadcast_to(np.asarray(v, dtype=dtype), (*lead, 3))
+
+
+def evaluate(
+    material: Any, wi: Any, wo: Any, uv: Any = None, *, dtype: Any = np.float64
+) -> np.ndarray:
+    """f(wi, wo) without the cosine, in the local shading frame (normal +z).
+
+    Parameters
+    ----------
+    material
+        A preset name or path, a :class:`~lookdev.library.Material`, a blended material
+        (:func:`blend`), or a model's parameters (``DisneyParams``, …). A layered
+        material given unblended is blended at :data:`EVALUATE_RESOLUTION`.
+    wi, wo
+        Unit directions ``(..., 3)`` towards the light and the viewer, both pointing away
+        from the surface; they broadcast against each other and ``uv``.
+    uv
+        ``(..., 2)`` texture coordinates of a blend whose parameters vary: each element
+        takes the parameters of the texel under it (nearest, repeating), the values
+        ``params_at(row, col)`` gives. Normal maps are not applied: the directions are
+        already in the shading frame.
+    dtype
+        ``np.float64`` (default) or ``np.float32``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(..., 3)``: RGB, per steradian.
+
+    Examples
+    --------
+    >>> import numpy as np, lookdev
+    >>> n = np.array([0.0, 0.0, 1.0])
+    >>> lookdev.evaluate("plastic_glossy", [n, n], n).shape
+    (2, 3)
+    """
+    from lookdev.materials.bsdf import evaluate as core
+
+    lead = _lead(uv, wi=wi, wo=wo)
+    model, params, maps = _bsdf(material, uv, lead)
+    return core(model, params, _full(wi, lead, dtype), _full(wo, lead, dtype), dtype=dtype, **maps)
+
+
+def pdf(material: Any, wi: Any, wo: Any, uv: Any = None, *, dtype: Any = np.float64) -> np.ndarray:
+    """The solid-angle density with which :func:`sample` draws ``wi`` given ``wo``.
+
+    Arguments as :func:`evaluate`; returns shape ``(...)``.
+
+    >>> import lookdev
+    >>> float(lookdev.pdf("gold", [0, 0, 1.0], [0, 0, 1.0])) > 0
+    True
+    """
+    from lookdev.materials.bsdf import density
+
+    lead = _lead(uv, wi=wi, wo=wo)
+    model, params, maps = _bsdf(material, uv, lead)
+    return density(
+        model, params, _full(wi, lead, dtype), _full(wo, lead, dtype), dtype=dtype, **maps
+    )
+
+
+def sample(
+    material: Any, wo: Any, u: Any, uv: Any = None, *, dtype: Any = np.float64
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Draw a light direction for the view ``wo``: ``(wi, weight, pdf)``.
+
+    ``u`` holds three uniforms in [0, 1) per element, ``(..., 3)``: the first picks the
+    lobe, the other two the direction. ``weight`` is ``f · |cos θi| / pdf`` ``(..., 3)``;
+    a failed sample has ``pdf`` 0 and ``weight`` 0. Other arguments as :func:`evaluate`.
+
+    >>> import numpy as np, lookdev
+    >>> wi, weight, p = lookdev.sample("gold", [0, 0, 1.0], np.full((5, 3), 0.5))
+    >>> wi.shape, weight.shape, p.shape
+    ((5, 3), (5, 3), (5,))
+    """
+    from lookdev.materials.bsdf import draw
+
+    lead = _lead(uv, wo=wo, u=u)
+    model, params, maps = _bsdf(material, uv, lead)
+    return draw(model, params, _full(wo, lead, dtype), _full(u, lead, dtype), dtype=dtype, **maps)
+
+
+# -- USD -----------------------------------------------------------------------------------------
+USD_CONTEXTS = ("universal", "mtlx", "ri")
+"""The render contexts :func:`export_usd` writes: UsdPreviewSurface, MaterialX, RenderMan."""
+
+
+@dataclass
+class UsdExport:
+    """What :func:`export_usd` wrote.
+
+    ``losses[material][context]`` is the sentence the surface of that render context
+    carries in its ``customData`` (``lookdev:loss``): the live parameters it cannot
+    express; ``""`` when it expresses everything.
+    """
+
+    output: Path
+    files: list[Path]
+    materials: list[str]
+    contexts: tuple[str, ...]
+    textures: list[Path]
+    losses: dict[str, dict[str, str]] = field(default_factory=dict)
+
+    def to_json(self) -> dict[str, Any]:
+        """The summary ``lookdev export usd --json`` prints."""
+        return {
+            "output": str(self.output),
+            "files": [str(p) for p in self.files],
+            "materials": self.materials,
+            "contexts": list(self.contexts),
+            "textures": [str(p) for p in self.textures],
+        }
+
+
+def export_usd(
+    materials: Any,
+    path: PathLike,
+    contexts: Sequence[str] = USD_CONTEXTS,
+    *,
+    mtlx: PathLike | None = None,
+    bake: bool = False,
+    map_resolution: int = 1024,
+    package: bool = False,
+    split: PathLike | None = None,
+    all_presets: bool = False,
+    library: Any = None,
+    progress: Callable[[int, int, str], None] | None = None,
+) -> UsdExport:
+    """Write materials as UsdShade materials under ``/Materials`` of ``path``.
+
+    Parameters
+    ----------
+    materials
+        One or several preset names, paths or :class:`~lookdev.library.Material` s;
+        several make a library whose ``/Look`` prim switches between them.
+    path
+        ``.usda``, ``.usdc``, ``.usd``, or ``.usdz`` (packaged with its textures).
+    contexts
+        Render contexts to write: ``universal`` (UsdPreviewSurface), ``mtlx``
+        (MaterialX), ``ri`` (RenderMan).
+    mtlx
+        Also write the MaterialX networks to this standalone ``.mtlx``.
+    bake
+        Layered materials: bake blended parameter maps for every context (by default
+        the MaterialX context mixes the layers live).
+    map_resolution
+        Texels a side of baked maps.
+    package
+        Write a ``.usdz`` holding the stage and its textures.
+    split
+        One file per material in this folder; ``path`` becomes a library referencing them.
+    all_presets
+        Also export every other preset of the library.
+    library
+        See :func:`load`.
+    progress
+        Called as ``progress(done, total, name)`` as each material is prepared.
+
+    Returns
+    -------
+    UsdExport
+        The files written, and per material and context what was lost.
+
+    Raises
+    ------
+    LookdevError
+        Nothing named, an unknown preset, an unwritable path …; nothing is left behind.
+    """
+    from lookdev.pipeline.export.usd import export_materials
+    from lookdev.pipeline.export.usd.network import CONTEXTS, ExportError
+
+    contexts = (contexts,) if isinstance(contexts, str) else tuple(contexts) or USD_CONTEXTS
+    for context in contexts:
+        if context not in CONTEXTS:
+            raise ExportError(
+                f"unknown render context {context!r}; allowed: {', '.join(CONTEXTS)}",
+                field="--context",
+            )
+    if isinstance(materials, str | os.PathLike) or hasattr(materials, "model"):
+        materials = [materials]
+    given = list(materials or [])
+    lib = library_for(library)
+    if all_presets:
+        names = {m for m in given if isinstance(m, str)}
+        given += [n for n in lib.names() if n not in names]
+    if not given:
+        raise ExportError("name at least one preset, or give --all", field="PRESETS")
+    loaded = _materials(given, lib)
+    result = export_materials(
+        (hub(m, map_resolution) for m in loaded),
+        path,
+        count=len(loaded),
+        contexts=contexts,
+        mtlx=mtlx,
+        bake=bake,
+        package=package,
+        split=split,
+        progress=progress,
+    )
+    return UsdExport(
+        result.files[0],
+        result.files,
+        result.materials,
+        contexts,
+        result.images,
+        result.losses,
+    )
+
+
+# -- Mitsuba -------------------------------------------------------------------------------------
+@dataclass
+class MitsubaExport:
+    """What :func:`export_mitsuba` wrote: the scene and what it holds."""
+
+    scene: Path
+    preset: str
+    bsdf: str
+    plugins: bool
+    """True when the scene uses lookdev's BSDF plugins (register them before loading)."""
+    max_depth: int
+    textures: list[str]
+
+    def to_json(self) -> dict[str, Any]:
+        """The summary ``lookdev export mitsuba --json`` prints."""
+        return {
+            "preset": self.preset,
+            "scene": str(self.scene),
+            "bsdf": self.bsdf,
+            "plugins": self.plugins,
+            "max_depth": self.max_depth,
+            "textures": self.textures,
+        }
+
+
+class IBLNotFoundError(LookdevError):
+    """The environment light named for an export does not exist."""
+
+
+def _environment_file(name_or_path: PathLike | None) -> Path | None:
+    """An IBL name (built-in, via the proof package) or an image file; None = white sky."""
+    if name_or_path is None:
+        return None
+    path = Path(name_or_path).expanduser()
+    if path.suffix.lower() in (".exr", ".hdr") or path.exists():
+        if not path.is_file():
+            raise IBLNotFoundError("no such environment image", where=str(path))
+        return path.resolve()
+    from lookdev.pipeline.proof import ibl as ibls
+
+    return Path(ibls.resolve(str(name_or_path)))
+
+
+def export_mitsuba(
+    material: Any,
+    path: PathLike,
+    *,
+    ibl: PathLike | None = None,
+    resolution: tuple[int, int] = (512, 512),
+    spp: int = 128,
+    map_resolution: int = 512,
+    force_all_lobes: bool = False,
+    library: Any = None,
+) -> MitsubaExport:
+    """Write a material as a Mitsuba 3 scene XML: the material on a sphere under a light.
+
+    Parameters
+    ----------
+    material
+        A preset name or path, a :class:`~lookdev.library.Material` or a blend.
+    path
+        The scene XML; maps of layered materials go to ``<stem>_textures/`` beside it.
+    ibl
+        A built-in IBL name (``studio``, ``sky``, ``overcast``, ``sunset``) or an
+        ``.exr``/``.hdr`` file; None: a constant white sky (the white furnace).
+    resolution, spp
+        Film size in pixels and samples per pixel.
+    map_resolution
+        Texels a side at which a layered material is blended.
+    force_all_lobes
+        Trace every lobe, zero weights included (the baseline for measuring pruning).
+    library
+        See :func:`load`.
+
+    Returns
+    -------
+    MitsubaExport
+        If ``plugins`` is true, load the scene after
+        ``lookdev.pipeline.export.mitsuba.register_plugins()``.
+    """
+    from lookdev.pipeline.export.mitsuba import MitsubaExportError, export_scene
+    from lookdev.pipeline.export.mitsuba.scene import files_of, uses_our_plugins
+
+    if min(resolution) < 1:
+        raise MitsubaExportError(
+            f"{resolution[0]} {resolution[1]}: width and height must be at least 1",
+            field="--resolution",
+        )
+    material = hub(material, map_resolution, library)
+    env = _environment_file(ibl)
+    scene = export_scene(
+        material,
+        path,
+        resolution=tuple(resolution),
+        spp=spp,
+        environment=env,
+        force_all_lobes=force_all_lobes,
+    )
+    bsdf = scene["ball"]["bsdf"]
+    return MitsubaExport(
+        Path(path),
+        material.name,
+        bsdf["bsdf"]["type"] if bsdf["type"] == "normalmap" else bsdf["type"],
+        uses_our_plugins(scene),
+        scene["integrator"]["max_depth"],
+        [f for f in files_of(scene) if f != str(env)],
+    )
+
+
+# -- proofs --------------------------------------------------------------------------------------
+REPRESENTATIVE = (
+    "gold",
+    "plastic_glossy",
+    "velvet",
+    "glass_clear",
+    "rusty_car_paint",
+    "pixar_paint_red",
+)
+"""The default subjects of :func:`proof`: a metal, a glossy plastic, cloth, glass, a
+layered material and a Pixar lobe-weight material."""
+
+
+def representative_presets(library: Any) -> list[str]:
+    """:data:`REPRESENTATIVE` as far as the library has them; else its first four."""
+    names = library.names()
+    chosen = [n for n in REPRESENTATIVE if n in names]
+    return chosen or names[:4]
+
+
+def proof(
+    materials: Any = None,
+    ibls: Sequence[PathLike] | PathLike | None = None,
+    out: PathLike = "proofs",
+    *,
+    frames: int = 8,
+    light_frames: int = 8,
+    spp: int = 32,
+    resolution: tuple[int, int] = (192, 96),
+    exposure: float = 0.0,
+    ibl_width: int = 512,
+    jobs: int | None = None,
+    scheduler: str | None = None,
+    executor: Executor | None = None,
+    report: bool = False,
+    library: Any = None,
+    progress: Callable[[Any], None] | None = None,
+) -> dict[str, Any]:
+    """Render turntable proofs (Burley §6.1): every material under every IBL.
+
+    Each proof turns the element through ``frames`` frames, then the lighting through
+    ``light_frames``, and writes under ``out/MATERIAL/IBL/``: EXR frames, view-transformed
+    PNGs, a labelled ``contact.png`` and a ``manifest.json``. Calling again with the same
+    arguments renders only the frames the manifests do not vouch for (size and SHA-256),
+    so an interrupted batch resumes.
+
+    Parameters
+    ----------
+    materials
+        Preset names, paths or Materials; None: :data:`REPRESENTATIVE`.
+    ibls
+        Built-in IBL names or ``.exr``/``.hdr`` files; None: every built-in.
+    out
+        The batch folder (shared with the workers when on a cluster).
+    frames, light_frames, spp, resolution, exposure
+        Element-rotation frames, lighting-rotation frames, samples per pixel, frame size
+        ``(width, height)``, and stops applied by the PNG view transform.
+    ibl_width
+        Every IBL is resampled to this width (× ½ high) so render kernels are reused.
+    jobs
+        Local worker processes (default 1: each renders on every core). They are spawned,
+        so a script calling :func:`proof` does so under ``if __name__ == "__main__":``.
+    scheduler
+        A Dask scheduler address (``tcp://host:8786``): run the proofs on that cluster.
+    executor
+        Any ``concurrent.futures.Executor`` to run the proofs on (it is not shut down).
+    report
+        Also write ``out/index.html``, a static review page.
+    library
+        See :func:`load`.
+    progress
+        Called with a :class:`lookdev.pipeline.proof.batch.Progress` about twice a second
+        and as each proof finishes (``frames_done``, ``frames_total``, ``finished``).
+
+    Returns
+    -------
+    dict
+        The batch manifest, as written to ``out/manifest.json`` (``proofs``: per material
+        × IBL the frames, how many were rendered and skipped, render time, noise), plus
+        ``report`` when one was written.
+    """
+    from lookdev.pipeline.proof import batch
+    from lookdev.pipeline.proof import ibl as ibl_module
+
+    lib = library_for(library)
+    if materials is None or (not isinstance(materials, str | os.PathLike) and not materials):
+        materials = representative_presets(lib)
+    loaded = [hub(m, batch.MAP_RESOLUTION, lib) for m in _materials(materials, lib)]
+    if isinstance(ibls, str | os.PathLike):
+        ibls = [ibls]
+    ibl_names = list(dict.fromkeys(ibls or ibl_module.builtin_names()))
+    environments = [ibl_module.load(name, ibl_width) for name in ibl_names]
+    if resolution[0] < 8 or resolution[1] < 8:
+        raise batch.ProofError(f"resolution {tuple(resolution)} is below 8×8", field="--resolution")
+    least = {"--frames": (frames, 1), "--light-frames": (light_frames, 0), "--spp": (spp, 2)}
+    if jobs is not None:
+        least["--workers"] = (jobs, 1)
+    for name, (value, low) in least.items():
+        if value < low:
+            raise batch.ProofError(f"{value} is below {low}", field=name)
+    settings = batch.Settings(frames, light_frames, spp, tuple(resolution), exposure)
+    output = Path(out)
+    doc = batch.proof(
+        loaded,
+        environments,
+        output,
+        settings,
+        scheduler=scheduler,
+        workers=jobs,
+        executor=executor,
+        progress=progress,
+    )
+    if report:
+        from lookdev.pipeline.analysis.report import write_report
+
+        doc["report"] = str(write_report(output, materials={m.name: m for m in loaded}))
+    return doc
+
+
+# -- plots ---------------------------------------------------------------------------------------
+PLOT_FORMATS = (".png", ".pdf", ".svg")
+PLOT_VIEWS = ("slice", "albedo", "polar", "sphere")
+
+
+@dataclass
+class Plot:
+    """What :func:`plot` wrote: the image, the view and the materials' labels."""
+
+    output: Path
+    view: str
+    materials: list[str]
+
+    def to_json(self) -> dict[str, Any]:
+        return {"output": str(self.output), "view": self.view, "materials": self.materials}
+
+
+def plot(
+    materials: Any,
+    path: PathLike,
+    *,
+    view: str = "slice",
+    exposure: float = 0.0,
+    ibl: str | None = None,
+    resolution: int = 128,
+    library: Any = None,
+) -> Plot:
+    """Draw materials side by side as one BRDF-explorer view (Burley §3.2) to an image.
+
+    ``view``: ``slice`` (f(θh, θd) at φd = 90°), ``albedo`` (directional albedo per
+    channel), ``polar`` (f in the plane of incidence) or ``sphere`` (a lit sphere, also
+    under ``ibl`` when given). ``path`` ends in ``.png``, ``.pdf`` or ``.svg``.
+    """
+    from lookdev.pipeline.analysis import plots
+
+    output = Path(path)
+    if output.suffix.lower() not in PLOT_FORMATS:
+        raise plots.PlotError(
+            f"cannot write {output.suffix or 'no extension'}; allowed {', '.join(PLOT_FORMATS)}",
+            where=str(output),
+        )
+    if view not in PLOT_VIEWS:
+        raise plots.PlotError(f"unknown view {view!r}; allowed {', '.join(PLOT_VIEWS)}")
+    lib = library_for(library)
+    if isinstance(materials, str | os.PathLike):
+        materials = [materials]
+    hubs = [hub(m, plots.MAP_RESOLUTION, lib) for m in _materials(materials, lib)]
+    environment = None
+    if ibl is not None:
+        if view != "sphere":
+            raise plots.PlotError("--ibl only applies to --view sphere", field="--ibl")
+        environment = plots.load_environment(ibl)
+    fig = plots.figure(
+        hubs,
+        view,
+        exposure=exposure,
+        environment=environment,
+        ibl_name=ibl or "",
+        resolution=resolution,
+    )
+    plots.save_figure(fig, output)
+    return Plot(output, view, [h.name for h in hubs])
+
+
+# -- stability -------------------------------------------------------------------------------------
+@dataclass
+class Stability:
+    """The stability sweep's findings: a report per model of the registry."""
+
+    reports: dict[str, Any]
+    """``{model: lookdev.pipeline.analysis.stability.ModelReport}``."""
+    seconds: float
+
+    @property
+    def failed(self) -> bool:
+        """True when any model produced a NaN, an infinity, a negative value, an
+        exception or an energy gain beyond its allowance."""
+        return any(r.failed for r in self.reports.values())
+
+    def to_json(self) -> dict[str, Any]:
+        """The object ``lookdev check --json`` prints."""
+        return {
+            "models": {name: r.to_json() for name, r in self.reports.items()},
+            "seconds": round(self.seconds, 3),
+        }
+
+
+def check(
+    models: Iterable[str] | None = None,
+    *,
+    progress: Callable[[int, int, str, str], None] | None = None,
+) -> Stability:
+    """Sweep every reflectance model (or those named) over its stiff and extreme cases.
+
+    Parameters at both ends of their ranges and DESIGN.md's combinations, directions at
+    and beyond grazing, ``wi = −wo``, uniforms at 0, ½ and 1 − 2⁻²⁴, in float32 and
+    float64; white-furnace albedos against each model's energy allowance.
+    ``progress(done, total, model, case)`` is called after each parameter set.
+
+    >>> import lookdev
+    >>> try:
+    ...     lookdev.check(["no_such_model"])
+    ... except lookdev.LookdevError as exc:
+    ...     print(type(exc).__name__)
+    CheckError
+    """
+    import time
+
+    from lookdev.pipeline.analysis import stability
+
+    names = list(models) if models else None
+    total = stability.case_count(names) if progress is not None else 0
+    done = 0
+
+    def advance(name: str, label: str) -> None:
+        nonlocal done
+        done += 1
+        if progress is not None:
+            progress(done, total, name, label)
+
+    started = time.perf_counter()
+    reports = stability.run(names, advance)
+    return Stability(reports, time.perf_counter() - started)
