@@ -147,6 +147,42 @@ def test_only_the_cli_and_the_benchmarks_import_the_benchmarks(graph):
     )
 
 
+CONSUMERS = ("lookdev.pipeline.export", "lookdev.pipeline.proof", "lookdev.pipeline.analysis")
+"""Modules that take the blended material (DESIGN.md: one hub): exporters, proofs, plots,
+the report and the stability sweep."""
+PRESET_WRITERS = ("lookdev.pipeline.export.usd.presets",)
+"""`lookdev import usd` writes what it read as preset files: the one consumer that needs
+the library, and only to write presets, never to look materials up."""
+
+
+def test_consumers_never_look_presets_up(graph):
+    bad = [
+        line
+        for line in _offending(graph, CONSUMERS, ("lookdev.library",))
+        if not any(
+            line.startswith(str(source_files()[m].relative_to(ROOT))) for m in PRESET_WRITERS
+        )
+    ]
+    assert not bad, "exporters, proofs and analysis take the blend, not presets:\n" + "\n".join(bad)
+
+
+def test_consumers_never_blend():
+    """Nothing that takes the hub imports the blending engine or its ``blend`` function."""
+    bad = []
+    for module, path in source_files().items():
+        if not any(_inside(module, c) for c in CONSUMERS):
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").endswith("blend"):
+                if any(alias.name == "blend" for alias in node.names):
+                    bad.append(f"{path.relative_to(ROOT)}:{node.lineno} imports blend()")
+            if isinstance(node, ast.ImportFrom) and (node.module or "").endswith("blend.engine"):
+                bad.append(f"{path.relative_to(ROOT)}:{node.lineno} imports the engine")
+    assert not bad, "consumers take the blended material; blend runs once, upstream:\n" + (
+        "\n".join(bad)
+    )
+
+
 def cycles(graph: list[Import]) -> list[list[Import]]:
     """One loop of imports through each strongly connected group of modules (Tarjan)."""
     modules = {e.source for e in graph}
