@@ -23,40 +23,30 @@ from lookdev.materials import registry
 from lookdev.materials.params import DisneyParams
 from lookdev.materials.pixar import PixarParams
 
-PARAM_LOBE: dict[str, dict[str, str]] = {
+FINER_GROUPS: dict[str, dict[str, str]] = {
     "disney": {
         "specular": "dielectric",
         "specular_tint": "dielectric",
         "ior": "dielectric",
-        "sheen": "sheen",
-        "sheen_tint": "sheen",
-        "sheen_model": "sheen",
         "sheen_roughness": "conty_kulla",
-        "clearcoat": "clearcoat",
-        "clearcoat_gloss": "clearcoat",
-        "spec_trans": "spec_trans",
-        "diff_trans": "diff_trans",
         "subsurface": "subsurface",
         "flatness": "flatness",
         "scatter_distance": "scatter",
     },
-    "pixar": {
-        "back": "diffuse_t",
-        "diffuse_t_scale": "diffuse_t",
-        "diffuse_scale": "diffuse",
-        "specular_scale": "specular",
-        "specular_cone_scale": "specular",
-        "reflection_scale": "reflection",
-        "reflection_cone_scale": "reflection",
-        "specular_t_scale": "specular_t",
-        "reflection_t_scale": "reflection_t",
-        "specular_tint": "highlights",
-        "transmission_tint": "transmission",
-        "ior": "transmission",
-    },
-    "pixar_weights": {},  # blended lobe weights: each is its own lobe's weight
 }
-"""model → parameter → the lobe it belongs to (parameters not listed are always live)."""
+"""model → parameter → the exporter's group (:func:`active_lobes`) that alone keeps it
+live, where that is finer than the model's lobes (the registry's ``Lobe.params``)."""
+
+
+def parameter_groups(model: str) -> dict[str, tuple[str, ...]]:
+    """Parameter → the lobes and groups any one of which keeps it live; parameters not
+    listed are always live. The model's own lobes come from the registry."""
+    out: dict[str, tuple[str, ...]] = {}
+    if model != "pixar_weights":  # blended weights: each is its own lobe's weight
+        out.update(registry.parameter_lobes(registry.MODELS[REGISTRY_MODEL[model]]))
+    out.update({k: (group,) for k, group in FINER_GROUPS.get(model, {}).items()})
+    return out
+
 
 DEFAULTS: dict[str, dict[str, Any]] = {
     "disney": {**DisneyParams().model_dump(), "ior": 1.5, "specular": 0.5},
@@ -147,6 +137,9 @@ def effective(values: dict[str, Any], model: str = "disney", lobes: dict | None 
     Two materials with equal effective values reflect light identically.
     """
     lobes = active_lobes(values, model) if lobes is None else lobes
-    owner = PARAM_LOBE[model]
+    owners = parameter_groups(model)
     defaults = DEFAULTS[model]
-    return {k: (v if k not in owner or lobes[owner[k]] else defaults[k]) for k, v in values.items()}
+    return {
+        k: (v if k not in owners or any(lobes[g] for g in owners[k]) else defaults[k])
+        for k, v in values.items()
+    }
