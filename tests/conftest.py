@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import os
+import sys
 from dataclasses import dataclass
+from pathlib import Path
 
 # Rich sizes its consoles when lookdev.pipeline.cli.common is first imported; a wide one
 # keeps long temporary paths on one line so tests can find them in the output.
@@ -11,6 +13,11 @@ os.environ["COLUMNS"] = "240"
 
 import pytest
 from hypothesis import settings
+
+# The tree under tests/ mirrors the code (tests/materials, tests/pipeline/blend …); the
+# helper modules shared by several of them (_lambert, _mitsuba_tiny …) live here.
+TESTS = Path(__file__).resolve().parent
+sys.path.insert(0, str(TESTS))
 
 # Property tests draw the same examples on every run (CI must not be red one run in ten);
 # HYPOTHESIS_PROFILE=explore searches afresh, and keeps what fails, when hunting bugs.

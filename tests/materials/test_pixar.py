@@ -141,6 +141,7 @@ def _sums(params: pixar.PixarParams, cos_view) -> tuple[np.ndarray, np.ndarray]:
     return normal, grazing
 
 
+@pytest.mark.slow
 def test_weights_partition_energy_on_a_dense_grid():
     grid = np.linspace(0.0, 1.0, 5)
     cos_view = np.linspace(0.0, 1.0, 9)
@@ -167,6 +168,7 @@ def test_weights_partition_energy_on_a_dense_grid():
 unit = st.floats(0.0, 1.0)
 
 
+@pytest.mark.slow
 @settings(max_examples=300, deadline=None)
 @given(
     surf=st.tuples(unit, unit, unit),

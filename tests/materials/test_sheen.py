@@ -160,6 +160,7 @@ def test_sample_weight_is_f_cos_over_pdf():
 
 
 # -- albedo table and layering -------------------------------------------------------------
+@pytest.mark.slow
 @pytest.mark.parametrize("soften", [False, True])
 def test_albedo_table_error_is_as_documented(soften):
     table = sheen._TABLES[int(soften)]

@@ -9,6 +9,7 @@ import pytest
 pytestmark = pytest.mark.render
 
 
+@pytest.mark.slow
 def test_bench_proof_quick_json_reports_every_measurement(cli, tmp_path, monkeypatch):
     monkeypatch.setenv("LOOKDEV_CACHE", str(tmp_path))
     r = cli("bench", "proof", "--quick", "--repeat", "1", "--preset", "gold", "--json")
@@ -37,6 +38,7 @@ def test_bench_proof_quick_json_reports_every_measurement(cli, tmp_path, monkeyp
     assert doc["speedup_target_met_up_to_samples_per_frame"] == max(met, default=None)
 
 
+@pytest.mark.slow
 def test_bench_proof_table_names_the_floor_and_the_frame_sizes(cli, tmp_path, monkeypatch):
     monkeypatch.setenv("LOOKDEV_CACHE", str(tmp_path))
     r = cli("bench", "proof", "--quick", "--repeat", "1", "--preset", "gold")

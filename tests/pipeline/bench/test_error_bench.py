@@ -110,6 +110,7 @@ def test_render_error_falls_like_one_over_spp():
     assert 6 < e1 / e16 < 40  # 16× the samples: relMSE ÷ ~16 (Monte Carlo variance)
 
 
+@pytest.mark.slow
 def test_run_measures_every_item_and_writes_outputs(tmp_path):
     from lookdev.pipeline.variant import use_mitsuba
 
@@ -128,6 +129,7 @@ def test_run_measures_every_item_and_writes_outputs(tmp_path):
     assert paths["plot"].read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.slow
 def test_cli_prints_one_json_object(cli, tmp_path):
     res = cli("bench", "error", "--quick", "--item", "lambda", "-o", str(tmp_path), "--json")
     assert res.code == 0, res.err

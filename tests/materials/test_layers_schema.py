@@ -139,7 +139,7 @@ def test_texture_leaves_can_be_listed_and_rebased():
 
 
 def test_every_builtin_layered_preset_validates():
-    folder = Path(__file__).resolve().parents[1] / "presets" / "layered"
+    folder = Path(__file__).resolve().parents[2] / "presets" / "layered"
     files = sorted(folder.glob("*.toml"))
     assert files
     for path in files:

@@ -160,6 +160,7 @@ def test_cli_pixar_layering_option(cli, tmp_path):
     assert r.code == 2 and "unknown Pixar layering 'x'" in r.err
 
 
+@pytest.mark.slow
 def test_bench_blend_smoke(cli):
     r = cli("bench", "blend", "--resolution", "16", "--repeat", "1", "--json")
     assert r.code == 0, r.err

@@ -127,6 +127,7 @@ def test_blend_streams_masks_larger_than_half_its_output(tmp_path):
     np.testing.assert_array_equal(streamed.maps["roughness"], decoded.maps["roughness"])
 
 
+@pytest.mark.slow
 def test_bench_blend_reports_resident_peaks_of_both_cases(cli):
     r = cli("bench", "blend", "--resolution", "16", "--repeat", "1", "--json")
     assert r.code == 0, r.err
@@ -139,6 +140,7 @@ def test_bench_blend_reports_resident_peaks_of_both_cases(cli):
     assert "peak_to_output" in doc  # tracemalloc's figure stays beside the resident one
 
 
+@pytest.mark.slow
 def test_bench_blend_table_says_met_or_missed(cli):
     r = cli("bench", "blend", "--resolution", "16", "--repeat", "1")
     assert r.code == 0, r.err

@@ -85,6 +85,7 @@ def test_frames_after_the_first_reuse_every_compiled_kernel(mitsuba):
     assert jit and all(k["cache_hit"] for k in jit)
 
 
+@pytest.mark.slow
 def test_frozen_frames_equal_plain_renders_and_stop_recording(mitsuba):
     """The frozen launch (dr.freeze) replays exactly what mi.render computes, and records
     only while the scene's first poses settle which of its values are literals, never
@@ -121,6 +122,7 @@ for name in sys.argv[1:]:
 """
 
 
+@pytest.mark.slow
 def test_every_kind_of_plugin_renders_frozen(tmp_path):
     """One preset per plugin and feature (Conty-Kulla sheen tables, Pixar lobes, layered
     Pixar weights, textures of a layered Disney stack, glass): a model that copied host
@@ -159,6 +161,7 @@ sys.exit(0 if jit and all(k["cache_hit"] for k in jit) else 1)
 """
 
 
+@pytest.mark.slow
 def test_another_ibl_of_the_same_size_reuses_the_compiled_kernels(tmp_path):
     """Why a batch brings IBLs to one size and folds exposure into pixels (DESIGN.md).
 
@@ -174,6 +177,7 @@ def test_another_ibl_of_the_same_size_reuses_the_compiled_kernels(tmp_path):
     assert done.returncode == 0
 
 
+@pytest.mark.slow
 def test_half_sample_noise_estimate_matches_the_true_error(mitsuba):
     table = _table(mitsuba, resolution=(48, 24))
     frame = turntable.Frame(0, "element", 0.0)
@@ -241,6 +245,7 @@ def test_changed_settings_render_everything_again_and_drop_stray_frames(mitsuba,
     assert frames == ["frame_000.exr", "frame_000.png", "frame_001.exr", "frame_001.png"]
 
 
+@pytest.mark.slow
 def test_a_batch_runs_on_a_dask_cluster(mitsuba, gold, tmp_path):
     from distributed import Client, LocalCluster
 
@@ -290,6 +295,7 @@ def test_proof_command_runs_on_a_dask_scheduler(cli, tmp_path):
     assert (out / "gold" / "sunset" / "contact.png").is_file()
 
 
+@pytest.mark.slow
 def test_proof_command_default_executor_is_a_process_pool(cli, tmp_path):
     out = tmp_path / "p"
     r = cli("proof", "gold", "--ibl", "studio", "-n", "1", "-m", "0", "-s", "2", "-r", "16", "8",

@@ -85,6 +85,7 @@ def scalar_run():
     return json.loads(run.stdout.strip().splitlines()[-1]), views, lights
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(CASES))
 def test_sheen_plugins_evaluate_on_scalar_rgb_as_numpy_does(scalar_run, name):
     """Mitsuba's eval (f·cos θ of the light) on scalar_rgb = the numpy model's f·cos θ."""

@@ -305,6 +305,7 @@ needs_chromium = pytest.mark.skipif(
 )
 
 
+@pytest.mark.slow
 @needs_chromium
 def test_the_chromium_check_itself_sees_broken_images_and_console_errors(tmp_path):
     page = tmp_path / "bad.html"
@@ -318,6 +319,7 @@ def test_the_chromium_check_itself_sees_broken_images_and_console_errors(tmp_pat
     assert seen["failed"] or seen["log"]  # the failed load is reported too
 
 
+@pytest.mark.slow
 @needs_chromium
 def test_page_opens_in_chromium_without_errors_or_broken_images(batch, tmp_path):
     from lookdev.library import load_material
@@ -338,6 +340,7 @@ def test_page_opens_in_chromium_without_errors_or_broken_images(batch, tmp_path)
     assert shot.read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.slow
 @pytest.mark.render
 @needs_chromium
 def test_lookdev_proof_report_writes_a_page_that_opens_cleanly(cli, tmp_path):

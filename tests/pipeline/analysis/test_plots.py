@@ -184,6 +184,7 @@ def test_mirror_like_sphere_reflects_the_environment_without_bias():
 
 
 # -- figures -------------------------------------------------------------------------
+@pytest.mark.slow
 @pytest.mark.parametrize("view", P.VIEWS)
 def test_every_view_draws_several_materials_labelled(tmp_path, view, monkeypatch):
     monkeypatch.setitem(registry.MODELS, "lambert", LAMBERT)
@@ -220,6 +221,7 @@ def test_cli_ibl_only_with_sphere(cli, tmp_path):
     assert res.code == 2 and "--ibl" in res.err
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("view", P.VIEWS)
 def test_cli_plots_presets_side_by_side(cli, tmp_path, view):
     out = tmp_path / f"{view}.png"

@@ -91,6 +91,7 @@ def test_plausible_excludes_pushed_parameters():
 
 
 # -- the command ----------------------------------------------------------------------------
+@pytest.mark.slow
 def test_check_json_reports_every_built_model(cli):
     result = cli("check", "--json")
     data = json.loads(result.out)

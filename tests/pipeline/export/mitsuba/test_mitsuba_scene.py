@@ -411,6 +411,7 @@ for name in sys.argv[1:]:
 """
 
 
+@pytest.mark.slow
 def test_plugins_render_on_the_scalar_fallback_variant(disney):
     """Without a usable libLLVM lookdev falls back to scalar_rgb: the plugins work there."""
     import subprocess

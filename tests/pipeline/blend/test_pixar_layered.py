@@ -151,6 +151,7 @@ def test_an_unset_grazing_weight_does_not_change_with_the_view():
     assert fading[0, 0] == steady[0, 0] and fading[2, 0] < 1e-5 * steady[2, 0]
 
 
+@pytest.mark.slow
 def test_stability_sweep_finds_no_nan_inf_negative_or_crash():
     """``lookdev check``'s sweep (every field at its extremes, stiff directions, float32
     and float64, per-element maps) on the composited-weights model. Energy is not judged
@@ -210,6 +211,7 @@ def _albedo(weights: PixarLobeWeights, cos_view: float, maps: dict, n: int = 409
     return weight.mean(axis=1), weight.std(axis=1) / math.sqrt(n)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", LAYERED_PRESETS)
 def test_builtin_layered_pixar_presets_never_reflect_more_than_arrives(name):
     blended = blend(Library(use_env=False).load(name), 64)  # coarser, the noise masks average out
@@ -370,6 +372,7 @@ def test_builtin_layered_pixar_presets_become_bsdfs(mi, name):
 
 
 # -- the commands ---------------------------------------------------------------------------
+@pytest.mark.slow
 def test_proof_of_a_layered_pixar_preset(cli, tmp_path):
     out = tmp_path / "proof"
     r = cli("proof", "pixar_rusty_metal", "--ibl", "studio", "--frames", "2", "--light-frames",
@@ -379,6 +382,7 @@ def test_proof_of_a_layered_pixar_preset(cli, tmp_path):
     assert len(frames) == 2
 
 
+@pytest.mark.slow
 def test_plot_of_a_layered_pixar_preset(cli, tmp_path):
     hub = blend(Library(use_env=False).load("pixar_painted_metal"), 64)
     assert hub.bsdf_model is LAYERED_MODEL and hub.maps

@@ -32,6 +32,7 @@ def _decode(srgb: np.ndarray) -> np.ndarray:
 channel = st.floats(0.0, 1e4, allow_nan=False)
 
 
+@pytest.mark.slow
 @settings(max_examples=200, deadline=None)
 @given(st.tuples(channel, channel, channel), st.floats(-4.0, 4.0))
 def test_view_keeps_hue_and_never_clips(rgb, exposure):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from _lambert import LAMBERT, PHONG, LambertParams, PhongParams
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -46,6 +47,7 @@ def test_phong_albedo_at_normal_incidence_is_one():
     np.testing.assert_allclose(q, 1.0, rtol=1e-6)
 
 
+@pytest.mark.slow
 @settings(max_examples=15, deadline=None)
 @given(exponent=st.floats(1.0, 200.0), theta=st.floats(0.0, 80.0))
 def test_monte_carlo_agrees_with_quadrature_within_its_error(exponent, theta):

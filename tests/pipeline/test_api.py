@@ -16,7 +16,7 @@ import lookdev
 from lookdev.materials.bsdf import Model
 from lookdev.materials.pixar import LAYERED_MODEL
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+README = Path(__file__).resolve().parents[2] / "README.md"
 RNG = np.random.default_rng(7)
 
 
@@ -233,6 +233,7 @@ def test_export_mitsuba_writes_a_scene(tmp_path):
         lookdev.export_mitsuba("gold", tmp_path / "g.xml", ibl=tmp_path / "none.exr")
 
 
+@pytest.mark.slow
 def test_check_returns_the_findings():
     seen = []
     result = lookdev.check(["pixar"], progress=lambda *a: seen.append(a))
@@ -252,6 +253,7 @@ def _readme_example() -> str:
     return blocks[0]
 
 
+@pytest.mark.slow
 @pytest.mark.render
 def test_the_readme_example_runs(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
@@ -264,6 +266,7 @@ def test_the_readme_example_runs(tmp_path, monkeypatch, capsys):
     assert "frames in" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 @pytest.mark.render
 def test_proof_returns_the_manifest_and_resumes(tmp_path):
     settings = dict(frames=1, light_frames=1, spp=4, resolution=(32, 16), ibl_width=64)

@@ -109,6 +109,7 @@ BSDF_GRID = [
 VIEWS = [_view(0.0), _view(50.0), _view(85.0)]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("wo", VIEWS, ids=["normal", "50deg", "85deg"])
 @pytest.mark.parametrize("params", BSDF_GRID, ids=range(len(BSDF_GRID)))
 def test_whole_bsdf_sampling_matches_pdf_chi2(params, wo):
@@ -274,6 +275,7 @@ def _lobe_eval(lobe, p, wi, wo):
     return evaluate(disney.lobe_model(lobe), p, wi, wo)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("thin", [False, True])
 def test_glass_reflects_and_transmits_at_most_what_arrives(thin):
     # Seen from outside, radiance mode: R + T/η² ≤ 1 for a solid, R + T ≤ 1 for a thin sheet.
@@ -334,6 +336,7 @@ def test_edges_give_no_nan_inf_or_negative(params, dtype):
         assert f.dtype == dtype and p.dtype == dtype
 
 
+@pytest.mark.slow
 @given(
     st.floats(0, 1),
     st.floats(0, 1),

@@ -44,6 +44,7 @@ def wait_for(predicate, proc: subprocess.Popen, timeout: float = 60.0) -> None:
         time.sleep(0.01)
 
 
+@pytest.mark.slow
 def test_sigkill_in_the_middle_of_a_save_leaves_the_old_file(tmp_path):
     lib = Library([tmp_path], use_env=False)
     target = lib.save(PresetFile(name="mine", extends="gold", params={"roughness": 0.3}))
@@ -97,6 +98,7 @@ WRITER = f"KEYS = {KEYS!r}\n" + textwrap.dedent(
 )
 
 
+@pytest.mark.slow
 def test_two_processes_saving_into_one_library_lose_nothing(tmp_path):
     lib = Library([tmp_path], use_env=False)
     lib.save(PresetFile(name="shared", extends="gold"))
@@ -129,6 +131,7 @@ FLIPPER = textwrap.dedent(
 )
 
 
+@pytest.mark.slow
 def test_readers_never_see_a_half_written_preset(tmp_path):
     lib = Library([tmp_path], use_env=False)
     lib.save(PresetFile(name="mine", extends="gold", params={"roughness": 0.5}))

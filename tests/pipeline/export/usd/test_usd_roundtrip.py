@@ -76,6 +76,7 @@ def _assert_same(got: dict, want: DisneyParams, keys: set[str]) -> None:
             np.testing.assert_allclose(a[k], b[k], rtol=2e-6, atol=2e-6, err_msg=k)
 
 
+@pytest.mark.slow
 @settings(
     max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
 )
@@ -88,6 +89,7 @@ def test_universal_round_trip_recovers_what_it_expresses(tmp_path, data):
     assert not unexpressed, f"read parameters the surface cannot hold: {unexpressed}"
 
 
+@pytest.mark.slow
 @settings(
     max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
 )
@@ -179,6 +181,7 @@ pixar = st.fixed_dictionaries(
 ).filter(lambda d: not ("ior" in d and "normal_fresnel" in d))
 
 
+@pytest.mark.slow
 @settings(
     max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
 )

@@ -11,6 +11,7 @@ import tomllib
 from pathlib import Path
 
 import jsonschema
+import pytest
 import tomli_w
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
@@ -117,6 +118,7 @@ SETTINGS = settings(
 )
 
 
+@pytest.mark.slow
 @SETTINGS
 @given(data=mutated())
 def test_any_file_loads_or_fails_in_one_line(tmp_path, data):
@@ -134,6 +136,7 @@ def test_any_file_loads_or_fails_in_one_line(tmp_path, data):
         raise AssertionError(f"listing raised {exc}") from exc
 
 
+@pytest.mark.slow
 @SETTINGS
 @given(doc=documents())
 def test_generated_documents_that_load_round_trip(tmp_path, doc):
@@ -152,6 +155,7 @@ def test_generated_documents_that_load_round_trip(tmp_path, doc):
 SCHEMA = jsonschema.Draft202012Validator(preset_schema())
 
 
+@pytest.mark.slow
 @SETTINGS
 @given(doc=documents())
 def test_the_json_schema_accepts_every_file_the_loader_accepts(doc):
@@ -164,6 +168,7 @@ def test_the_json_schema_accepts_every_file_the_loader_accepts(doc):
     assert not errors, errors
 
 
+@pytest.mark.slow
 @SETTINGS
 @given(
     changes=st.dictionaries(
