@@ -16,8 +16,6 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
-from lookdev.pipeline.api import REPRESENTATIVE, representative_presets  # noqa: F401 (moved)
-
 from .common import console, err_console, print_json, table
 
 

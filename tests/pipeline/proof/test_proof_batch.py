@@ -356,7 +356,7 @@ def test_at_most_in_flight_jobs_are_queued(monkeypatch, in_flight, most):
 def test_representative_set_takes_what_the_library_has():
     from types import SimpleNamespace
 
-    from lookdev.pipeline.cli.proof import REPRESENTATIVE, representative_presets
+    from lookdev.pipeline.api import REPRESENTATIVE, representative_presets
 
     full = SimpleNamespace(names=lambda: sorted([*REPRESENTATIVE, "zinc"]))
     assert representative_presets(full) == list(REPRESENTATIVE)
