@@ -54,6 +54,19 @@ class Header(NamedTuple):
     def path(self) -> Path:
         return Path(self.file)
 
+    def to_json(self, library: str | None = None) -> dict[str, Any]:
+        """What ``presets list --json`` prints of it; ``library`` names where it was found
+        (default: its folder)."""
+        return {
+            "name": self.name,
+            "model": self.model,
+            "description": self.description,
+            "tags": list(self.tags),
+            "extends": self.extends,
+            "file": self.file,
+            "library": self.library if library is None else library,
+        }
+
 
 def scan_folder(folder: Path, *, cache: bool = True, skip: tuple[str, ...] = ()) -> list[Header]:
     """Headers of every preset file under ``folder``: shallowest first, then by path.

@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from lookdev.library import Library
-from lookdev.library.index import INDEX_NAME, Header
+from lookdev.library.index import INDEX_NAME
 
 TARGET_RATIO = 2.0
 MODELS = ("disney", "disney", "disney", "layered")
@@ -134,25 +134,13 @@ def listing(lib: Library, *, as_json: bool = False) -> str:
     text row (or with ``as_json`` a JSON document) per preset that parses."""
     shown = [h for h in lib.entries() if not h.error]
     if as_json:
-        lines = ",\n".join("  " + json.dumps(_header_doc(h)) for h in shown)
+        lines = ",\n".join("  " + json.dumps(h.to_json()) for h in shown)
         return f"[\n{lines}\n]\n"
     rows = (
         "  ".join((h.name, h.model or "?", ", ".join(h.tags), h.library, h.description))
         for h in shown
     )
     return "\n".join(rows) + "\n"
-
-
-def _header_doc(h: Header) -> dict[str, Any]:
-    return {
-        "name": h.name,
-        "model": h.model,
-        "description": h.description,
-        "tags": list(h.tags),
-        "extends": h.extends,
-        "file": h.file,
-        "library": h.library,
-    }
 
 
 def run(

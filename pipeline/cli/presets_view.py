@@ -37,15 +37,7 @@ def origin(h: Header, lib: Library) -> str:
 
 
 def header_json(h: Header, lib: Library) -> dict[str, Any]:
-    return {
-        "name": h.name,
-        "model": h.model,
-        "description": h.description,
-        "tags": list(h.tags),
-        "extends": h.extends,
-        "file": h.file,
-        "library": origin(h, lib),
-    }
+    return h.to_json(origin(h, lib))
 
 
 def material_json(m: Material) -> dict[str, Any]:
