@@ -99,7 +99,8 @@ def _constants(hub: BlendedMaterial) -> dict[str, Any]:
     data.update({name: hub.mean(name) for name in hub.maps})
     if "ior" in data and "specular" in data:
         del data["specular"]
-    return canonical(DisneyParams.parse(data, where=hub.name))
+    # Means of valid maps and blended constants are valid: not validated again.
+    return canonical(DisneyParams.model_construct(**data))
 
 
 def weights_source(hub: BlendedMaterial, texture_dir: Path) -> Source:
