@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from lookdev.materials import registry
 from lookdev.materials.layers import ConstantMask, Mask, TextureMask
 
 from .errors import BlendError
@@ -98,8 +99,9 @@ def stack_of(material: Any) -> list[Entry]:
 
 def _entry(index: int, layer: Any) -> Entry:
     mat = layer.material
-    if mat.model not in ("disney", "pixar"):
-        raise BlendError(f"material {mat.name!r} is {mat.model}, not disney or pixar")
+    if mat.model not in registry.PRESET_MODELS:
+        allowed = " or ".join(registry.PRESET_MODELS)
+        raise BlendError(f"material {mat.name!r} is {mat.model}, not {allowed}")
     return Entry(
         label=layer.name or mat.name or f"#{index}",
         model=mat.model,

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from lookdev.materials import registry
 from lookdev.materials.fresnel import specular_to_ior
 from lookdev.materials.params import DisneyParams
 from lookdev.pipeline.blend.result import LOBE_WEIGHTS, BlendedMaterial
@@ -23,7 +24,7 @@ from .live import live_stack
 from .lobes import DEFAULTS, canonical
 from .network import ExportError, Image, Source, source_from_params
 
-SUPPORTED = ("disney", "pixar")  # layered Pixar: see weights_source
+SUPPORTED = registry.PRESET_MODELS  # a layered Pixar blend: see weights_source
 
 
 def source_for(
