@@ -10,11 +10,12 @@ leaves no half-written scene behind.
 from __future__ import annotations
 
 import os
-import tempfile
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
+
+from lookdev.library import files
 
 from .plugin import PLUGIN_PREFIX, MitsubaExportError
 from .scene import scene_dict, uses_our_plugins
@@ -162,11 +163,4 @@ def _check_writable(folder: Path) -> None:
 
 def _atomic_write(path: Path, text: str) -> None:
     _check_writable(path.parent)
-    fd, tmp = tempfile.mkstemp(suffix=".xml", prefix=f".{path.stem}.", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    files.atomic_write(path, text)

@@ -17,6 +17,8 @@ from typing import Any
 
 from pxr import Gf, Sdf
 
+from lookdev.library import files
+
 from . import mtlx, preview, ri
 from .network import (
     CONTEXT_OUTPUT,
@@ -166,39 +168,9 @@ def add_switch(layer, targets: dict[str, tuple[str, str]]) -> None:
         look.variantSelections["preset"] = next(iter(targets))
 
 
-@dataclass
-class Staging:
-    """Files written under temporary names, renamed into place together on commit."""
-
-    moves: list[tuple[Path, Path]] = field(default_factory=list)
-    created: list[Path] = field(default_factory=list)
-
-    def folder(self, path: Path) -> None:
-        """Create ``path`` (and parents) if missing; an abort removes what it created."""
-        missing = [p for p in (path, *path.parents) if not p.exists()]
-        path.mkdir(parents=True, exist_ok=True)
-        self.created += reversed(missing)
-
-    def temp_for(self, final: Path) -> Path:
-        fd, name = tempfile.mkstemp(prefix=f".{final.stem}.", suffix=final.suffix, dir=final.parent)
-        os.close(fd)
-        tmp = Path(name)
-        self.moves.append((tmp, final))
-        return tmp
-
-    def commit(self) -> None:
-        for tmp, final in self.moves:
-            os.replace(tmp, final)
-        self.moves.clear()
-
-    def abort(self) -> None:
-        for tmp, _ in self.moves:
-            tmp.unlink(missing_ok=True)
-        for folder in reversed(self.created):
-            if folder.is_dir() and not any(folder.iterdir()):
-                folder.rmdir()
-        self.moves.clear()
-        self.created.clear()
+class Staging(files.Transaction):
+    """Files written under temporary names, renamed into place together on commit: the one
+    write path's transaction (:class:`lookdev.library.files.Transaction`)."""
 
 
 def check_writable(path: Path) -> None:
@@ -299,20 +271,17 @@ def export_usd(
     _check_names(specs, out)
     images = images_of(specs)
     check_images(images)
-    staging = Staging()
-    try:
+    with Staging() as staging:  # commits on success; removes every temporary otherwise
         if package:
-            files = _write_package(specs, images, out, Path(workdir or out.parent), staging)
+            written = _write_package(specs, images, out, Path(workdir or out.parent), staging)
         else:
-            files = _write_all(specs, images, out, split_dir, staging)
+            written = _write_all(specs, images, out, split_dir, staging)
         if mtlx_path is not None:
             mtlx.write_document(specs, staging.temp_for(Path(mtlx_path)), where=mtlx_path)
-            files.append(Path(mtlx_path))
-        staging.commit()
-    except BaseException:
-        staging.abort()
-        raise
-    return ExportResult(files, [s.name for s in specs], [i.path for i in images], losses_of(specs))
+            written.append(Path(mtlx_path))
+    return ExportResult(
+        written, [s.name for s in specs], [i.path for i in images], losses_of(specs)
+    )
 
 
 def _check_names(specs: list[MaterialSpec], out: Path) -> None:
