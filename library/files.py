@@ -55,6 +55,7 @@ __all__ = [
     "WriteError",
     "atomic_path",
     "atomic_write",
+    "failure_reason",
     "cache_root",
     "is_temporary",
     "new_file_mode",
@@ -88,6 +89,17 @@ def write_error(path: str | os.PathLike, exc: OSError) -> WriteError:
     """``cannot write PATH: <reason>``, one line."""
     reason = exc.strerror or str(exc) or type(exc).__name__
     return WriteError(f"cannot write {os.fspath(path)}: {reason}")
+
+
+def failure_reason(path: str | os.PathLike, message: str) -> str:
+    """The reason a writer that reports only its own words (OpenImageIO, USD) failed:
+    ``No space left on device`` when the folder's filesystem is full, else its first line."""
+    folder = os.path.dirname(os.path.abspath(path)) or "."
+    with contextlib.suppress(OSError, AttributeError):
+        if os.statvfs(folder).f_bavail == 0:
+            return os.strerror(errno.ENOSPC)
+    lines = [line.strip() for line in str(message).splitlines() if line.strip()]
+    return lines[-1] if lines else "unknown error"
 
 
 # -- modes -----------------------------------------------------------------------------

@@ -329,9 +329,11 @@ def _write_index(folder: Path, found: list[tuple], headers: list[Header]) -> Non
     data = json.dumps({"version": INDEX_VERSION, "entries": entries}, separators=(",", ":"))
     target = index_file(folder)
     try:
+        if target.parent != folder:
+            target.parent.mkdir(parents=True, exist_ok=True)
         files.atomic_write(target, data)
         return
-    except files.WriteError:
+    except (files.WriteError, OSError):
         pass  # root on a chmod-0555 folder passes os.access, a read-only mount does not
     # The folder refused: the library is read-only, so the cache goes under $LOOKDEV_CACHE.
     with contextlib.suppress(files.WriteError, OSError):

@@ -53,7 +53,8 @@ def bake(
     stale = _listed_files(sidecar) - set(names.values())
     with files.Transaction() as staged:  # renamed into place together, the sidecar last
         for i, (name, array) in enumerate(arrays.items()):
-            _write_exr(staged.temp_for(out_dir / names[name]), _encode(name, array), blended.name)
+            final = out_dir / names[name]
+            _write_exr(staged.temp_for(final), _encode(name, array), blended.name, final)
             if progress is not None:
                 progress(i + 1, len(arrays) + 1)
         text = json.dumps(sidecar_dict(blended, names), indent=2)
@@ -99,7 +100,7 @@ def _encode(name: str, array: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(array[::-1], dtype=np.float32)
 
 
-def _write_exr(path: Path, pixels: np.ndarray, where: str) -> None:
+def _write_exr(path: Path, pixels: np.ndarray, where: str, final: Path) -> None:
     height, width, channels = pixels.shape
     spec = oiio.ImageSpec(width, height, channels, oiio.FLOAT)
     spec.channelnames = ("Y",) if channels == 1 else ("R", "G", "B")
@@ -110,7 +111,8 @@ def _write_exr(path: Path, pixels: np.ndarray, where: str) -> None:
     if out is not None:
         out.close()
     if not ok:
-        raise BlendError(f"cannot write {path.name}: {message or 'unknown error'}", where=where)
+        reason = files.failure_reason(path, message or "unknown error")
+        raise BlendError(f"cannot write {final}: {reason}", where=where)
 
 
 def _listed_files(sidecar: Path) -> set[str]:

@@ -9,6 +9,7 @@ leaves no half-written scene behind.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping
@@ -145,8 +146,15 @@ def export_scene(material: Any, path: str | Path, **scene_options: Any) -> dict[
     path = Path(path)
     _check_writable(path.parent)
     textures = path.parent.resolve() / f"{path.stem}_textures"
-    scene = scene_dict(material, texture_dir=textures, **scene_options)
-    write_xml(scene, path)
+    existed = textures.exists()
+    try:
+        scene = scene_dict(material, texture_dir=textures, **scene_options)
+        write_xml(scene, path)
+    except BaseException:
+        if not existed:  # a failed export leaves no empty textures folder behind
+            with contextlib.suppress(OSError):
+                textures.rmdir()
+        raise
     return scene
 
 

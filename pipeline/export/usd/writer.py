@@ -302,13 +302,13 @@ def _write_all(specs, images, out, split_dir, staging) -> list[Path]:
     for image in images:
         if image.write:
             staging.folder(image.path.parent)
-            _write_image(image, staging.temp_for(image.path))
+            _write_image(image, staging.temp_for(image.path), image.path)
     files = [out, *(i.path for i in images if i.write)]
     if split_dir is not None:
         staging.folder(Path(split_dir))
         return files + _write_split(specs, out, Path(split_dir), staging)
     layer = _one_layer(specs, out.parent)
-    _export_layer(layer, staging.temp_for(out))
+    _export_layer(layer, staging.temp_for(out), out)
     return files
 
 
@@ -343,11 +343,11 @@ def _one_layer(specs: list[MaterialSpec], base: Path):
     return layer
 
 
-def _write_image(image: Image, target: Path) -> None:
+def _write_image(image: Image, target: Path, shown: Path | None = None) -> None:
     if image.origin is not None:
         shutil.copyfile(image.origin, target)
     else:
-        write_image(target, image.pixels)
+        write_image(target, image.pixels, shown)
 
 
 def _write_split(specs, out: Path, folder: Path, staging: Staging) -> list[Path]:
@@ -360,17 +360,24 @@ def _write_split(specs, out: Path, folder: Path, staging: Staging) -> list[Path]
         path = folder / f"{name}.usda"
         layer = new_layer()
         (prim_path,) = author(layer, [spec], folder)
-        _export_layer(layer, staging.temp_for(path))
+        _export_layer(layer, staging.temp_for(path), path)
         asset = relative_asset(path, out.parent)
         ref = Sdf.PrimSpec(scope, name, Sdf.SpecifierDef, "Material")
         ref.referenceList.prependedItems.append(Sdf.Reference(asset, Sdf.Path(prim_path)))
         targets[name] = (asset, prim_path)
         files.append(path)
     add_switch(library, targets)
-    _export_layer(library, staging.temp_for(out))
+    _export_layer(library, staging.temp_for(out), out)
     return files
 
 
-def _export_layer(layer, path: Path) -> None:
-    if not layer.Export(str(path)):
-        raise ExportError("USD could not write the layer", where=str(path))
+def _export_layer(layer, path: Path, shown: Path | None = None) -> None:
+    from pxr import Tf
+
+    try:
+        ok, message = layer.Export(str(path)), ""
+    except Tf.ErrorException as exc:  # a full disk, a vanished folder
+        ok, message = False, str(exc)
+    if not ok:
+        reason = files.failure_reason(path, message)
+        raise ExportError(f"USD could not write the layer: {reason}", where=str(shown or path))
