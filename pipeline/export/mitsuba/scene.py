@@ -220,9 +220,8 @@ def write_exr(data: np.ndarray, path: Path) -> Path:
         if out is not None:
             out.close()
         if not ok:
-            raise MitsubaExportError(
-                f"OpenImageIO could not write it: {oiio.geterror()}", where=str(path)
-            )
+            reason = files.failure_reason(tmp, oiio.geterror())
+            raise MitsubaExportError(f"cannot write: {reason}", where=str(path))
     return path
 
 
