@@ -478,19 +478,29 @@ def test_an_existing_file_keeps_its_mode_and_group(cli, tmp_path, env):
 
 
 # -- a full disk -------------------------------------------------------------------------------
-FULL_DISK_CASES = [
-    ("export", "usd", "gold", "-o", "{full}/g.usda"),
-    ("export", "usd", "rusty_iron", "-o", "{full}/r.usdz"),
-    ("export", "mitsuba", "rusty_iron", "-o", "{full}/m.xml"),
-    ("blend", "rusty_iron", "-o", "{full}/maps", "--resolution", "64"),
-    ("import", "usd", "{src}/g.usda", "-o", "{full}"),
-    ("plot", "gold", "-o", "{full}/p.png"),
-    ("presets", "new", "mine", "--from", "gold", "-L", "{full}"),
+FULL_DISK_CASES = [  # (args, written by Python code: a simulated full disk reaches it)
+    (("export", "usd", "gold", "-o", "{full}/g.usda"), False),
+    (("export", "usd", "rusty_iron", "-o", "{full}/r.usdz"), False),
+    (("export", "mitsuba", "rusty_iron", "-o", "{full}/m.xml"), False),
+    (("blend", "rusty_iron", "-o", "{full}/maps", "--resolution", "64"), False),
+    (("import", "usd", "{src}/g.usda", "-o", "{full}"), True),
+    (("plot", "gold", "-o", "{full}/p.png"), False),
+    (("presets", "new", "mine", "--from", "gold", "-L", "{full}"), True),
 ]
 
 
-@pytest.mark.parametrize("args", FULL_DISK_CASES, ids=lambda a: " ".join(a[:2]))
-def test_a_full_disk_ends_in_one_line_and_leaves_nothing(cli, tmp_path, env, full_disk, args):
+@pytest.mark.parametrize(
+    ("args", "python_writer"),
+    FULL_DISK_CASES,
+    ids=lambda a: " ".join(a[:2]) if isinstance(a, tuple) else "",
+)
+def test_a_full_disk_ends_in_one_line_and_leaves_nothing(
+    cli, tmp_path, env, full_disk, args, python_writer
+):
+    if not python_writer and fault_mode("full") != "tmpfs":
+        pytest.skip(
+            "USD, OpenImageIO and matplotlib write from C: only a real full disk reaches them"
+        )
     src = tmp_path / "src"
     src.mkdir()
     if "import" in args:
