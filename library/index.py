@@ -9,16 +9,20 @@ costs a directory walk and one JSON read instead of opening every file.
 A file changed twice within the filesystem's timestamp granularity could keep its stat;
 as in git's "racy" check, headers of files modified less than :data:`RACY_S` before the
 index is written are not stored, so they are re-read until they settle. The index is a
-cache: it is rewritten atomically, silently skipped where the folder is read-only, and
-deleting it is always safe.
+cache: it is rewritten atomically; a folder that cannot be written keeps its cache under
+``$LOOKDEV_CACHE/index/`` instead (:func:`index_file`); deleting it is always safe.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
+import hashlib
 import json
 import os
 import re
+import stat
+import sys
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -26,6 +30,7 @@ from typing import Any, NamedTuple
 
 from lookdev.materials.errors import LookdevError
 
+from . import files
 from .errors import PresetError
 from .preset import MODELS, NAME_RE, parse_toml
 
@@ -196,9 +201,13 @@ def _walk(root: str, skip: tuple[str, ...] = ()) -> list[tuple[str, int, int, in
     """``(relative path, mtime_ns, size, inode)`` of every visible preset file, sorted.
 
     Each folder is scanned through a descriptor, so a stat is an ``fstatat`` relative
-    to it rather than a walk of the whole path (a third cheaper on Linux).
+    to it rather than a walk of the whole path (a third cheaper on Linux). Reads follow
+    symlinks; a link that dangles, loops (``loopdir -> ..``) or leads to a folder already
+    walked is skipped with a one-line warning on stderr (:func:`warn`).
     """
     out: list[tuple[str, int, int, int]] = []
+    top = os.stat(root)
+    seen = {(top.st_dev, top.st_ino)}
     stack = [(root, "")]
     while stack:
         here, prefix = stack.pop()
@@ -207,13 +216,60 @@ def _walk(root: str, skip: tuple[str, ...] = ()) -> list[tuple[str, int, int, in
                 name = e.name
                 if name.startswith(".") or (not prefix and name in skip):
                     continue
-                if name.endswith(SUFFIX) and e.is_file():
+                is_preset = name.endswith(SUFFIX)
+                if e.is_symlink():
+                    st = _link_stat(os.path.join(here, name), is_preset)
+                    if st is None:
+                        continue
+                    if stat.S_ISDIR(st.st_mode):
+                        key = (st.st_dev, st.st_ino)
+                        if key in seen:
+                            warn(
+                                f"{os.path.join(here, name)}: skipped: a symlink loop "
+                                f"(-> {os.readlink(os.path.join(here, name))})"
+                            )
+                            continue
+                        seen.add(key)
+                        stack.append((os.path.join(here, name), f"{prefix}{name}/"))
+                    elif is_preset and stat.S_ISREG(st.st_mode):
+                        out.append((prefix + name, st.st_mtime_ns, st.st_size, st.st_ino))
+                elif is_preset and e.is_file(follow_symlinks=False):
                     st = e.stat()
                     out.append((prefix + name, st.st_mtime_ns, st.st_size, st.st_ino))
-                elif e.is_dir():
+                elif e.is_dir(follow_symlinks=False):
+                    st = e.stat(follow_symlinks=False)
+                    seen.add((st.st_dev, st.st_ino))
                     stack.append((os.path.join(here, name), f"{prefix}{name}/"))
     out.sort(key=lambda f: (f[0].count("/"), f[0]))  # shallowest first: it wins a name
     return out
+
+
+def _link_stat(path: str, is_preset: bool) -> os.stat_result | None:
+    """What a symlink leads to, or None (with a warning) when it dangles or loops."""
+    try:
+        return os.stat(path)
+    except OSError as exc:
+        try:
+            target = os.readlink(path)
+        except OSError:
+            target = "?"
+        if is_preset or exc.errno == errno.ELOOP:
+            what = "a symlink loop" if exc.errno == errno.ELOOP else "a dangling symlink"
+            warn(f"{path}: skipped: {what} (-> {target})")
+        return None
+
+
+_warned: set[str] = set()
+
+
+def warn(message: str) -> None:
+    """One line on stderr, ``lookdev: warning: …``, once per message and process."""
+    if message in _warned:
+        return
+    _warned.add(message)
+    with contextlib.suppress(OSError, ValueError):
+        sys.stderr.write(f"lookdev: warning: {message}\n")
+        sys.stderr.flush()
 
 
 @contextlib.contextmanager
@@ -247,10 +303,27 @@ def _well_typed(e: list[Any]) -> bool:
     )
 
 
+def index_file(folder: Path) -> Path:
+    """Where ``folder``'s header cache lives: inside it, or under ``$LOOKDEV_CACHE``.
+
+    A library that cannot be written (a read-only mount, a shared folder without write
+    permission) is used read-only: its cache goes to ``$LOOKDEV_CACHE/index/``, keyed by the
+    folder's real path, so every user and every link to it share one entry per machine.
+    """
+    if os.access(folder, os.W_OK | os.X_OK):
+        return folder / INDEX_NAME
+    return read_only_index_file(folder)
+
+
+def read_only_index_file(folder: Path) -> Path:
+    key = hashlib.sha256(os.fsencode(os.path.realpath(folder))).hexdigest()[:32]
+    return files.cache_root() / "index" / f"{key}.json"
+
+
 def _read_index(folder: Path) -> dict[str, list[Any]]:
     """``{relative path: [path, mtime_ns, size, inode, *header]}`` from the index, or ``{}``."""
     try:
-        doc = json.loads((folder / INDEX_NAME).read_bytes())
+        doc = json.loads(index_file(folder).read_bytes())
         if doc.get("version") != INDEX_VERSION:
             return {}
         return {e[0]: e for e in doc["entries"]}
@@ -262,15 +335,22 @@ def _write_index(folder: Path, found: list[tuple], headers: list[Header]) -> Non
     """Store the stats and headers of settled files, one flat list per file."""
     settled = time.time_ns() - int(RACY_S * 1e9)
     entries = [
-        [*stat, h.name, h.model, h.description, list(h.tags), h.extends, h.error]
-        for stat, h in zip(found, headers, strict=True)
-        if stat[1] < settled
+        [*st, h.name, h.model, h.description, list(h.tags), h.extends, h.error]
+        for st, h in zip(found, headers, strict=True)
+        if st[1] < settled
     ]
     data = json.dumps({"version": INDEX_VERSION, "entries": entries}, separators=(",", ":"))
-    tmp = folder / f"{INDEX_NAME}.{os.getpid()}.tmp"
+    target = index_file(folder)
     try:
-        tmp.write_text(data, encoding="utf-8")
-        os.replace(tmp, folder / INDEX_NAME)
-    except OSError:
-        # A read-only library (an installed wheel, a shared mount) just lists uncached.
-        tmp.unlink(missing_ok=True)
+        if target.parent != folder:
+            target.parent.mkdir(parents=True, exist_ok=True)
+        files.atomic_write(target, data)
+        return
+    except (files.WriteError, OSError):
+        pass  # root on a chmod-0555 folder passes os.access, a read-only mount does not
+    # The folder refused: the library is read-only, so the cache goes under $LOOKDEV_CACHE.
+    with contextlib.suppress(files.WriteError, OSError):
+        cached = read_only_index_file(folder)
+        if cached != target:
+            cached.parent.mkdir(parents=True, exist_ok=True)
+            files.atomic_write(cached, data)

@@ -181,6 +181,9 @@ class Library:
         target = self.target(folder)
         self._refuse_builtin(target, preset.name)
         store.make_folder(target)
+        _refuse_read_only(target)
+        path = self._find_in(target, preset.name) or target / f"{preset.name}{SUFFIX}"
+        refuse_links_out(path, target)
         with store.locked(target):
             path = self._find_in(target, preset.name)
             if path is not None and not force:
@@ -189,6 +192,7 @@ class Library:
                     where=str(target),
                 )
             path = path or target / f"{preset.name}{SUFFIX}"
+            refuse_links_out(path, target)
             self._write(preset, path)
         return path
 
@@ -200,7 +204,9 @@ class Library:
         """
         path = self.find(name)
         self._refuse_builtin(path, name)
-        with store.locked(_library_root(path, self.user_folders)):
+        root = self._writable_root(path)
+        with store.locked(root):
+            refuse_links_out(path, root)
             preset = read_preset(path)
             self._write(apply_changes(preset, changes, where=str(path)), path)
         return path
@@ -215,8 +221,10 @@ class Library:
                 f"{', '.join(users)} build on {name!r}; pass --force to remove it anyway",
                 where=str(path),
             )
-        with store.locked(_library_root(path, self.user_folders)):
-            store.remove(path)
+        root = self._writable_root(path)
+        with store.locked(root):
+            refuse_links_out(path, root)
+            store.remove(path)  # a link (inside the library) is removed, not its target
         return path
 
     def dependants(self, name: str) -> list[str]:
@@ -287,6 +295,21 @@ class Library:
 
         return lookup
 
+    def read_through(self, path: Path) -> list[tuple[Path, Path]]:
+        """The symlinks (and where they lead) a preset file is read through, below the root
+        of the library holding it (for a file outside the path: the file itself)."""
+        plain = Path(os.path.abspath(path))
+        root = next((f for f in self.folders if plain.is_relative_to(os.path.abspath(f))), None)
+        return links_on_the_way(path, root if root is not None else plain.parent)
+
+    def _writable_root(self, path: Path) -> Path:
+        """The library folder holding ``path``, checked to lead nowhere outside and to be
+        writable, before its lock is taken (so no ``.lookdev.lock`` lands outside)."""
+        root = _library_root(path, self.user_folders)
+        refuse_links_out(path, root)
+        _refuse_read_only(root)
+        return root
+
     def _refuse_builtin(self, path: Path, name: str) -> None:
         if self.builtin is not None and path.resolve().is_relative_to(self.builtin.resolve()):
             raise LibraryError(
@@ -351,8 +374,61 @@ def _with_model(h: Header, winners: dict[str, Header]) -> Header:
 
 
 def _library_root(path: Path, folders: Sequence[Path]) -> Path:
+    """The library folder ``path`` was found in: by its path as written (a link inside the
+    library may lead elsewhere), else by its real path, else its own folder."""
+    plain = Path(os.path.abspath(path))
+    for f in folders:
+        if plain.is_relative_to(os.path.abspath(f)):
+            return f
     resolved = path.resolve()
     return next((f for f in folders if resolved.is_relative_to(f.resolve())), path.parent)
+
+
+def links_on_the_way(path: Path, root: Path | None = None) -> list[tuple[Path, Path]]:
+    """``(link, where it leads)`` for each symlink ``path`` is reached through below ``root``
+    (default: every component of ``path``), the file itself included."""
+    plain = Path(os.path.abspath(path))
+    base = Path(os.path.abspath(root)) if root is not None else Path(plain.anchor)
+    if not plain.is_relative_to(base):
+        return []
+    out, here = [], base
+    for part in plain.relative_to(base).parts:
+        here = here / part
+        if here.is_symlink():
+            out.append((here, Path(os.path.realpath(here))))
+    return out
+
+
+def refuse_links_out(path: Path, root: Path) -> None:
+    """Refuse a write or delete at ``path`` through a symlink that leads out of ``root``.
+
+    The rule (DESIGN.md, Files on shared storage): a library never writes or deletes
+    through a link out of its root; reads may. A link to a file *inside* the root is
+    edited in place: the write goes through to its target and the link stays a link;
+    ``presets rm`` removes the link itself. The root folder may itself be a link.
+    """
+    real_root = Path(os.path.realpath(root))
+    for link, dest in links_on_the_way(path, root):
+        if not dest.is_relative_to(real_root):
+            raise LibraryError(
+                f"refusing to write through {link}: it is a symlink that leads out of the "
+                f"library to {dest}",
+                where=str(root),
+            )
+
+
+def _refuse_read_only(root: Path) -> None:
+    """A library folder this process cannot write is used read-only: say so, in one line."""
+    if root.is_dir() and not os.access(root, os.W_OK | os.X_OK):
+        reason = "Read-only file system" if _on_read_only_mount(root) else "Permission denied"
+        raise store.read_only(root, reason)
+
+
+def _on_read_only_mount(folder: Path) -> bool:
+    try:
+        return bool(os.statvfs(folder).f_flag & os.ST_RDONLY)
+    except (OSError, AttributeError):
+        return False
 
 
 def _layer_refs(path: Path, name: str) -> bool:

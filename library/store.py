@@ -4,7 +4,9 @@ A reader never sees a half-written preset: the new bytes go to a hidden temporar
 beside the target, are flushed to disk, and replace the target in one ``os.replace``
 (atomic on POSIX and Windows), after which the folder entry itself is flushed. A process
 killed at any point leaves either the old file or the new one, plus at worst a stale
-hidden ``.NAME.toml.PID.tmp`` that listing ignores and the next locked write removes.
+hidden ``.NAME.toml.HOST-PID-TOKEN.tmp.toml`` that listing ignores and the next locked
+write removes. Modes, links and signals follow :mod:`lookdev.library.files`, the one write
+path.
 
 Two processes writing into one library serialise on ``.lookdev.lock`` (``filelock``),
 so a read-modify-write (``presets set``) or a check-then-create (``presets new``) never
@@ -24,6 +26,7 @@ from pathlib import Path
 
 from filelock import FileLock, Timeout
 
+from . import files
 from .errors import LibraryError
 
 LOCK_NAME = ".lookdev.lock"
@@ -54,34 +57,33 @@ def locked(folder: Path) -> Iterator[None]:
 
 def _remove_stale_temporaries(folder: Path) -> None:
     """Temporaries of killed saves: every writer holds the lock, so none is in use now."""
-    for tmp in folder.glob(".*.toml.*.tmp"):
-        tmp.unlink(missing_ok=True)
+    with contextlib.suppress(OSError):
+        for tmp in folder.glob(".*.toml.*.tmp.toml"):
+            if files.is_temporary(tmp.name):
+                files.remove_quietly(tmp)
 
 
 def atomic_write(path: Path, data: bytes) -> None:
-    """Replace ``path`` with ``data`` so that readers see the old or the new file, never half."""
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    """Replace ``path`` with ``data`` so that readers see the old or the new file, never half.
+
+    The write path is :mod:`lookdev.library.files` (modes, links, signals); here a refusal
+    becomes the library's one-line error.
+    """
     try:
-        with open(tmp, "wb") as f:
-            f.write(data)
-            f.flush()
-            os.fsync(f.fileno())
-        _test_pause()
-        os.replace(tmp, path)
-        _fsync_folder(path.parent)
-    except OSError as exc:
-        tmp.unlink(missing_ok=True)
-        raise unwritable(path.parent, exc) from None
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+        with files.Transaction() as t:
+            tmp = t.temp_for(path)
+            with open(tmp, "wb") as f:
+                f.write(data)
+            _test_pause()
+    except files.WriteError as exc:
+        raise LibraryError(exc.message) from None
 
 
 def remove(path: Path) -> None:
     """Delete one preset file, durably."""
     try:
         path.unlink()
-        _fsync_folder(path.parent)
+        files.fsync_folder(str(path.parent))
     except OSError as exc:
         raise unwritable(path.parent, exc) from None
 
@@ -97,21 +99,21 @@ def make_folder(folder: Path) -> None:
 def unwritable(folder: Path, exc: OSError) -> LibraryError:
     """The one-line error for a library folder that refuses a write."""
     reason = exc.strerror or type(exc).__name__
+    if exc.errno in files.READ_ONLY_ERRNOS:
+        return read_only(folder, reason)
     return LibraryError(
         f"cannot write to this library ({reason}); choose a writable folder with --library",
         where=str(folder),
     )
 
 
-def _fsync_folder(folder: Path) -> None:
-    # The rename is durable only once the directory entry is on disk (POSIX; no-op elsewhere).
-    if os.name != "posix":
-        return
-    fd = os.open(folder, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
+def read_only(folder: Path, reason: str = "not writable") -> LibraryError:
+    """The one-line error for a write to a library that can only be read."""
+    return LibraryError(
+        f"cannot write to this library: it is read-only ({reason}); "
+        "choose a writable folder with --library",
+        where=str(folder),
+    )
 
 
 def _test_pause() -> None:

@@ -153,6 +153,10 @@ the report and the stability sweep."""
 PRESET_WRITERS = ("lookdev.pipeline.export.usd.presets",)
 """`lookdev import usd` writes what it read as preset files: the one consumer that needs
 the library, and only to write presets, never to look materials up."""
+WRITE_PATH = "lookdev.library.files"
+"""The one write path (atomic, modes, links, signals): every consumer writes through it.
+It lives in ``library`` (which ``materials``, doing no I/O, cannot hold) and imports nothing
+of the library but the error root, so using it looks no preset up."""
 
 
 def test_consumers_never_look_presets_up(graph):
@@ -162,8 +166,19 @@ def test_consumers_never_look_presets_up(graph):
         if not any(
             line.startswith(str(source_files()[m].relative_to(ROOT))) for m in PRESET_WRITERS
         )
+        and not line.endswith(f"imports {WRITE_PATH}")
     ]
     assert not bad, "exporters, proofs and analysis take the blend, not presets:\n" + "\n".join(bad)
+
+
+def test_the_write_path_imports_nothing_of_the_library(graph):
+    bad = [
+        str(e)
+        for e in graph
+        if e.source == WRITE_PATH and e.target.startswith("lookdev.") and e.target != WRITE_PATH
+        if e.target != "lookdev.materials.errors"
+    ]
+    assert not bad, "library/files.py must stay generic:\n" + "\n".join(bad)
 
 
 def test_consumers_never_blend():

@@ -30,6 +30,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from lookdev.library import files  # noqa: E402
 from lookdev.materials.bsdf import Model, evaluate  # noqa: E402
 from lookdev.materials.colour import luminance  # noqa: E402
 from lookdev.materials.errors import LookdevError  # noqa: E402
@@ -309,11 +310,9 @@ def save_figure(fig: Any, path: str | Path) -> Path:
     """Write the figure atomically (temporary file, then rename) and close it."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.stem}.tmp{path.suffix}")
     try:
-        fig.savefig(tmp, dpi=110)
-        tmp.replace(path)
+        with files.atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=110)
     finally:
         plt.close(fig)
-        tmp.unlink(missing_ok=True)
     return path

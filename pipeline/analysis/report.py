@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from lookdev.library import files
 from lookdev.materials.errors import LookdevError
 
 REPORT_DIR = "report"
@@ -210,10 +211,9 @@ def web_image(src: Path, out_dir: Path, exposure: float = 0.0) -> Path:
     dst.parent.mkdir(parents=True, exist_ok=True)
     out = oiio.ImageBuf(oiio.ImageSpec(img.shape[1], img.shape[0], 3, oiio.UINT8))
     out.set_pixels(oiio.ROI(), img)
-    tmp = dst.with_name(f".{dst.name}")
-    if not out.write(str(tmp)):
-        raise ReportError(f"cannot write thumbnail: {out.geterror()}", where=str(dst))
-    tmp.replace(dst)
+    with files.atomic_path(dst) as tmp:
+        if not out.write(str(tmp)):
+            raise ReportError(f"cannot write thumbnail: {out.geterror()}", where=str(dst))
     return dst
 
 
@@ -353,7 +353,4 @@ def write_report(
     made = material_plots(names, materials or {}, out, entries[0].ibl) if plots else {}
     page = render_page(batch_dir, entries, contact_sheets(batch_dir), made)
     index = batch_dir / "index.html"
-    tmp = index.with_name(".index.html.tmp")
-    tmp.write_text(page, encoding="utf-8")
-    tmp.replace(index)
-    return index
+    return files.atomic_write(index, page)

@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from lookdev.library import files
 from lookdev.materials import sheen
 from lookdev.materials.arrays import NumpyOps
 
@@ -171,7 +172,7 @@ def write_albedo_module(path: Path, tables: np.ndarray, errors: list[FitError]) 
         f"{errors[0]};\nwith softening:\n{errors[1]}.\n"
         f'"""\n\nN_MU = {n_mu}\nN_R = {n_r}\n# fmt: off\nVALUES = (\n{lines}\n)\n# fmt: on\n'
     )
-    Path(path).write_text(text)
+    files.atomic_write(path, text)
 
 
 TABLE_SHAPE = (64, 32)  # (μ, r) nodes: chosen by albedo_table_error, see sheen_albedo

@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from lookdev.library import files
 from lookdev.materials.bsdf import Model
 from lookdev.materials.errors import LookdevError
 
@@ -315,9 +316,7 @@ def write_outputs(report: Report, settings: Settings, out_dir: Path) -> dict[str
     """``error_bench.json`` and ``error_bench.png`` in ``out_dir``, each written whole."""
     out_dir.mkdir(parents=True, exist_ok=True)
     js = out_dir / "error_bench.json"
-    tmp = js.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(report.to_json(settings), indent=2) + "\n")
-    tmp.replace(js)
+    files.atomic_write(js, json.dumps(report.to_json(settings), indent=2) + "\n")
     return {"json": js, "plot": plot_error_vs_time(report, out_dir / "error_bench.png")}
 
 

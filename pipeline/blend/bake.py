@@ -10,8 +10,9 @@ Files are written the way images are viewed, top row first: the top row of each 
 v = 1 (the UsdUVTexture and OpenImageIO convention), so UV (0, 0) is the bottom-left.
 Reading one back with :func:`.resample.read_channels` gives the map in UV order again.
 
-Nothing is half-written: every file goes to a temporary folder beside the output first
-and is renamed into place only when all were written; the sidecar is renamed last, so a
+Nothing is half-written: every file goes to a temporary beside its destination first
+(:class:`lookdev.library.files.Transaction`, the one write path) and is renamed into place
+only when all were written; the sidecar is renamed last, so a
 sidecar on disk always describes files that are complete. Map files listed by an older
 sidecar of the same material and not written now are removed (they no longer vary).
 """
@@ -19,15 +20,14 @@ sidecar of the same material and not written now are removed (they no longer var
 from __future__ import annotations
 
 import json
-import os
-import shutil
-import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import OpenImageIO as oiio
+
+from lookdev.library import files
 
 from .errors import BlendError
 from .result import BlendedMaterial
@@ -44,30 +44,29 @@ def bake(
     """Write the maps and the sidecar; returns ``{map name: path, "sidecar": path}``."""
     out_dir = Path(out_dir)
     try:
+        created = not out_dir.exists()
         out_dir.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise BlendError(f"cannot create {out_dir}: {exc.strerror}", where=blended.name) from None
     arrays = blended.arrays
-    files = {name: f"{blended.name}_{name}.exr" for name in arrays}
+    names = {name: f"{blended.name}_{name}.exr" for name in arrays}
     sidecar = out_dir / f"{blended.name}.json"
-    stale = _listed_files(sidecar) - set(files.values())
-    tmp = Path(tempfile.mkdtemp(prefix=f".{blended.name}-", dir=out_dir))
-    try:
+    stale = _listed_files(sidecar) - set(names.values())
+    with files.Transaction() as staged:  # renamed into place together, the sidecar last
+        if created:
+            staged.created.append(out_dir)  # a failed first bake leaves no empty folder
         for i, (name, array) in enumerate(arrays.items()):
-            _write_exr(tmp / files[name], _encode(name, array), blended.name)
+            final = out_dir / names[name]
+            _write_exr(staged.temp_for(final), _encode(name, array), blended.name, final)
             if progress is not None:
                 progress(i + 1, len(arrays) + 1)
-        (tmp / sidecar.name).write_text(json.dumps(sidecar_dict(blended, files), indent=2))
-        for name in files.values():
-            os.replace(tmp / name, out_dir / name)
-        os.replace(tmp / sidecar.name, sidecar)
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+        text = json.dumps(sidecar_dict(blended, names), indent=2)
+        staged.temp_for(sidecar).write_text(text, encoding="utf-8")
     for name in stale:
-        (out_dir / name).unlink(missing_ok=True)
+        files.remove_quietly(out_dir / name)
     if progress is not None:
         progress(len(arrays) + 1, len(arrays) + 1)
-    return {**{name: out_dir / f for name, f in files.items()}, "sidecar": sidecar}
+    return {**{name: out_dir / f for name, f in names.items()}, "sidecar": sidecar}
 
 
 def sidecar_dict(blended: BlendedMaterial, files: dict[str, str]) -> dict[str, Any]:
@@ -104,7 +103,7 @@ def _encode(name: str, array: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(array[::-1], dtype=np.float32)
 
 
-def _write_exr(path: Path, pixels: np.ndarray, where: str) -> None:
+def _write_exr(path: Path, pixels: np.ndarray, where: str, final: Path) -> None:
     height, width, channels = pixels.shape
     spec = oiio.ImageSpec(width, height, channels, oiio.FLOAT)
     spec.channelnames = ("Y",) if channels == 1 else ("R", "G", "B")
@@ -115,7 +114,8 @@ def _write_exr(path: Path, pixels: np.ndarray, where: str) -> None:
     if out is not None:
         out.close()
     if not ok:
-        raise BlendError(f"cannot write {path.name}: {message or 'unknown error'}", where=where)
+        reason = files.failure_reason(path, message or "unknown error")
+        raise BlendError(f"cannot write {final}: {reason}", where=where)
 
 
 def _listed_files(sidecar: Path) -> set[str]:

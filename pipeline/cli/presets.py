@@ -135,11 +135,13 @@ def show(
     explicit = name.endswith(".toml")
     others = [] if explicit else [p for p in lib.definitions(preset.name) if p != path]
     material = lib.load_file(path) if resolved else None
+    links = lib.read_through(path)
     if as_json:
         doc: dict[str, Any] = {
             "name": preset.name,
             "file": str(path),
             "shadows": [str(p) for p in others],
+            "read_through_links": {str(k): str(v) for k, v in links},
         }
         doc["preset"] = preset_document(preset)
         if material is not None:
@@ -149,6 +151,8 @@ def show(
     console.print(f"[bold]{preset.name}[/] from {path}", highlight=False)
     for p in others:
         console.print(f"  shadows {p}", style="dim", highlight=False)
+    for link, dest in links:
+        console.print(f"  read through the symlink {link} -> {dest}", style="dim", highlight=False)
     if material is None:
         text = path.read_text(encoding="utf-8")
         console.print(Syntax(text, "toml", theme="ansi_dark", word_wrap=True))

@@ -38,6 +38,7 @@ from typing import Any
 
 import numpy as np
 
+from lookdev.library import files
 from lookdev.materials.errors import LookdevError
 
 from . import contact, tonemap
@@ -136,10 +137,8 @@ def frames_done(job: Job) -> int:
 
 
 def write_json(doc: dict[str, Any], path: Path) -> None:
-    """Write ``doc`` as JSON atomically (a temporary name, then a rename)."""
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.write_text(json.dumps(doc, indent=2) + "\n", encoding="utf-8")
-    os.replace(tmp, path)
+    """Write ``doc`` as JSON atomically (:mod:`lookdev.library.files`, the one write path)."""
+    files.atomic_write(path, json.dumps(doc, indent=2) + "\n")
 
 
 # -- one job (runs in a worker) ------------------------------------------------------------
@@ -340,11 +339,15 @@ def _result(fut: Future, job: Job) -> dict[str, Any]:
         raise
     except Exception as exc:  # noqa: BLE001 - any worker crash is reported the same way
         log = job.folder / "error.log"
-        job.folder.mkdir(parents=True, exist_ok=True)
-        log.write_text("".join(traceback.format_exception(exc)), encoding="utf-8")
         first = str(exc).splitlines()[0] if str(exc) else ""
+        try:
+            job.folder.mkdir(parents=True, exist_ok=True)
+            files.atomic_write(log, "".join(traceback.format_exception(exc)))
+            where_log = f"traceback in {log}"
+        except (OSError, files.WriteError) as log_exc:  # a full disk: no half-written log
+            where_log = f"its traceback could not be saved ({getattr(log_exc, 'message', log_exc)})"
         raise ProofError(
-            f"rendering failed ({type(exc).__name__}: {first}); traceback in {log}",
+            f"rendering failed ({type(exc).__name__}: {first}); {where_log}",
             where=f"{job.material.name} × {job.ibl}",
         ) from None
 

@@ -8,19 +8,16 @@ still labels every frame, so a sheet is never unlabelled.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from lookdev.library import files
 from lookdev.materials.errors import LookdevError
 
 BACKGROUND = 0.08
 TEXT = (0.92, 0.92, 0.92)
 GAP = 4
-_UMASK = os.umask(0o022)
-os.umask(_UMASK)
 
 # 3×5 glyphs, rows top to bottom, '#' = ink. Lower case is drawn as upper case.
 _GLYPHS = {
@@ -144,20 +141,19 @@ def _atomic_write(path: Path, suffix: str, write) -> Path:
     path = Path(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(suffix=suffix, prefix=f".{path.stem}.", dir=path.parent)
-        os.close(fd)
+        with files.atomic_path(path) as tmp:  # the one write path: modes, signals, cleanup
+            error = write(str(tmp))
+            if error is not None:
+                raise ProofImageError(f"cannot write: {_first_line(error)}", where=str(path))
     except OSError as exc:
         raise ProofImageError(f"cannot write ({exc.strerror})", where=str(path)) from None
-    try:
-        error = write(tmp)
-        if error is not None:
-            raise ProofImageError(f"cannot write: {error}", where=str(path))
-        os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp makes 0600; a frame is a normal file
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    except files.WriteError as exc:
+        raise ProofImageError(exc.message) from None
     return path
+
+
+def _first_line(text: str) -> str:
+    return next((line for line in str(text).splitlines() if line.strip()), "unknown error")
 
 
 def write_exr(pixels: np.ndarray, path: Path) -> Path:

@@ -15,13 +15,13 @@ from __future__ import annotations
 
 import hashlib
 import math
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from lookdev.library import files
 
 from .ibl import cache_dir
 
@@ -125,11 +125,7 @@ def write_ply(mesh: MeshData, path: Path) -> Path:
     faces = np.zeros(f, dtype=[("n", "u1"), ("i", "<u4", 3)])
     faces["n"], faces["i"] = 3, mesh.faces
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(suffix=".ply", prefix=f".{path.stem}.", dir=path.parent)
-    with os.fdopen(fd, "wb") as out:
-        out.write(header.encode("ascii") + vertices.tobytes() + faces.tobytes())
-    os.replace(tmp, path)
-    return path
+    return files.atomic_write(path, header.encode("ascii") + vertices.tobytes() + faces.tobytes())
 
 
 def cup_ply() -> Path:

@@ -53,7 +53,7 @@ def test_sigkill_in_the_middle_of_a_save_leaves_the_old_file(tmp_path):
     proc = start(CLI, "presets", "set", "mine", "roughness=0.9", "-L", str(tmp_path), pause=60)
 
     def new_bytes_are_on_disk() -> bool:
-        tmps = list(tmp_path.glob(".mine.toml.*.tmp"))
+        tmps = list(tmp_path.glob(".mine.toml.*.tmp.toml"))
         return bool(tmps) and b"roughness = 0.9" in tmps[0].read_bytes()
 
     wait_for(new_bytes_are_on_disk, proc)
@@ -64,10 +64,10 @@ def test_sigkill_in_the_middle_of_a_save_leaves_the_old_file(tmp_path):
     assert lib.load("mine").params.roughness == 0.3
     # The stale temporary is invisible, and the dead process's lock does not block.
     assert lib.names().count("mine") == 1 and "mine" in lib.names()
-    assert list(tmp_path.glob(".mine.toml.*.tmp"))
+    assert list(tmp_path.glob(".mine.toml.*.tmp.toml"))
     lib.update("mine", {"roughness": 0.5})
     assert lib.load("mine").params.roughness == 0.5
-    assert not list(tmp_path.glob(".mine.toml.*.tmp"))  # the next locked write cleans up
+    assert not list(tmp_path.glob(".mine.toml.*.tmp.toml"))  # the next locked write cleans up
 
 
 KEYS = {
@@ -116,7 +116,7 @@ def test_two_processes_saving_into_one_library_lose_nothing(tmp_path):
     # The same new name from both: exactly one wins, the other is refused, never clobbered.
     verdicts = sorted(out.strip().split(":")[0] for out, _ in outs)
     assert verdicts == ["refused dup", "saved dup"], outs
-    assert not list(tmp_path.glob(".*.tmp"))
+    assert not list(tmp_path.glob(".*.tmp*"))
 
 
 FLIPPER = textwrap.dedent(

@@ -15,14 +15,13 @@ texel (0, 0) is UV (0, 0), so maps go to Mitsuba row for row, in memory and in E
 from __future__ import annotations
 
 import math
-import os
-import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from lookdev.library import files
 from lookdev.materials import registry
 from lookdev.materials.pixar import GRAZING
 from lookdev.materials.registry import is_color_field
@@ -210,26 +209,19 @@ def write_exr(data: np.ndarray, path: Path) -> Path:
     path = Path(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(suffix=".exr", prefix=f".{path.stem}.", dir=path.parent)
-        os.close(fd)
     except OSError as exc:
         raise MitsubaExportError(
             f"cannot write textures: {exc.strerror}", where=str(path)
         ) from None
     spec = oiio.ImageSpec(data.shape[1], data.shape[0], data.shape[2], oiio.FLOAT)
-    out = oiio.ImageOutput.create(tmp)
-    try:
-        ok = out is not None and out.open(tmp, spec) and out.write_image(data)
+    with files.atomic_path(path) as tmp:
+        out = oiio.ImageOutput.create(str(tmp))
+        ok = out is not None and out.open(str(tmp), spec) and out.write_image(data)
         if out is not None:
             out.close()
         if not ok:
-            raise MitsubaExportError(
-                f"OpenImageIO could not write it: {oiio.geterror()}", where=str(path)
-            )
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+            reason = files.failure_reason(tmp, oiio.geterror())
+            raise MitsubaExportError(f"cannot write: {reason}", where=str(path))
     return path
 
 

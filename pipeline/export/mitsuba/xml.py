@@ -9,12 +9,14 @@ leaves no half-written scene behind.
 
 from __future__ import annotations
 
+import contextlib
 import os
-import tempfile
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
+
+from lookdev.library import files
 
 from .plugin import PLUGIN_PREFIX, MitsubaExportError
 from .scene import scene_dict, uses_our_plugins
@@ -144,8 +146,15 @@ def export_scene(material: Any, path: str | Path, **scene_options: Any) -> dict[
     path = Path(path)
     _check_writable(path.parent)
     textures = path.parent.resolve() / f"{path.stem}_textures"
-    scene = scene_dict(material, texture_dir=textures, **scene_options)
-    write_xml(scene, path)
+    existed = textures.exists()
+    try:
+        scene = scene_dict(material, texture_dir=textures, **scene_options)
+        write_xml(scene, path)
+    except BaseException:
+        if not existed:  # a failed export leaves no empty textures folder behind
+            with contextlib.suppress(OSError):
+                textures.rmdir()
+        raise
     return scene
 
 
@@ -162,11 +171,4 @@ def _check_writable(folder: Path) -> None:
 
 def _atomic_write(path: Path, text: str) -> None:
     _check_writable(path.parent)
-    fd, tmp = tempfile.mkstemp(suffix=".xml", prefix=f".{path.stem}.", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    files.atomic_write(path, text)

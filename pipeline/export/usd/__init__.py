@@ -8,11 +8,11 @@ Importing this package does not import ``pxr``: :func:`export_materials` does.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import Any
+
+from lookdev.library import files
 
 __all__ = ["export_materials"]
 
@@ -47,7 +47,9 @@ def export_materials(
     contexts = tuple(contexts) if contexts else CONTEXTS
     out = Path(out).expanduser()
     package = package or out.suffix == ".usdz"
-    with tempfile.TemporaryDirectory(prefix=".lookdev-bake-", dir=_existing(out)) as scratch:
+    # Scratch beside the output (same filesystem); removed on errors, Ctrl-C and SIGTERM,
+    # and swept by the next export when a SIGKILL left it (lookdev.library.files).
+    with files.scratch_folder(out.parent) as scratch:
         textures = f"{out.stem}_textures"
         texture_dir = Path(scratch, textures) if package else out.parent / textures
         sources = []
@@ -64,8 +66,3 @@ def export_materials(
             split_dir=None if split is None else Path(split),
             workdir=Path(scratch),
         )
-
-
-def _existing(out: Path) -> str | None:
-    """The output's folder if it exists (scratch space beside it), else the system temp."""
-    return str(out.parent) if out.parent.is_dir() and os.access(out.parent, os.W_OK) else None

@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
+from lookdev.library import files
+
 from .names import Slot
 from .network import ExportError, Image
 
@@ -32,7 +34,7 @@ def converted(image: Image, slot: Slot) -> Image:
     return Image(path, out.astype(np.float32), write=True)
 
 
-def write_image(path: Path, pixels: np.ndarray) -> None:
+def write_image(path: Path, pixels: np.ndarray, shown: Path | None = None) -> None:
     """Write float32 ``pixels`` ((H, W) or (H, W, C), row 0 = top) as an EXR."""
     import OpenImageIO as oiio
 
@@ -41,9 +43,13 @@ def write_image(path: Path, pixels: np.ndarray) -> None:
     spec = oiio.ImageSpec(px.shape[1], px.shape[0], channels, oiio.FLOAT)
     out = oiio.ImageOutput.create(str(path))
     if out is None or not out.open(str(path), spec):
-        raise ExportError(f"cannot write {path}: {oiio.geterror()}")
+        raise ExportError(
+            f"cannot write {shown or path}: {files.failure_reason(path, oiio.geterror())}"
+        )
     try:
-        if not out.write_image(px):
-            raise ExportError(f"cannot write {path}: {out.geterror()}")
+        ok = out.write_image(px)
+        message = "" if ok else out.geterror()
     finally:
         out.close()
+    if not ok:
+        raise ExportError(f"cannot write {shown or path}: {files.failure_reason(path, message)}")

@@ -17,6 +17,8 @@ from typing import Any
 
 from pxr import Gf, Sdf
 
+from lookdev.library import files
+
 from . import mtlx, preview, ri
 from .network import (
     CONTEXT_OUTPUT,
@@ -166,39 +168,9 @@ def add_switch(layer, targets: dict[str, tuple[str, str]]) -> None:
         look.variantSelections["preset"] = next(iter(targets))
 
 
-@dataclass
-class Staging:
-    """Files written under temporary names, renamed into place together on commit."""
-
-    moves: list[tuple[Path, Path]] = field(default_factory=list)
-    created: list[Path] = field(default_factory=list)
-
-    def folder(self, path: Path) -> None:
-        """Create ``path`` (and parents) if missing; an abort removes what it created."""
-        missing = [p for p in (path, *path.parents) if not p.exists()]
-        path.mkdir(parents=True, exist_ok=True)
-        self.created += reversed(missing)
-
-    def temp_for(self, final: Path) -> Path:
-        fd, name = tempfile.mkstemp(prefix=f".{final.stem}.", suffix=final.suffix, dir=final.parent)
-        os.close(fd)
-        tmp = Path(name)
-        self.moves.append((tmp, final))
-        return tmp
-
-    def commit(self) -> None:
-        for tmp, final in self.moves:
-            os.replace(tmp, final)
-        self.moves.clear()
-
-    def abort(self) -> None:
-        for tmp, _ in self.moves:
-            tmp.unlink(missing_ok=True)
-        for folder in reversed(self.created):
-            if folder.is_dir() and not any(folder.iterdir()):
-                folder.rmdir()
-        self.moves.clear()
-        self.created.clear()
+class Staging(files.Transaction):
+    """Files written under temporary names, renamed into place together on commit: the one
+    write path's transaction (:class:`lookdev.library.files.Transaction`)."""
 
 
 def check_writable(path: Path) -> None:
@@ -299,20 +271,17 @@ def export_usd(
     _check_names(specs, out)
     images = images_of(specs)
     check_images(images)
-    staging = Staging()
-    try:
+    with Staging() as staging:  # commits on success; removes every temporary otherwise
         if package:
-            files = _write_package(specs, images, out, Path(workdir or out.parent), staging)
+            written = _write_package(specs, images, out, Path(workdir or out.parent), staging)
         else:
-            files = _write_all(specs, images, out, split_dir, staging)
+            written = _write_all(specs, images, out, split_dir, staging)
         if mtlx_path is not None:
             mtlx.write_document(specs, staging.temp_for(Path(mtlx_path)), where=mtlx_path)
-            files.append(Path(mtlx_path))
-        staging.commit()
-    except BaseException:
-        staging.abort()
-        raise
-    return ExportResult(files, [s.name for s in specs], [i.path for i in images], losses_of(specs))
+            written.append(Path(mtlx_path))
+    return ExportResult(
+        written, [s.name for s in specs], [i.path for i in images], losses_of(specs)
+    )
 
 
 def _check_names(specs: list[MaterialSpec], out: Path) -> None:
@@ -333,13 +302,13 @@ def _write_all(specs, images, out, split_dir, staging) -> list[Path]:
     for image in images:
         if image.write:
             staging.folder(image.path.parent)
-            _write_image(image, staging.temp_for(image.path))
+            _write_image(image, staging.temp_for(image.path), image.path)
     files = [out, *(i.path for i in images if i.write)]
     if split_dir is not None:
         staging.folder(Path(split_dir))
         return files + _write_split(specs, out, Path(split_dir), staging)
     layer = _one_layer(specs, out.parent)
-    _export_layer(layer, staging.temp_for(out))
+    _export_layer(layer, staging.temp_for(out), out)
     return files
 
 
@@ -374,11 +343,11 @@ def _one_layer(specs: list[MaterialSpec], base: Path):
     return layer
 
 
-def _write_image(image: Image, target: Path) -> None:
+def _write_image(image: Image, target: Path, shown: Path | None = None) -> None:
     if image.origin is not None:
         shutil.copyfile(image.origin, target)
     else:
-        write_image(target, image.pixels)
+        write_image(target, image.pixels, shown)
 
 
 def _write_split(specs, out: Path, folder: Path, staging: Staging) -> list[Path]:
@@ -391,17 +360,24 @@ def _write_split(specs, out: Path, folder: Path, staging: Staging) -> list[Path]
         path = folder / f"{name}.usda"
         layer = new_layer()
         (prim_path,) = author(layer, [spec], folder)
-        _export_layer(layer, staging.temp_for(path))
+        _export_layer(layer, staging.temp_for(path), path)
         asset = relative_asset(path, out.parent)
         ref = Sdf.PrimSpec(scope, name, Sdf.SpecifierDef, "Material")
         ref.referenceList.prependedItems.append(Sdf.Reference(asset, Sdf.Path(prim_path)))
         targets[name] = (asset, prim_path)
         files.append(path)
     add_switch(library, targets)
-    _export_layer(library, staging.temp_for(out))
+    _export_layer(library, staging.temp_for(out), out)
     return files
 
 
-def _export_layer(layer, path: Path) -> None:
-    if not layer.Export(str(path)):
-        raise ExportError("USD could not write the layer", where=str(path))
+def _export_layer(layer, path: Path, shown: Path | None = None) -> None:
+    from pxr import Tf
+
+    try:
+        ok, message = layer.Export(str(path)), ""
+    except Tf.ErrorException as exc:  # a full disk, a vanished folder
+        ok, message = False, str(exc)
+    if not ok:
+        reason = files.failure_reason(path, message)
+        raise ExportError(f"USD could not write the layer: {reason}", where=str(shown or path))

@@ -86,16 +86,21 @@ def test_a_failing_write_leaves_nothing_half_written(tmp_path, monkeypatch):
     real = bake_module._write_exr
     calls = []
 
-    def flaky(path, pixels, where):
+    def flaky(path, pixels, where, final):
         calls.append(path)
         if len(calls) == 3:
             raise BlendError("disk full", where=where)
-        real(path, pixels, where)
+        real(path, pixels, where, final)
 
     monkeypatch.setattr(bake_module, "_write_exr", flaky)
     with pytest.raises(BlendError, match="disk full"):
         bake(blended, out)
-    assert list(out.iterdir()) == []  # no maps, no sidecar, no temporary folder
+    assert not out.exists()  # no maps, no sidecar, no temporary, not even the new folder
+    out.mkdir()
+    with pytest.raises(BlendError, match="disk full"):
+        calls.clear()
+        bake(blended, out)
+    assert list(out.iterdir()) == []  # an existing folder stays, empty
 
 
 # -- the CLI -------------------------------------------------------------------------------
