@@ -24,12 +24,15 @@ from lookdev.pipeline.export.usd.writer import export_usd  # noqa: E402
 
 PREVIEW_PARAMS = {s.param for s in PREVIEW_DISNEY} | {"specular"}
 """What UsdPreviewSurface expresses: its table, with both spellings of the F0."""
-UNEXPRESSIBLE = {"sheen_model", "sheen_roughness"}
+UNEXPRESSIBLE = {"sheen_model", "sheen_roughness", "flatness"}
 
 PIXAR_PREVIEW = {"surface_color", "metallic", "roughness", "clear", "normal_fresnel", "ior"}
 """What UsdPreviewSurface expresses of Smits' model (the F0 as the surface's IOR)."""
 
-"""No target has Conty-Kulla's sheen: MaterialX's and RenderMan's Disney sheen is Burley's."""
+"""What no context reads back: the sheen model and roughness (MaterialX's Disney sheen is
+Conty-Kulla's with a fixed roughness, RenderMan's is Burley's), and ``flatness``, which
+neither ND_disney_principled nor PxrDisneyBsdf has (lookdev wrote RenderMan a
+``flatness`` input RenderMan does not define: it was never read by a renderer)."""
 
 unit = st.floats(0.0, 1.0)
 edge_unit = st.sampled_from([0.0, 1.0]) | unit  # the edges themselves, often
