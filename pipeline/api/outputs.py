@@ -62,7 +62,12 @@ class UsdExport:
             "materials": self.materials,
             "contexts": list(self.contexts),
             "textures": [str(p) for p in self.textures],
+            "losses": {m: {c: n for c, n in by.items() if n} for m, by in self.losses.items()},
         }
+
+    def loss_rows(self) -> list[tuple[str, str, str]]:
+        """(material, context, what it cannot express) for every context with a loss."""
+        return [(m, c, n) for m, by in self.losses.items() for c, n in by.items() if n]
 
 
 def export_usd(
@@ -78,6 +83,7 @@ def export_usd(
     all_presets: bool = False,
     library: Any = None,
     progress: Callable[[int, int, str], None] | None = None,
+    preview_opacity: str = "keep",
 ) -> UsdExport:
     """Write materials as UsdShade materials under ``/Materials`` of ``path``.
 
@@ -108,6 +114,11 @@ def export_usd(
         See :func:`load`.
     progress
         Called as ``progress(done, total, name)`` as each material is prepared.
+    preview_opacity
+        ``"keep"`` (default): the universal context keeps ``opacity`` at 1 for
+        transmissive materials (DCCs read ``opacity`` as alpha) and names the loss;
+        ``"transmission"``: the UsdPreviewSurface spec's reading, ``opacity = 1 −
+        spec_trans`` (``1 − clear`` for Pixar).
 
     Returns
     -------
@@ -149,6 +160,7 @@ def export_usd(
         package=package,
         split=split,
         progress=progress,
+        preview_opacity=preview_opacity,
     )
     return UsdExport(
         result.files[0],

@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from lookdev.materials.params import DisneyParams
+from lookdev.pipeline.export.usd.mtlx import mtlx_version
 from lookdev.pipeline.export.usd.network import (
     CONTEXT_OUTPUT,
     CONTEXTS,
@@ -41,8 +42,10 @@ from lookdev.pipeline.export.usd.network import (
     source_from_params,
 )
 from lookdev.pipeline.export.usd.writer import (
+    MTLX_CONFIG_API,
     author,
     export_usd,
+    loss_doc,
     material_spec,
     new_layer,
     prim_name,
@@ -133,6 +136,9 @@ def spec_paths(specs: list[MaterialSpec]) -> tuple[list[Any], list[tuple[Any, An
     for spec in specs:
         path = scope.AppendChild(prim_name(spec.name))
         prims.append(path)
+        if any(net.context == "mtlx" for net in spec.networks):
+            version = path.AppendProperty("config:mtlx:version")
+            attributes.append((version, types["string"], Sdf.VariabilityUniform))
         for net in spec.networks:
             output = path.AppendProperty(f"outputs:{CONTEXT_OUTPUT[net.context]}")
             attributes.append((output, types["token"], Sdf.VariabilityVarying))
@@ -179,6 +185,14 @@ def author_naive(specs: list[MaterialSpec], base: Path):
         path = Sdf.Path("/Materials").AppendChild(prim_name(spec.name))
         material = UsdShade.Material.Define(stage, path)
         material.GetPrim().SetCustomData({"lookdev": dict(spec.custom)})
+        material.GetPrim().SetDocumentation(loss_doc(spec))
+        if any(net.context == "mtlx" for net in spec.networks):
+            material.GetPrim().SetMetadata(
+                "apiSchemas", Sdf.TokenListOp.Create(prependedItems=[MTLX_CONFIG_API])
+            )
+            material.GetPrim().CreateAttribute(
+                "config:mtlx:version", types["string"], True, Sdf.VariabilityUniform
+            ).Set(mtlx_version())
         for net in spec.networks:
             shaders = {}
             for node in net.nodes:

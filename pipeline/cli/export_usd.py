@@ -25,6 +25,11 @@ class Context(StrEnum):
     ri = "ri"
 
 
+class PreviewOpacity(StrEnum):
+    keep = "keep"
+    transmission = "transmission"
+
+
 def export_usd(
     presets: Annotated[
         list[str] | None,
@@ -73,14 +78,25 @@ def export_usd(
         list[Path] | None,
         typer.Option("--library", "-L", help="Extra preset folders searched before the built-ins."),
     ] = None,
+    preview_opacity: Annotated[
+        PreviewOpacity,
+        typer.Option(
+            "--preview-opacity",
+            help="Transmissive materials in UsdPreviewSurface: 'keep' opacity at 1 (DCCs read "
+            "opacity as alpha; the loss is named) or 'transmission', the spec's reading "
+            "opacity = 1 - spec_trans.",
+        ),
+    ] = PreviewOpacity.keep,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
     """Write presets as UsdShade materials that DCCs and their renderers read.
 
     Each preset becomes /Materials/NAME with up to three render contexts: **universal**
-    (UsdPreviewSurface, read everywhere; what it cannot express is named in the surface's
-    customData), **mtlx** (MaterialX ND_disney_principled) and **ri** (RenderMan
-    PxrDisneyBsdf). Only what a material needs is written: inputs at the target's
+    (UsdPreviewSurface, read everywhere), **mtlx** (MaterialX ND_disney_principled) and
+    **ri** (RenderMan PxrDisneyBsdf). What a context cannot express is printed as a
+    table, written as the Material's doc string and kept in the surface's customData
+    (under "losses" with --json). Glass keeps opacity 1 in UsdPreviewSurface unless
+    --preview-opacity transmission. Only what a material needs is written: inputs at the target's
     default and lobes without weight are left out. Layered presets are blended and their
     varying parameters baked to EXR maps beside the file (UsdPreviewSurface has no mix
     node). With several presets, /Look carries a variant set that switches between them.
@@ -110,6 +126,7 @@ def export_usd(
             all_presets=all_presets,
             library=library,
             progress=progress,
+            preview_opacity=preview_opacity.value,
         )
     if as_json:
         print_json(result.to_json())
@@ -120,6 +137,18 @@ def export_usd(
     )
     for extra in result.files[1:]:
         console.print(f"  {extra}", highlight=False)
+    rows = result.loss_rows()
+    if rows:
+        losses = table(
+            "What each render context could not express",
+            ["material", "context", "cannot express"],
+            [list(r) for r in rows],
+        )
+        losses.columns[1].justify = losses.columns[2].justify = "left"
+        losses.columns[2].overflow = "fold"
+        console.print(losses)
+    else:
+        console.print("every render context expresses every material fully")
 
 
 @contextmanager
@@ -214,7 +243,10 @@ def validate_usd(
 
     usd-core cannot know MaterialX (ND_*) or RenderMan (Pxr*) shader ids, so their
     MissingShaderIdInRegistry errors are expected and listed apart; every other error
-    fails. Exit code 0 when valid, 1 when not.
+    fails. Every authored shader input is also checked against its node's definition
+    (renderers ignore an unknown input silently): Pxr* against RenderMan's input names
+    kept with lookdev, ND_* against MaterialX's node definitions, UsdPreviewSurface and
+    UsdUVTexture against usd-core's Sdr registry. Exit code 0 when valid, 1 when not.
     """
     from lookdev.pipeline.export.usd.validate import validate_usd as check
 
@@ -229,6 +261,7 @@ def validate_usd(
                 "warnings": report.warnings,
                 "allowed": report.allowed,
                 "mtlx_networks": report.mtlx_networks,
+                "inputs_checked": report.inputs_checked,
             }
         )
     else:
@@ -237,6 +270,7 @@ def validate_usd(
             ["warnings", len(report.warnings)],
             ["expected (MaterialX/RenderMan ids)", len(report.allowed)],
             ["MaterialX networks checked", report.mtlx_networks],
+            ["shader inputs checked against their node's definition", report.inputs_checked],
         ]
         console.print(table(f"{file} — {report.validators} validators", ["check", "count"], rows))
         for line in report.errors + report.warnings:

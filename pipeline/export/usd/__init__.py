@@ -28,6 +28,7 @@ def export_materials(
     package: bool = False,
     split: str | Path | None = None,
     progress: Callable[[int, int, str], None] | None = None,
+    preview_opacity: str = "keep",
 ):
     """Write blended materials (:class:`~lookdev.pipeline.blend.BlendedMaterial`) as
     UsdShade materials to ``out``.
@@ -39,6 +40,7 @@ def export_materials(
     ``progress(done, total, name)`` is called after each material's network source is
     made (varying parameters are baked then). Maps are baked into a scratch folder beside
     ``out`` and only copied into place when every file could be written.
+    ``preview_opacity``: see :data:`.names.PREVIEW_OPACITY`.
     """
     from .network import CONTEXTS
     from .sources import source_for
@@ -65,4 +67,5 @@ def export_materials(
             package=package,
             split_dir=None if split is None else Path(split),
             workdir=Path(scratch),
+            preview_opacity=preview_opacity,
         )

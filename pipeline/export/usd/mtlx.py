@@ -62,6 +62,13 @@ def _library():
 
 
 @cache
+def mtlx_version() -> str:
+    """The MaterialX document version of the installed libraries (which define
+    ``ND_disney_principled``): what ``config:mtlx:version`` records."""
+    return _library().getVersionString()
+
+
+@cache
 def node_defaults(node_id: str) -> dict[str, Any]:
     """Input defaults of a MaterialX node definition, as plain Python values."""
     nodedef = _library().getNodeDef(node_id)
@@ -88,6 +95,8 @@ def build(source: Source) -> Network:
     elif source.normal_map is not None:
         inputs[NORMAL_INPUT[source.model]] = _normal(nodes, source.normal_map)
     mapped = mapped_params("mtlx", source.model)
+    if source.model == "disney" and source.lobes["sheen"]:
+        mapped |= _sheen(source.live_values, extra)
     note = loss_note(source, node_id, mapped, "; ".join(extra))
     surface = Node(SURFACE, node_id, inputs, {"out": "token"}, {"loss": note})
     return Network("mtlx", Connection(SURFACE, "out"), [surface, *nodes])
@@ -101,6 +110,30 @@ EXTRA_LOSS = {
     "broad lobe's roughness; no transmitted diffuse; lobe scales fold into colours only "
     "where a colour exists",
 }
+
+
+def _sheen(values: dict[str, Any], extra: list[str]) -> set[str]:
+    """What ``ND_disney_principled`` does with a live sheen; returns the params it keeps.
+
+    Its node graph (MaterialX ``libraries/bxdf/disney_principled.mtlx``) builds the
+    sheen from ``sheen_bsdf`` with that node's defaults: ``mode`` conty_kulla and a
+    fixed ``roughness``, neither exposed as an input of ``ND_disney_principled``.
+    """
+    sheen = node_defaults("ND_sheen_bsdf")
+    mode, rough = sheen.get("mode", "conty_kulla"), float(sheen.get("roughness", 0.3))
+    why = (
+        f"ND_disney_principled's sheen is sheen_bsdf in mode {mode} with roughness "
+        f"{rough:g}, and it has no input for either"
+    )
+    if values["sheen_model"] != mode:
+        extra.append(f"{why}: the {values['sheen_model']} sheen renders as {mode}")
+        return set()
+    kept = {"sheen_model"}
+    if abs(values["sheen_roughness"] - rough) < 1e-6:
+        kept.add("sheen_roughness")
+    else:
+        extra.append(f"{why}: sheen_roughness={values['sheen_roughness']:g} renders as {rough:g}")
+    return kept
 
 
 def _normal(nodes: list[Node], image: Image) -> tuple[str, Any]:

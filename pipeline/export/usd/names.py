@@ -120,16 +120,6 @@ PREVIEW_DISNEY: tuple[Slot, ...] = (
         from_target=roughness_to_gloss,
         texture_linear=None,
     ),
-    # The spec: opacity < 1 is translucent, refracting by `ior`: the spec_trans lobe.
-    Slot(
-        "spec_trans",
-        "opacity",
-        "float",
-        lobe="spec_trans",
-        to_target=_one_minus,
-        from_target=_one_minus,
-        texture_linear=(-1.0, 1.0),
-    ),
 )
 
 # Burley's parameters under their camelCase names, as both Disney targets spell them.
@@ -168,7 +158,8 @@ MTLX_DISNEY: tuple[Slot, ...] = (
     _scatter("subsurfaceDistance"),
 )
 
-# RenderMan PxrDisneyBsdf: Schutte's 2015 parameter set under camelCase names. Like
+# RenderMan PxrDisneyBsdf: Schutte's 2015 parameter set under RenderMan's own names
+# (renderman_inputs.json, checked at export). Like
 # Burley 2015 it has no `specular`: its dielectric F0 follows `ior` for reflection and
 # refraction alike (RenderMan 24 docs, PxrDisneyBsdf, "Specular Reflect Scale"), so
 # Burley 2012's specular reaches it as the IOR of the same F0 (§5.4).
@@ -177,32 +168,48 @@ RI_DISNEY: tuple[Slot, ...] = (
     Slot("ior", "ior", "float", lobe="dielectric"),
     Slot("diff_trans", "diffTrans", "float", lobe="diff_trans"),
     Slot("subsurface", "subsurface", "float", lobe="subsurface"),
-    Slot("flatness", "flatness", "float", lobe="flatness"),
-    _scatter("scatterDistance"),
-    Slot("thin", "thin", "int", lobe="thin", to_target=_flag, from_target=bool),
+    # Burley 2015's subsurface is tinted by the base colour; PxrDisneyBsdf takes that
+    # tint as its own input (default: RenderMan's, not ours), so it is written.
+    Slot("base_color", "subsurfaceColor", "color3f", lobe="subsurface"),
+    _scatter("scatterDistances"),
+    Slot("thin", "isThin", "int", lobe="thin", to_target=_flag, from_target=bool),
+    # PxrDisneyBsdf has no `flatness` input: the loss note names it.
 )
 
 # UsdPreviewSurface for Smits' model: his surface colour, metallic blend and roughness
 # play the roles of the surface's own (metallic workflow: diffuse goes to 0 and the
 # highlight takes the surface colour as metallic → 1, as Smits' nRefl does).
 # `roughness` passes as it is: it is the one control of highlight width and fade in
-# both. `clear` (light passing straight through) is the surface's translucency.
+# both. `clear` (light passing straight through) reaches ``opacity`` only under
+# ``--preview-opacity transmission`` (:data:`PREVIEW_OPACITY`).
 PREVIEW_PIXAR: tuple[Slot, ...] = (
     Slot("surface_color", "diffuseColor", "color3f"),
     Slot("metallic", "metallic", "float"),
     Slot("roughness", "roughness", "float"),
-    # Smits' nRefl scales metals too, and `clear` also darkens the diffuse: both are
-    # live whatever the lobes, so neither is gated.
+    # Smits' nRefl scales metals too: live whatever the lobes, so not gated.
     Slot("eta", "ior", "float"),
-    Slot(
-        "clear",
+)
+
+PREVIEW_OPACITY = ("keep", "transmission")
+"""How the universal context treats transmission. ``keep`` (the default): ``opacity``
+stays 1 and the loss is named, because DCC importers read ``opacity`` as alpha (a
+cut-out) and glass would arrive invisible. ``transmission``: the spec's own reading
+(UsdPreviewSurface spec: opacity < 1 is translucent, refracting by ``ior``),
+``opacity = 1 − spec_trans`` (Disney) or ``1 − clear`` (Pixar)."""
+
+OPACITY_SLOTS: dict[str, Slot] = {
+    model: Slot(
+        param,
         "opacity",
         "float",
+        lobe=lobe,
         to_target=_one_minus,
         from_target=_one_minus,
         texture_linear=(-1.0, 1.0),
-    ),
-)
+    )
+    for model, param, lobe in (("disney", "spec_trans", "spec_trans"), ("pixar", "clear", None))
+}
+"""model → the ``opacity`` slot written under ``--preview-opacity transmission``."""
 
 # MaterialX OpenPBR for Smits' model (see the module note for the choice).
 MTLX_PIXAR: tuple[Slot, ...] = (
@@ -273,9 +280,12 @@ SURFACE_IDS: dict[tuple[str, str], str] = {
 """(context, model) → the surface shader's ``info:id``."""
 
 
-def table_for(context: str, model: str) -> tuple[Slot, ...]:
-    """The name table of ``context`` for ``model``."""
-    return TABLES[(context, model)]
+def table_for(context: str, model: str, preview_opacity: str = "keep") -> tuple[Slot, ...]:
+    """The name table of ``context`` for ``model`` (see :data:`PREVIEW_OPACITY`)."""
+    table = TABLES[(context, model)]
+    if context == "universal" and preview_opacity == "transmission" and model in OPACITY_SLOTS:
+        return (*table, OPACITY_SLOTS[model])
+    return table
 
 
 _SMITS_WEIGHT = frozenset(
@@ -295,9 +305,9 @@ DERIVED_FROM: dict[str, frozenset[str]] = {
 """Derived target quantity (:mod:`.pixar`) → the parameters it carries."""
 
 
-def mapped_params(context: str, model: str) -> set[str]:
+def mapped_params(context: str, model: str, preview_opacity: str = "keep") -> set[str]:
     """Our parameters that ``context`` expresses, directly or through derived weights."""
     out: set[str] = set()
-    for slot in table_for(context, model):
+    for slot in table_for(context, model, preview_opacity):
         out |= DERIVED_FROM.get(slot.param, {slot.param})
     return out

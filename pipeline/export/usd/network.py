@@ -213,16 +213,18 @@ def loss_note(source: Source, context: str, mapped: set[str], extra: str = "") -
     return "; ".join(parts + source.notes)
 
 
-def lobe_coverage(source: Source, context: str) -> dict[str, str]:
+def lobe_coverage(source: Source, context: str, preview_opacity: str = "keep") -> dict[str, str]:
     """Each of the model's lobes in ``context``: ``"dead"`` (no weight: nothing written),
     ``"written"`` (live, and the context carries it: a base lobe, or one of the
     parameters that switch it on is mapped), or ``"lost"`` (live, and no switch of it is
     expressible: :func:`loss_note` names them). No lobe is live and silently missing.
+    ``preview_opacity`` as for the universal context's build (transmission is lost
+    there unless ``"transmission"`` asks for the spec's opacity reading).
     """
     from .names import mapped_params
 
     model = registry.MODELS[REGISTRY_MODEL[source.model]]
-    mapped = mapped_params(context, source.model)
+    mapped = mapped_params(context, source.model, preview_opacity)
     out = {}
     for lobe in model.lobes:
         if not source.lobes[lobe.name]:

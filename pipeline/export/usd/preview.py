@@ -1,7 +1,7 @@
 """The universal context: a ``UsdPreviewSurface`` network every DCC reads.
 
 Maps are ``UsdUVTexture`` nodes reading ``st`` through one ``UsdPrimvarReader_float2``;
-affine conversions (``opacity = 1 - spec_trans``, the clearcoat scale) ride on the
+affine conversions (the clearcoat scale, ``opacity = 1 - spec_trans`` when asked) ride on the
 texture's ``scale``/``bias`` so the baked image is shared with the other contexts.
 What the surface cannot express is named in the surface shader's ``customData``
 (``lookdev:loss``), and an importer reads only what is there.
@@ -39,6 +39,12 @@ SHAPE_NOTES = {
 }
 """model → lobe → what the surface changes about it when that lobe is live."""
 
+TRANSMISSION_LOBES = {"disney": ("spec_trans",), "pixar": ("specular_t", "reflection_t")}
+KEPT_OPAQUE = (
+    "transmission is not expressible; opacity kept at 1 so DCCs do not read it as alpha "
+    "(--preview-opacity transmission writes the spec's opacity = 1 - transmission)"
+)
+
 
 @cache
 def preview_defaults() -> dict[str, Any]:
@@ -55,10 +61,15 @@ def _plain(value: Any) -> Any:
     return tuple(float(x) for x in value)
 
 
-def build(source: Source) -> Network:
-    """The UsdPreviewSurface network of ``source``."""
+def build(source: Source, preview_opacity: str = "keep") -> Network:
+    """The UsdPreviewSurface network of ``source``.
+
+    ``preview_opacity`` (:data:`.names.PREVIEW_OPACITY`): ``keep`` leaves ``opacity`` at
+    1 for transmissive materials and names the loss; ``transmission`` writes the spec's
+    ``opacity = 1 − spec_trans`` (``1 − clear`` for Pixar).
+    """
     nodes: list[Node] = []
-    table = table_for("universal", source.model)
+    table = table_for("universal", source.model, preview_opacity)
     inputs = surface_inputs(source, table, preview_defaults(), nodes, _texture)
     if source.model in SPECULAR_WORKFLOW:
         inputs["useSpecularWorkflow"] = ("int", 1)
@@ -66,8 +77,12 @@ def build(source: Source) -> Network:
         inputs["normal"] = _normal(nodes, source.normal_map)
     lobes = source.lobes
     notes = SHAPE_NOTES[source.model]
-    shapes = "; ".join(text for lobe, text in notes.items() if lobes[lobe])
-    note = loss_note(source, "UsdPreviewSurface", mapped_params("universal", source.model), shapes)
+    shapes = [text for lobe, text in notes.items() if lobes[lobe]]
+    transmissive = any(lobes[lobe] for lobe in TRANSMISSION_LOBES.get(source.model, ()))
+    if transmissive and preview_opacity == "keep":
+        shapes.insert(0, KEPT_OPAQUE)
+    mapped = mapped_params("universal", source.model, preview_opacity)
+    note = loss_note(source, "UsdPreviewSurface", mapped, "; ".join(shapes))
     surface = Node(SURFACE, "UsdPreviewSurface", inputs, {"surface": "token"})
     surface.custom["loss"] = note
     return Network("universal", Connection(SURFACE, "surface"), [surface, *nodes])

@@ -21,7 +21,7 @@ from lookdev.materials.colour import luminance
 from lookdev.materials.fresnel import SPECULAR_F0_SCALE, ior_to_specular, specular_to_ior
 
 from .lobes import DEFAULTS, active_lobes, effective
-from .names import SURFACE_IDS, table_for
+from .names import DERIVED_FROM, SURFACE_IDS, table_for
 from .network import (
     CONTEXT_OUTPUT,
     F0_KEYS,
@@ -41,8 +41,10 @@ READ_ORDER = ("universal", "ri", "mtlx")
 READABLE = {
     "disney": READ_ORDER,
     # PxrSurface and OpenPBR get Smits' derived weights, which do not invert to his
-    # parameters: a Pixar material is read from its UsdPreviewSurface.
-    "pixar": ("universal",),
+    # parameters: a Pixar material is read from its UsdPreviewSurface, and of OpenPBR
+    # only the inputs that take one of his parameters as it is (`clear`, which the
+    # preview surface keeps out of `opacity` by default, among them).
+    "pixar": ("universal", "mtlx"),
     # A blend of Pixar layers is lobe weights, not parameters: nothing to read back.
     "pixar_weights": (),
 }
@@ -224,6 +226,8 @@ def _read_surface(net, surface, context, model, values, result) -> None:
     table = table_for(context, model)
     has_specular = any(s.param == "specular" for s in table)
     pending = []
+    if model == "pixar" and context != "universal":
+        table = tuple(s for s in table if s.param not in DERIVED_FROM)
     for slot in table:
         if slot.param == "ior" and has_specular:
             continue  # there `ior` only refracts and equals the specular's IOR by construction

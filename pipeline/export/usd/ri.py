@@ -4,15 +4,64 @@ usd-core has no Sdr description of RenderMan's nodes, so only the defaults that 
 certain are relied on (a lobe weight of 0 and RenderMan's zero metallic, anisotropy and
 tint); every other input of a live lobe is written. Maps are ``PxrTexture`` nodes
 (``resultRGB``/``resultR``), the normal map a ``PxrNormalMap`` into ``bumpNormal``.
+
+RenderMan ignores an input it does not know, silently. The input names of the nodes
+written here are kept as data, ``renderman_inputs.json`` (with the sources they were
+read from), and every network is checked against it before it is written: an unknown
+name is a bug in the name table and raises.
 """
 
 from __future__ import annotations
 
+import json
+from functools import cache
+from pathlib import Path
 from typing import Any
 
 from .names import SURFACE_IDS, Slot, mapped_params, table_for
-from .network import Connection, Image, Network, Node, Source, loss_note, surface_inputs
+from .network import (
+    Connection,
+    ExportError,
+    Image,
+    Network,
+    Node,
+    Source,
+    loss_note,
+    surface_inputs,
+)
 from .textures import converted
+
+INPUTS_FILE = Path(__file__).with_name("renderman_inputs.json")
+
+
+@cache
+def renderman_inputs() -> dict[str, frozenset[str]]:
+    """RenderMan node id → its documented input names (``renderman_inputs.json``)."""
+    data = json.loads(INPUTS_FILE.read_text(encoding="utf-8"))
+    return {node: frozenset(d["inputs"]) for node, d in data["nodes"].items()}
+
+
+def unknown_inputs(node_id: str, names) -> list[str] | None:
+    """Names that ``node_id`` does not have; ``None`` when the node is not in the data."""
+    known = renderman_inputs().get(node_id)
+    if known is None:
+        return None
+    return sorted(n for n in names if n not in known)
+
+
+def check_network(net: Network, material: str) -> None:
+    """Raise when a node of ``net`` has an input RenderMan does not define."""
+    for node in net.nodes:
+        bad = unknown_inputs(node.id, node.inputs)
+        if bad is None:
+            raise ExportError(f"no input definitions for RenderMan node {node.id}", where=material)
+        if bad:
+            raise ExportError(
+                f"{node.id} has no input {', '.join(bad)} (renderman_inputs.json): "
+                "a name-table bug",
+                where=material,
+            )
+
 
 SURFACE = "ri_surface"
 RI_DEFAULTS = {"metallic": 0.0, "anisotropic": 0.0, "specularTint": 0.0}
@@ -34,12 +83,16 @@ def build(source: Source) -> Network:
         )
         inputs["bumpNormal"] = ("normal3f", Connection("ri_normal_map", "resultN"))
     node_id = SURFACE_IDS[("ri", source.model)]
+    extra = [EXTRA_LOSS[source.model]] if source.model in EXTRA_LOSS else []
     if source.model in PXR_SURFACE_MODELS:
         inputs.update(_pixar_gains(source.lobes))
-    extra = EXTRA_LOSS.get(source.model, "")
-    note = loss_note(source, node_id, mapped_params("ri", source.model), extra)
+        if source.lobes["reflection_t"]:
+            extra.append(GLASS_REFLECTION)
+    note = loss_note(source, node_id, mapped_params("ri", source.model), "; ".join(extra))
     surface = Node(SURFACE, node_id, inputs, {"bxdf_out": "token"}, {"loss": note})
-    return Network("ri", Connection(SURFACE, "bxdf_out"), [surface, *nodes])
+    net = Network("ri", Connection(SURFACE, "bxdf_out"), [surface, *nodes])
+    check_network(net, source.name)
+    return net
 
 
 PXR_SURFACE_GAINS = {
@@ -49,6 +102,21 @@ PXR_SURFACE_GAINS = {
     "diffuse_t": ("diffuseTransmitGain", 0.0),
     "reflection_t": ("refractionGain", 0.0),
 }
+PXR_SURFACE_WITH = {
+    # lobe: inputs PxrSurface needs besides the gain for that lobe to act.
+    # Diffuse transmission is computed only on a double-sided diffuse lobe (PxrSurface
+    # docs, Diffuse: "This only applies when Double-Sided is on"); hdPrman sets it too.
+    "diffuse_t": {"diffuseDoubleSided": ("int", 1)},
+    # The glass lobe splits energy by Fresnel between its reflection and refraction;
+    # with reflectionGain at its default 0 the reflected share (total internal
+    # reflection included) is dropped.
+    "reflection_t": {"reflectionGain": ("float", 1.0)},
+}
+GLASS_REFLECTION = (
+    "PxrSurface's glass lobe reflects too (reflectionGain 1, which keeps its Fresnel "
+    "split and internal reflection): at the front that adds to Smits' reflection lobe, "
+    "written as the primary specular"
+)
 PIXAR_LOSS = (
     "PxrSurface has no transmitted specular lobe (Smits' specT); the diffuse weight is "
     "its normal-incidence colour, without Smits' view-dependent Fresnel shape"
@@ -66,6 +134,8 @@ def _pixar_gains(lobes: dict[str, bool]) -> dict[str, tuple[str, Any]]:
         wanted = 1.0 if lobes[lobe] else 0.0
         if wanted != default:
             out[name] = ("float", wanted)
+        if lobes[lobe]:
+            out.update(PXR_SURFACE_WITH.get(lobe, {}))
     return out
 
 
@@ -74,5 +144,7 @@ def _texture(nodes: list[Node], slot: Slot, image: Image) -> tuple[str, Any]:
         image = converted(image, slot)
     output = "resultRGB" if slot.type == "color3f" else "resultR"
     name = f"ri_{slot.param}"
+    if any(n.name == name for n in nodes):  # one map feeding two inputs (subsurfaceColor)
+        return slot.type, Connection(name, output)
     nodes.append(Node(name, "PxrTexture", {"filename": ("asset", image)}, {output: slot.type}))
     return slot.type, Connection(name, output)

@@ -5,11 +5,19 @@ is ``MissingShaderIdInRegistry`` for MaterialX (``ND_*``) and RenderMan (``Pxr*`
 shader ids: the pip build ships without UsdMtlx and RenderMan's node definitions, so
 Sdr cannot know them. Those networks are checked instead by converting each MaterialX
 network back into a MaterialX document and running MaterialX's ``validate``.
+
+Every shader's authored inputs are then checked against the node's own definition,
+because renderers ignore an input they do not know, silently: ``Pxr*`` against
+RenderMan's input names kept in ``renderman_inputs.json``, ``ND_*`` against MaterialX's
+node definitions (``getActiveInputs``), and Sdr-registered ids (``UsdPreviewSurface``,
+``UsdUVTexture``, ``UsdPrimvarReader_*``) against usd-core's Sdr registry. An unknown
+input is an error naming the prim and the input.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cache
 from pathlib import Path
 
 from .network import ExportError
@@ -28,6 +36,7 @@ class Report:
     allowed: list[str] = field(default_factory=list)
     validators: int = 0
     mtlx_networks: int = 0
+    inputs_checked: int = 0
 
     @property
     def ok(self) -> bool:
@@ -50,7 +59,65 @@ def validate_usd(path: Path) -> Report:
     for error in UsdValidation.ValidationContext(validators).Validate(stage):
         _file(report, error)
     _check_mtlx(stage, report)
+    _check_inputs(stage, report)
     return report
+
+
+def _check_inputs(stage, report: Report) -> None:
+    """Every authored shader input against its node's definition (see the module note)."""
+    from pxr import Usd, UsdShade
+
+    for prim in stage.Traverse(Usd.TraverseInstanceProxies()):
+        if not prim.IsA(UsdShade.Shader):
+            continue
+        shader = UsdShade.Shader(prim)
+        ident = str(shader.GetIdAttr().Get() or "")
+        names = [i.GetBaseName() for i in shader.GetInputs() if i.GetAttr().IsAuthored()]
+        known = known_inputs(ident)
+        if known is None:
+            if names and ident.startswith(FOREIGN_ID_PREFIXES):
+                report.warnings.append(
+                    f"UnknownShaderInputs: {prim.GetPath()} ({ident}): no definition of its "
+                    "inputs to check them against"
+                )
+            continue
+        report.inputs_checked += len(names)
+        for name in names:
+            if name not in known:
+                report.errors.append(
+                    f"UnknownShaderInput: {prim.GetPath()} ({ident}) has no input '{name}'"
+                )
+
+
+def known_inputs(ident: str) -> frozenset[str] | None:
+    """The input names the node ``ident`` defines; None when no definition is known."""
+    if ident.startswith("Pxr"):
+        from .ri import renderman_inputs
+
+        return renderman_inputs().get(ident)
+    if ident.startswith("ND_"):
+        return _mtlx_inputs(ident)
+    return _sdr_inputs(ident)
+
+
+@cache
+def _mtlx_inputs(ident: str) -> frozenset[str] | None:
+    from .mtlx import _library
+
+    nodedef = _library().getNodeDef(ident)
+    if nodedef is None:
+        return None
+    return frozenset(i.getName() for i in nodedef.getActiveInputs())
+
+
+@cache
+def _sdr_inputs(ident: str) -> frozenset[str] | None:
+    from pxr import Sdr
+
+    node = Sdr.Registry().GetShaderNodeByIdentifier(ident) if ident else None
+    if node is None:
+        return None
+    return frozenset(str(n) for n in node.GetShaderInputNames())
 
 
 def _file(report: Report, error) -> None:

@@ -20,6 +20,7 @@ from pxr import Gf, Sdf
 from lookdev.library import files
 
 from . import mtlx, preview, ri
+from .names import PREVIEW_OPACITY
 from .network import (
     CONTEXT_OUTPUT,
     Connection,
@@ -32,18 +33,38 @@ from .network import (
 from .textures import write_image
 
 BUILDERS = {"universal": preview.build, "mtlx": mtlx.build, "ri": ri.build}
+MTLX_CONFIG_API = "MaterialXConfigAPI"
 SWITCH = "Look"  # the prim whose variant set switches between the exported presets
 USD_SUFFIXES = (".usda", ".usdc", ".usd")
 
 
-def material_spec(source: Source, contexts: tuple[str, ...]) -> MaterialSpec:
+def material_spec(
+    source: Source, contexts: tuple[str, ...], preview_opacity: str = "keep"
+) -> MaterialSpec:
     """The networks of ``source`` for each of ``contexts`` and the material's metadata."""
     custom = {
         "preset": source.name,
         "model": source.model,
         "spelling": source.spelling,
     }
-    return MaterialSpec(source.name, [BUILDERS[c](source) for c in contexts], custom)
+    networks = [
+        preview.build(source, preview_opacity) if c == "universal" else BUILDERS[c](source)
+        for c in contexts
+    ]
+    return MaterialSpec(source.name, networks, custom)
+
+
+def loss_doc(spec: MaterialSpec) -> str:
+    """The Material's ``doc``: what each render context could not express, one per line."""
+    lines = [
+        f"{net.context}: {note}"
+        for net in spec.networks
+        for note in ["; ".join(n.custom["loss"] for n in net.nodes if n.custom.get("loss"))]
+        if note
+    ]
+    if not lines:
+        return "lookdev: every render context expresses this material fully."
+    return "lookdev: what each render context cannot express.\n" + "\n".join(lines)
 
 
 def value_types() -> dict[str, Any]:
@@ -117,7 +138,15 @@ def author(layer, specs: list[MaterialSpec], base: Path) -> list[str]:
 def _author_material(layer, scope, spec: MaterialSpec, base: Path, types: dict[str, Any]):
     prim = Sdf.PrimSpec(scope, prim_name(spec.name), Sdf.SpecifierDef, "Material")
     prim.customData = {"lookdev": dict(spec.custom)}
+    prim.documentation = loss_doc(spec)
     path = prim.path
+    if any(net.context == "mtlx" for net in spec.networks):
+        # UsdMtlx reads the MaterialX version of the networks from MaterialXConfigAPI.
+        prim.SetInfo("apiSchemas", Sdf.TokenListOp.Create(prependedItems=[MTLX_CONFIG_API]))
+        version = path.AppendProperty("config:mtlx:version")
+        _attribute(
+            layer, version, types["string"], Sdf.VariabilityUniform
+        ).default = mtlx.mtlx_version()
     for net in spec.networks:
         output = path.AppendProperty(f"outputs:{CONTEXT_OUTPUT[net.context]}")
         _attribute(layer, output, types["token"]).connectionPathList.explicitItems = [
@@ -245,13 +274,15 @@ def export_usd(
     package: bool = False,
     split_dir: Path | None = None,
     workdir: Path | None = None,
+    preview_opacity: str = "keep",
 ) -> ExportResult:
     """Export ``sources`` to ``out`` (``.usda``/``.usdc``/``.usd``, or ``.usdz`` to package).
 
     ``split_dir``: one file per material there, ``out`` a library referencing them.
     ``mtlx_path``: also a standalone MaterialX document. ``workdir`` (packages): where the
     stage is staged before packaging; textures below it keep their path relative to it
-    inside the ``.usdz``. Nothing is left behind on error.
+    inside the ``.usdz``. ``preview_opacity``: see :data:`.names.PREVIEW_OPACITY`.
+    Nothing is left behind on error.
     """
     out = Path(out)
     package = package or out.suffix == ".usdz"
@@ -267,7 +298,12 @@ def export_usd(
             check_writable(Path(path))
     if split_dir is not None:
         check_folder(Path(split_dir))
-    specs = [material_spec(s, contexts) for s in sources]
+    if preview_opacity not in PREVIEW_OPACITY:
+        raise ExportError(
+            f"preview opacity {preview_opacity!r}: use {' or '.join(PREVIEW_OPACITY)}",
+            where=str(out),
+        )
+    specs = [material_spec(s, contexts, preview_opacity) for s in sources]
     _check_names(specs, out)
     images = images_of(specs)
     check_images(images)

@@ -117,7 +117,14 @@ def test_plain_diffuse_has_no_clearcoat_sheen_or_transmission(tmp_path):
         "inputs:roughness",
         "outputs:bxdf_out",
     ]
-    assert sum(len(v) for v in attrs.values()) == 3 + 4 + 4 + 5  # material outputs + shaders
+    # the Material: three outputs and MaterialXConfigAPI's config:mtlx:version
+    assert attrs["/Materials/plaster"] == [
+        "config:mtlx:version",
+        "outputs:mtlx:surface",
+        "outputs:ri:surface",
+        "outputs:surface",
+    ]
+    assert sum(len(v) for v in attrs.values()) == 4 + 4 + 4 + 5
 
 
 @pytest.mark.parametrize("specular", [0.0, 0.3, 0.5, 2.0])

@@ -24,12 +24,18 @@ from lookdev.pipeline.export.usd.writer import export_usd  # noqa: E402
 
 PREVIEW_PARAMS = {s.param for s in PREVIEW_DISNEY} | {"specular"}
 """What UsdPreviewSurface expresses: its table, with both spellings of the F0."""
-UNEXPRESSIBLE = {"sheen_model", "sheen_roughness"}
+UNEXPRESSIBLE = {"sheen_model", "sheen_roughness", "flatness"}
 
 PIXAR_PREVIEW = {"surface_color", "metallic", "roughness", "clear", "normal_fresnel", "ior"}
-"""What UsdPreviewSurface expresses of Smits' model (the F0 as the surface's IOR)."""
+"""What a Pixar material is read back from: UsdPreviewSurface (the F0 as the surface's
+IOR) and the OpenPBR inputs that take one of Smits' parameters as it is (``clear``, which
+the preview surface keeps out of ``opacity`` by default)."""
+PIXAR_OPENPBR = {"surface_color", "metallic", "specular_tint", "clear", "transmission_tint"}
 
-"""No target has Conty-Kulla's sheen: MaterialX's and RenderMan's Disney sheen is Burley's."""
+"""What no context reads back: the sheen model and roughness (MaterialX's Disney sheen is
+Conty-Kulla's with a fixed roughness, RenderMan's is Burley's), and ``flatness``, which
+neither ND_disney_principled nor PxrDisneyBsdf has (lookdev wrote RenderMan a
+``flatness`` input RenderMan does not define: it was never read by a renderer)."""
 
 unit = st.floats(0.0, 1.0)
 edge_unit = st.sampled_from([0.0, 1.0]) | unit  # the edges themselves, often
@@ -191,15 +197,24 @@ def test_pixar_universal_round_trip(tmp_path, data):
 
     params = PixarParams(**data)
     out = tmp_path / "px.usda"
-    export_usd([source_from_params("px", "pixar", params)], out)
+    source = source_from_params("px", "pixar", params)
+    result = export_usd([source], out)
     (found,) = import_usd(out)
-    assert found.model == "pixar" and found.contexts == ["universal"]
+    assert found.model == "pixar" and found.contexts == ["universal", "mtlx"]
     got = effective(canonical(PixarParams.parse(found.params)), "pixar")
     want = effective(canonical(params), "pixar")
-    for k in PIXAR_PREVIEW - {"ior"}:
+    keys = PIXAR_PREVIEW - {"ior"}
+    if not source.lobes["transmission"]:
+        # `clear` travels as OpenPBR's transmission_weight, written only while a
+        # transmitted lobe lives (the preview surface keeps opacity 1); otherwise its
+        # darkening of the diffuse is a loss the universal note names.
+        keys = keys - {"clear"}
+        if params.clear > 0:
+            assert "clear=" in result.losses["px"]["universal"]
+    for k in keys:
         np.testing.assert_allclose(got[k], want[k], rtol=2e-6, atol=2e-6, err_msg=k)
     np.testing.assert_allclose(got["eta"], want["eta"], rtol=2e-6, err_msg="eta")
-    assert set(found.params) <= PIXAR_PREVIEW
+    assert set(found.params) <= PIXAR_PREVIEW | PIXAR_OPENPBR
 
 
 def test_pixar_ri_surface_carries_smits_weights(tmp_path):
