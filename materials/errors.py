@@ -115,8 +115,9 @@ def _range_text(exc: ValidationError, err: dict[str, Any]) -> str:
     schema is not known here (a nested model that did not call :func:`register_schema`)."""
     ctx = err.get("ctx") or {}
     loc = err["loc"]
-    if loc and isinstance(loc[-1], int):
-        lo, hi = 0.0, 1.0  # a colour channel
+    if loc and isinstance(loc[-1], int):  # an element of a tuple (a colour channel, a UV)
+        field = next((p for p in reversed(loc) if isinstance(p, str)), None)
+        lo, hi = _element_bounds(exc.title, field)
     else:
         field = next((p for p in reversed(loc) if isinstance(p, str)), None)
         lo, hi = _bounds(exc.title, field)
@@ -129,6 +130,29 @@ def _range_text(exc: ValidationError, err: dict[str, Any]) -> str:
 
 
 _OPS = (("ge", "≥"), ("gt", ">"), ("le", "≤"), ("lt", "<"))
+
+
+def _element_bounds(model_name: str, field: str | None) -> tuple[float | None, float | None]:
+    """The (ge, le) bounds of the elements of the tuple field ``field`` (colour channels
+    are [0, 1], texture UVs ±4096), found like :func:`_bounds`."""
+    import typing
+
+    named = _SCHEMAS.get(model_name)
+    for cls in [named] * (named is not None) + list(_SCHEMAS.values()):
+        if field not in cls.model_fields:
+            continue
+        for arg in typing.get_args(cls.model_fields[field].annotation):
+            lo = hi = None
+            for m in [
+                c
+                for m in getattr(arg, "__metadata__", ())
+                for c in (m, *getattr(m, "metadata", ()))
+            ]:
+                lo = getattr(m, "ge", None) if getattr(m, "ge", None) is not None else lo
+                hi = getattr(m, "le", None) if getattr(m, "le", None) is not None else hi
+            if lo is not None or hi is not None:
+                return lo, hi
+    return 0.0, 1.0  # a colour channel of an unregistered schema
 
 
 def _bounds(model_name: str, field: str | None) -> tuple[float | None, float | None]:
