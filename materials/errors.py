@@ -143,11 +143,8 @@ def _element_bounds(model_name: str, field: str | None) -> tuple[float | None, f
             continue
         for arg in typing.get_args(cls.model_fields[field].annotation):
             lo = hi = None
-            for m in [
-                c
-                for m in getattr(arg, "__metadata__", ())
-                for c in (m, *getattr(m, "metadata", ()))
-            ]:
+            meta = getattr(arg, "__metadata__", ())
+            for m in [c for item in meta for c in (item, *getattr(item, "metadata", ()))]:
                 lo = getattr(m, "ge", None) if getattr(m, "ge", None) is not None else lo
                 hi = getattr(m, "le", None) if getattr(m, "le", None) is not None else hi
             if lo is not None or hi is not None:
