@@ -100,6 +100,39 @@ def one_line(
     return error(msg, where=where, field=field)
 
 
+def check_range(
+    value: float,
+    low: float,
+    high: float,
+    *,
+    field: str,
+    error: type[LookdevError] = ParameterError,
+    where: str | None = None,
+) -> float:
+    """``value`` when it is a finite number in ``[low, high]``; else one ``error`` line in the
+    wording of :func:`one_line` (the numeric options of the API and the CLI use it).
+
+    >>> try:
+    ...     check_range(float("nan"), -32, 32, field="--exposure")
+    ... except LookdevError as exc:
+    ...     print(exc)
+    --exposure: nan is not a finite number; allowed [-32, 32]
+    """
+    import math
+
+    allowed = f"allowed [{low:g}, {high:g}]"
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        message = f"{short_repr(value)} is not a number; {allowed}"
+        raise error(message, field=field, where=where) from None
+    if not math.isfinite(number):
+        raise error(f"{number} is not a finite number; {allowed}", field=field, where=where)
+    if not low <= number <= high:
+        raise error(f"{value:g} is out of range; {allowed}", field=field, where=where)
+    return value
+
+
 def short_repr(value: Any, limit: int = 60) -> str:
     """``repr(value)``, cut to ``limit`` characters with ``...`` (a message stays one line).
 

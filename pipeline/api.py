@@ -47,7 +47,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from lookdev.materials.errors import LookdevError
+from lookdev.materials.errors import LookdevError, check_range
 
 if TYPE_CHECKING:
     from lookdev.library import Library, Material
@@ -583,6 +583,10 @@ def _environment_file(name_or_path: PathLike | None) -> Path | None:
     return Path(ibls.resolve(str(name_or_path)))
 
 
+FILM_MAX_SIDE = 16384
+"""Largest film width or height of an exported Mitsuba scene, in pixels."""
+
+
 def export_mitsuba(
     material: Any,
     path: PathLike,
@@ -623,11 +627,11 @@ def export_mitsuba(
     from lookdev.pipeline.export.mitsuba import MitsubaExportError, export_scene
     from lookdev.pipeline.export.mitsuba.scene import files_of, uses_our_plugins
 
-    if min(resolution) < 1:
-        raise MitsubaExportError(
-            f"{resolution[0]} {resolution[1]}: width and height must be at least 1",
-            field="--resolution",
-        )
+    if len(tuple(resolution)) != 2:
+        raise MitsubaExportError(f"{tuple(resolution)} is not W H", field="--resolution")
+    for side in resolution:
+        check_range(side, 1, FILM_MAX_SIDE, field="--resolution", error=MitsubaExportError)
+    check_range(spp, 1, 2**20, field="--spp", error=MitsubaExportError)
     material = hub(material, map_resolution, library)
     env = _environment_file(ibl)
     scene = export_scene(
@@ -733,6 +737,7 @@ def proof(
     from lookdev.pipeline.proof import batch
     from lookdev.pipeline.proof import ibl as ibl_module
 
+    check_proof_settings(resolution, frames, light_frames, spp, exposure, jobs)
     lib = library_for(library)
     if materials is None or (not isinstance(materials, str | os.PathLike) and not materials):
         materials = representative_presets(lib)
@@ -741,14 +746,6 @@ def proof(
         ibls = [ibls]
     ibl_names = list(dict.fromkeys(ibls or ibl_module.builtin_names()))
     environments = [ibl_module.load(name, ibl_width) for name in ibl_names]
-    if resolution[0] < 8 or resolution[1] < 8:
-        raise batch.ProofError(f"resolution {tuple(resolution)} is below 8×8", field="--resolution")
-    least = {"--frames": (frames, 1), "--light-frames": (light_frames, 0), "--spp": (spp, 2)}
-    if jobs is not None:
-        least["--workers"] = (jobs, 1)
-    for name, (value, low) in least.items():
-        if value < low:
-            raise batch.ProofError(f"{value} is below {low}", field=name)
     settings = batch.Settings(frames, light_frames, spp, tuple(resolution), exposure)
     output = Path(out)
     doc = batch.proof(
@@ -766,6 +763,40 @@ def proof(
 
         doc["report"] = str(write_report(output, materials={m.name: m for m in loaded}))
     return doc
+
+
+def check_proof_settings(
+    resolution: tuple[int, int],
+    frames: int,
+    light_frames: int,
+    spp: int,
+    exposure: float,
+    jobs: int | None,
+) -> None:
+    """Every numeric setting of a proof batch in its documented range, or one line."""
+    from lookdev.pipeline.proof import batch, tonemap
+
+    error = batch.ProofError
+    if len(tuple(resolution)) != 2:
+        raise error(f"{tuple(resolution)} is not W H", field="--resolution")
+    for side in resolution:
+        check_range(side, batch.MIN_SIDE, batch.MAX_SIDE, field="--resolution", error=error)
+    checks = {"--frames": (frames, 1, 360), "--light-frames": (light_frames, 0, 360)}
+    checks["--spp"] = (spp, 2, 65536)
+    if jobs is not None:
+        checks["--workers"] = (jobs, 1, 1024)
+    for name, (value, low, high) in checks.items():
+        check_range(value, low, high, field=name, error=error)
+    check_range(
+        exposure, -tonemap.EXPOSURE_MAX, tonemap.EXPOSURE_MAX, field="--exposure", error=error
+    )
+    samples = resolution[0] * resolution[1] * spp
+    if samples > batch.MAX_SAMPLES:
+        raise error(
+            f"{resolution[0]}×{resolution[1]} at {spp} spp is {samples:.3g} samples a frame; "
+            f"allowed ≤ {batch.MAX_SAMPLES:.3g} (lower --spp or --resolution)",
+            field="--resolution",
+        )
 
 
 # -- plots ---------------------------------------------------------------------------------------
@@ -811,6 +842,10 @@ def plot(
         )
     if view not in PLOT_VIEWS:
         raise plots.PlotError(f"unknown view {view!r}; allowed {', '.join(PLOT_VIEWS)}")
+    from lookdev.pipeline.proof.tonemap import EXPOSURE_MAX
+
+    check_range(exposure, -EXPOSURE_MAX, EXPOSURE_MAX, field="--exposure", error=plots.PlotError)
+    check_range(resolution, 8, 1024, field="--resolution", error=plots.PlotError)
     lib = library_for(library)
     if isinstance(materials, str | os.PathLike):
         materials = [materials]

@@ -133,8 +133,10 @@ def _usage_line(exc) -> str:
         first = next(iter(getattr(cause, "errors", lambda: [{}])()), {})
         given = first.get("input", "")
         name = max(param.opts, key=len) if param.opts else param.name
-        allowed = f"[{'-∞' if low is None else low}, {'∞' if high is None else high}]"
-        if first.get("type") in _RANGE_ERRORS:
+        allowed = f"[{'-∞' if low is None else f'{low:g}'}, {'∞' if high is None else f'{high:g}'}]"
+        if str(given).strip().lower().lstrip("+-") in ("nan", "inf", "infinity"):
+            message = f"{name}: {given} is not a finite number; allowed {allowed}"
+        elif first.get("type") in _RANGE_ERRORS:
             message = f"{name}: {given} is out of range; allowed {allowed}"
         else:
             message = f"{name}: {given!r} is not a number in {allowed}"

@@ -48,6 +48,11 @@ TICK_S = 0.5
 FORMAT_VERSION = 1
 MAP_RESOLUTION = 512
 """Texels a side of a layered material's maps in a proof (the blend the proof renders)."""
+MIN_SIDE, MAX_SIDE = 8, 8192
+"""Frame width and height of a proof, in pixels (``--resolution W H``)."""
+MAX_SAMPLES = 2**32 - 1
+"""Most samples a frame may take, width × height × spp: Dr.Jit indexes a render's
+wavefront with 32-bit integers."""
 
 
 class ProofError(LookdevError):
