@@ -7,6 +7,7 @@ allowed, so the CLI can print it as it is and exit with code 2.
 
 from __future__ import annotations
 
+import difflib
 from typing import Any, TypeVar
 
 from pydantic import BaseModel, ValidationError
@@ -88,7 +89,12 @@ def one_line(
     elif kind == "extra_forbidden":
         schema = _SCHEMAS.get(exc.title)
         known = len(loc) == 1 and schema is not None
-        msg = "unknown field" + (f"; allowed: {', '.join(schema.model_fields)}" if known else "")
+        msg = "unknown field"
+        if known:
+            names = list(schema.model_fields)
+            close = difflib.get_close_matches(str(loc[-1]), names, n=1, cutoff=0.6)
+            msg += f"; did you mean {close[0]!r}?" if close else ""
+            msg += f"{' ' if close else '; '}allowed: {', '.join(names)}"
     elif kind == "missing":
         msg = "required field is missing"
     elif kind == "finite_number":

@@ -57,7 +57,8 @@ def write_presets(found: list[Imported], output: Path | None) -> list[Path]:
         targets = [output]
     else:
         if not output.is_dir():
-            raise ExportError("folder does not exist (or give a .toml file)", where=str(output))
+            what = "is a file, not a folder" if output.exists() else "folder does not exist"
+            raise ExportError(f"{what} (give a folder or a .toml file)", where=str(output))
         targets = [output / f"{preset_name(m.name)}.toml" for m in found]
     texts = [preset_toml(m) for m in found]
     for path in targets:
