@@ -741,13 +741,19 @@ def proof(
     lib = library_for(library)
     if materials is None or (not isinstance(materials, str | os.PathLike) and not materials):
         materials = representative_presets(lib)
-    loaded = [hub(m, batch.MAP_RESOLUTION, lib) for m in _materials(materials, lib)]
+    # The whole batch is checked before the first frame: the output folder, every preset
+    # and every texture it names (layers a blend would prune included), every IBL.
+    output = Path(out)
+    batch.check_writable(output)
+    chosen = _materials(materials, lib)
+    for material in chosen:
+        check_textures(material)
     if isinstance(ibls, str | os.PathLike):
         ibls = [ibls]
     ibl_names = list(dict.fromkeys(ibls or ibl_module.builtin_names()))
     environments = [ibl_module.load(name, ibl_width) for name in ibl_names]
+    loaded = [hub(m, batch.MAP_RESOLUTION, lib) for m in chosen]
     settings = batch.Settings(frames, light_frames, spp, tuple(resolution), exposure)
-    output = Path(out)
     doc = batch.proof(
         loaded,
         environments,
@@ -763,6 +769,25 @@ def proof(
 
         doc["report"] = str(write_report(output, materials={m.name: m for m in loaded}))
     return doc
+
+
+def check_textures(material: Any) -> None:
+    """Every texture a material names (masks and normal maps of every layer, nested
+    layered presets included, pruned or not) exists, decodes and has its channels; else
+    the one line of :class:`~lookdev.pipeline.blend.resample.TextureError`."""
+    from lookdev.materials.layers import textures
+    from lookdev.pipeline.blend.resample import TextureFile
+
+    for i, layer in enumerate(getattr(material, "layers", None) or []):
+        if not hasattr(layer, "mask"):  # a blend's or a model's own: nothing to read
+            return
+        where = f"{material.name}: layer {layer.name or layer.material.name or i!r}"
+        for tex in textures(layer.mask):
+            TextureFile(tex, 1, where=where)
+        for tex in (layer.normal_map, layer.specular_normal_map):
+            if tex is not None:
+                TextureFile(tex, 3, where=where)
+        check_textures(layer.material)
 
 
 def check_proof_settings(

@@ -223,7 +223,8 @@ def material_plots(
     """``{material: {view: png}}``; the sphere also under ``ibl`` (one of the batch's).
 
     ``hubs`` are the blended materials by name; a material of the batch not among them
-    (proofed in an earlier run) gets no plots; its frames and numbers are still shown.
+    (proofed in an earlier run) keeps the plots that run drew, if they are still there;
+    its frames and numbers are shown either way.
     """
     from .plots import figure, load_environment, save_figure
 
@@ -231,6 +232,10 @@ def material_plots(
     result: dict[str, dict[str, Path]] = {}
     for name in names:
         if name not in hubs:
+            # Proofed in an earlier run into this folder: keep the plots it drew.
+            kept = {v: out_dir / "plots" / f"{_slug(name)}_{v}.png" for v in PLOT_VIEWS}
+            if all(p.is_file() for p in kept.values()):
+                result[name] = kept
             continue
         result[name] = {
             view: save_figure(
