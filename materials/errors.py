@@ -165,7 +165,7 @@ def _range_text(exc: ValidationError, err: dict[str, Any]) -> str:
         return bound or "a smaller or larger value"
     lo_text = "-∞" if lo is None else f"{float(lo):g}"
     hi_text = "∞" if hi is None else f"{float(hi):g}"
-    return f"[{lo_text}, {hi_text}]"
+    return f"{'(' if isinstance(lo, _Open) else '['}{lo_text}, {hi_text}]"
 
 
 _OPS = (("ge", "≥"), ("gt", ">"), ("le", "≤"), ("lt", "<"))
@@ -201,7 +201,13 @@ def _bounds(model_name: str, field: str | None) -> tuple[float | None, float | N
         lo = hi = None
         for m in cls.model_fields[field].metadata:
             lo = getattr(m, "ge", None) if getattr(m, "ge", None) is not None else lo
+            if getattr(m, "gt", None) is not None:  # an open floor: "(0, 10]"
+                lo = _Open(m.gt)
             hi = getattr(m, "le", None) if getattr(m, "le", None) is not None else hi
         if lo is not None or hi is not None:
             return lo, hi
     return None, None
+
+
+class _Open(float):
+    """A lower bound the value must exceed (pydantic's ``gt``)."""
