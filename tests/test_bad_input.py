@@ -568,3 +568,18 @@ def test_random_option_values_never_give_a_traceback_or_more_than_one_line(cli, 
         assert len(lines) == 1, (args, r.err)
         assert lines[0].startswith("lookdev: error: ") or r.code == 130, (args, r.err)
         assert r.code == 2, (args, r.code, r.err)
+
+
+def test_a_truncated_png_is_one_error_and_libpng_prints_nothing(tmp_path, capfd):
+    from lookdev.pipeline.proof import contact
+
+    good = contact.write_png(np.full((8, 16, 3), 0.5), tmp_path / "frame.png")
+    cut = tmp_path / "cut.png"
+    cut.write_bytes(good.read_bytes()[:60])
+    capfd.readouterr()
+    with pytest.raises(LookdevError) as info:
+        contact.read_rgb(cut)
+    assert "cut.png: cannot decode the image" in str(info.value) and "\n" not in str(info.value)
+    assert contact.read_rgb(good).shape == (8, 16, 3)
+    out, err = capfd.readouterr()
+    assert err == "" and "libpng" not in out

@@ -201,11 +201,12 @@ def web_image(src: Path, out_dir: Path, exposure: float = 0.0) -> Path:
     dst = out_dir / "frames" / ("_".join(parts) + ".png")
     if dst.exists() and dst.stat().st_mtime >= src.stat().st_mtime:
         return dst
-    buf = oiio.ImageBuf(str(src))
-    pixels = np.asarray(buf.get_pixels(oiio.FLOAT))
-    if buf.has_error or pixels.ndim != 3:
-        raise ReportError(f"cannot read frame: {buf.geterror()}", where=str(src))
-    rgb = pixels[..., :3] if pixels.shape[-1] >= 3 else np.repeat(pixels[..., :1], 3, -1)
+    from lookdev.pipeline.proof.contact import ProofImageError, read_rgb
+
+    try:
+        rgb = read_rgb(src)
+    except ProofImageError as exc:
+        raise ReportError(f"cannot read frame: {exc.message}", where=str(src)) from None
     img = to_8bit(view(rgb, exposure))
     dst.parent.mkdir(parents=True, exist_ok=True)
     out = oiio.ImageBuf(oiio.ImageSpec(img.shape[1], img.shape[0], 3, oiio.UINT8))

@@ -211,12 +211,10 @@ def _remove_strays(folder: Path, doc: dict[str, Any]) -> None:
 
 
 def _sheet(job: Job, doc: dict[str, Any]) -> Path:
-    import OpenImageIO as oiio
 
     images, labels = [], []
     for entry in doc["frames"]:
-        buf = oiio.ImageBuf(str(job.folder / entry["png"]["file"]))
-        images.append(buf.get_pixels(oiio.FLOAT)[..., :3])
+        images.append(contact.read_rgb(job.folder / entry["png"]["file"]))
         labels.append(f"{entry['kind']} {entry['angle']:.0f}°")
     title = f"{job.material.name} × {job.ibl}  ({job.settings.spp} spp)"
     columns = max(job.settings.element_frames, job.settings.light_frames)
@@ -491,14 +489,13 @@ def _first_png(out: Path, entry: dict[str, Any]) -> Path | None:
 def overview(out: Path, entries: list[dict[str, Any]]) -> Path:
     """``OUT/overview.png``: the first frame of every proof the batch lists, a row per
     material."""
-    import OpenImageIO as oiio
 
     images, labels = [], []
     for entry in entries:
         first = _first_png(out, entry)
         if first is None:
             continue
-        images.append(oiio.ImageBuf(str(first)).get_pixels(oiio.FLOAT)[..., :3])
+        images.append(contact.read_rgb(first))
         labels.append(f"{entry['material']} × {entry['ibl']}")
     columns = len({e["ibl"] for e in entries})
     sheet = contact.contact_sheet(images, labels, f"{len(images)} proofs", columns)

@@ -309,15 +309,12 @@ class Environment:
 
 def read_image(path: Path) -> np.ndarray:
     """An .exr/.hdr as (H, W, 3) float32 RGB; NaN and negative pixels become 0."""
-    import OpenImageIO as oiio
+    from .contact import ProofImageError, read_rgb
 
-    buf = oiio.ImageBuf(str(path))
-    pixels = buf.get_pixels(oiio.FLOAT) if not buf.has_error else None
-    if pixels is None or buf.has_error or pixels.ndim != 3:
-        raise IblError(
-            f"cannot decode the image ({buf.geterror() or 'no pixels'})", where=str(path)
-        )
-    pixels = pixels[..., :3] if pixels.shape[-1] >= 3 else np.repeat(pixels[..., :1], 3, -1)
+    try:
+        pixels = read_rgb(path)
+    except ProofImageError as exc:
+        raise IblError(exc.message, where=str(path)) from None
     return np.clip(np.nan_to_num(pixels, nan=0.0, posinf=0.0), 0.0, None).astype(np.float32)
 
 
