@@ -8,6 +8,7 @@ Commands are verbs; each group lives in its own module beside this one and is ad
 
 from __future__ import annotations
 
+import os
 import sys
 from importlib import metadata
 
@@ -82,6 +83,8 @@ def main(argv: list[str] | None = None) -> None:
     2; exit 1 stays "checked and found problems"; Ctrl-C ends in one line and exit 130.
     """
     click = _click_exceptions()
+    if argv is None:  # the console script: spawned proof workers inherit the filter
+        os.environ.setdefault("PYTHONWARNINGS", "ignore::RuntimeWarning")
     code: object = 0
     try:
         with quiet_numerics():
@@ -141,7 +144,7 @@ def _usage_line(exc) -> str:
         else:
             message = f"{name}: {given!r} is not a number in {allowed}"
     else:
-        message = exc.format_message().rstrip(".")
+        message = exc.format_message().replace("Value error, ", "").rstrip(".")
         message = message[:1].lower() + message[1:]
     return f"{message} (see '{where} --help')"
 
