@@ -123,7 +123,7 @@ def _header_doc(file: str) -> dict[str, Any]:
     cut = data.find(b"\n[")
     head = data if cut < 0 else data[: cut + 1]
     try:
-        doc = simple_header(head.decode("utf-8"))
+        doc = simple_header(head.decode("utf-8").removeprefix("\ufeff"))
     except UnicodeDecodeError:
         doc = None
     if doc is not None:
@@ -178,6 +178,10 @@ def simple_header(text: str) -> dict[str, Any] | None:
 def _header_fields(doc: dict[str, Any], name: str, where: str) -> tuple:
     """(model, description, tags, extends) of a parsed preset, checked just enough to list."""
     got = {k: doc.get(k) for k in ("name", "model", "description", "tags", "extends")}
+    if not doc:
+        raise PresetError("empty preset file: it needs at least name and model", where=where)
+    if got["name"] is None:
+        raise PresetError(f"no name; add name = {name!r}", where=where, field="name")
     if got["name"] != name or not NAME_RE.fullmatch(name):
         raise PresetError(f"name {got['name']!r} differs from the file name", where=where)
     if got["model"] is not None and got["model"] not in (*MODELS, "layered"):

@@ -108,9 +108,12 @@ def _merge_chain(name: str, lookup: Lookup, seen: tuple[str, ...]) -> tuple[Pres
     while current is not None:
         names = [*seen, *(p.name for p, _ in chain)]
         if current in names:
-            cycle = " → ".join([*names[names.index(current) :], current])
+            start = names.index(current)
+            cycle = " → ".join([*names[start:], current])
             where = str(chain[-1][1]) if chain else None
-            raise PresetError(f"cycle of presets: {cycle}", where=where, field="extends")
+            # A cycle that starts among the enclosing materials passes through a layer.
+            field = "layers" if start < len(seen) else "extends"
+            raise PresetError(f"cycle of presets: {cycle}", where=where, field=field)
         chain.append(_find_parent(current, lookup, chain))
         current = chain[-1][0].extends
     preset = chain[-1][0]

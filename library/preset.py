@@ -114,7 +114,10 @@ def parse_preset(data: bytes, *, where: str, stem: str | None = None) -> PresetF
     ``where`` names the file in messages; ``stem``, when given, is the file name the
     preset's ``name`` must equal.
     """
-    return build_preset(parse_toml(data, where=where), where=where, stem=stem)
+    doc = parse_toml(data, where=where)
+    if not doc:
+        raise PresetError("empty preset file: it needs at least name and model", where=where)
+    return build_preset(doc, where=where, stem=stem)
 
 
 def build_preset(doc: dict[str, Any], *, where: str, stem: str | None = None) -> PresetFile:
@@ -142,7 +145,8 @@ def parse_toml(data: bytes, *, where: str) -> dict[str, Any]:
             where=where,
         )
     try:
-        text = data.decode("utf-8")
+        # A byte-order mark (some Windows editors write one) is accepted and ignored.
+        text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         raise PresetError(f"not UTF-8 text (bad byte at offset {exc.start})", where=where) from None
     try:

@@ -7,6 +7,7 @@ allowed, so the CLI can print it as it is and exit with code 2.
 
 from __future__ import annotations
 
+import difflib
 from typing import Any, TypeVar
 
 from pydantic import BaseModel, ValidationError
@@ -88,7 +89,12 @@ def one_line(
     elif kind == "extra_forbidden":
         schema = _SCHEMAS.get(exc.title)
         known = len(loc) == 1 and schema is not None
-        msg = "unknown field" + (f"; allowed: {', '.join(schema.model_fields)}" if known else "")
+        msg = "unknown field"
+        if known:
+            names = list(schema.model_fields)
+            close = difflib.get_close_matches(str(loc[-1]), names, n=1, cutoff=0.6)
+            msg += f"; did you mean {close[0]!r}?" if close else ""
+            msg += f"{' ' if close else '; '}allowed: {', '.join(names)}"
     elif kind == "missing":
         msg = "required field is missing"
     elif kind == "finite_number":
@@ -98,6 +104,39 @@ def one_line(
     else:
         msg = f"{err['msg']} (got {given})"
     return error(msg, where=where, field=field)
+
+
+def check_range(
+    value: float,
+    low: float,
+    high: float,
+    *,
+    field: str,
+    error: type[LookdevError] = ParameterError,
+    where: str | None = None,
+) -> float:
+    """``value`` when it is a finite number in ``[low, high]``; else one ``error`` line in the
+    wording of :func:`one_line` (the numeric options of the API and the CLI use it).
+
+    >>> try:
+    ...     check_range(float("nan"), -32, 32, field="--exposure")
+    ... except LookdevError as exc:
+    ...     print(exc)
+    --exposure: nan is not a finite number; allowed [-32, 32]
+    """
+    import math
+
+    allowed = f"allowed [{low:g}, {high:g}]"
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        message = f"{short_repr(value)} is not a number; {allowed}"
+        raise error(message, field=field, where=where) from None
+    if not math.isfinite(number):
+        raise error(f"{number} is not a finite number; {allowed}", field=field, where=where)
+    if not low <= number <= high:
+        raise error(f"{value:g} is out of range; {allowed}", field=field, where=where)
+    return value
 
 
 def short_repr(value: Any, limit: int = 60) -> str:
@@ -115,8 +154,9 @@ def _range_text(exc: ValidationError, err: dict[str, Any]) -> str:
     schema is not known here (a nested model that did not call :func:`register_schema`)."""
     ctx = err.get("ctx") or {}
     loc = err["loc"]
-    if loc and isinstance(loc[-1], int):
-        lo, hi = 0.0, 1.0  # a colour channel
+    if loc and isinstance(loc[-1], int):  # an element of a tuple (a colour channel, a UV)
+        field = next((p for p in reversed(loc) if isinstance(p, str)), None)
+        lo, hi = _element_bounds(exc.title, field)
     else:
         field = next((p for p in reversed(loc) if isinstance(p, str)), None)
         lo, hi = _bounds(exc.title, field)
@@ -125,10 +165,30 @@ def _range_text(exc: ValidationError, err: dict[str, Any]) -> str:
         return bound or "a smaller or larger value"
     lo_text = "-∞" if lo is None else f"{float(lo):g}"
     hi_text = "∞" if hi is None else f"{float(hi):g}"
-    return f"[{lo_text}, {hi_text}]"
+    return f"{'(' if isinstance(lo, _Open) else '['}{lo_text}, {hi_text}]"
 
 
 _OPS = (("ge", "≥"), ("gt", ">"), ("le", "≤"), ("lt", "<"))
+
+
+def _element_bounds(model_name: str, field: str | None) -> tuple[float | None, float | None]:
+    """The (ge, le) bounds of the elements of the tuple field ``field`` (colour channels
+    are [0, 1], texture UVs ±4096), found like :func:`_bounds`."""
+    import typing
+
+    named = _SCHEMAS.get(model_name)
+    for cls in [named] * (named is not None) + list(_SCHEMAS.values()):
+        if field not in cls.model_fields:
+            continue
+        for arg in typing.get_args(cls.model_fields[field].annotation):
+            lo = hi = None
+            meta = getattr(arg, "__metadata__", ())
+            for m in [c for item in meta for c in (item, *getattr(item, "metadata", ()))]:
+                lo = getattr(m, "ge", None) if getattr(m, "ge", None) is not None else lo
+                hi = getattr(m, "le", None) if getattr(m, "le", None) is not None else hi
+            if lo is not None or hi is not None:
+                return lo, hi
+    return 0.0, 1.0  # a colour channel of an unregistered schema
 
 
 def _bounds(model_name: str, field: str | None) -> tuple[float | None, float | None]:
@@ -141,7 +201,13 @@ def _bounds(model_name: str, field: str | None) -> tuple[float | None, float | N
         lo = hi = None
         for m in cls.model_fields[field].metadata:
             lo = getattr(m, "ge", None) if getattr(m, "ge", None) is not None else lo
+            if getattr(m, "gt", None) is not None:  # an open floor: "(0, 10]"
+                lo = _Open(m.gt)
             hi = getattr(m, "le", None) if getattr(m, "le", None) is not None else hi
         if lo is not None or hi is not None:
             return lo, hi
     return None, None
+
+
+class _Open(float):
+    """A lower bound the value must exceed (pydantic's ``gt``)."""

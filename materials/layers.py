@@ -31,6 +31,15 @@ from pydantic import BeforeValidator, Field, TypeAdapter, model_validator
 
 from .params import Params, register_schema
 
+UV_MAX = 4096.0
+"""Ceiling of ``|uv_scale|`` and ``|uv_offset|`` of a texture (repeats of the UV square)."""
+UV = Annotated[float, Field(ge=-UV_MAX, le=UV_MAX)]
+SEED_MAX = 2**32 - 1
+"""Largest noise seed: the lattice hash is 32-bit."""
+RAMP_MAX = 1024.0
+RAMP_MIN_SPAN = 1e-6
+"""Bounds of a ramp's ``start`` and ``end`` (UV units) and their least separation."""
+
 Wrap = Literal["periodic", "clamp", "black", "mirror"]
 """How UVs outside 0..1 read a texture: repeat, edge texel, zero, or mirrored repeat."""
 
@@ -66,8 +75,14 @@ class TextureMask(Params):
         0, description="Channel index from 0, or its name ('R', 'G', 'B', 'A', 'Y', 'mask.R')."
     )
     invert: bool = Field(False, strict=True, description="Use 1 - value.")
-    uv_scale: tuple[float, float] = Field((1.0, 1.0), description="Repeats across the UV square.")
-    uv_offset: tuple[float, float] = Field((0.0, 0.0), description="Shift in UV, after scaling.")
+    uv_scale: tuple[UV, UV] = Field(
+        (1.0, 1.0),
+        description=f"Repeats across the UV square, each within ±{UV_MAX:g}: beyond it a "
+        "texel of the largest blend spans a whole repeat and u·scale loses its float32 fraction.",
+    )
+    uv_offset: tuple[UV, UV] = Field(
+        (0.0, 0.0), description=f"Shift in UV, after scaling; each within ±{UV_MAX:g}."
+    )
     wrap: Wrap = Field("periodic", description="Lookup outside 0..1: periodic|clamp|black|mirror.")
 
     @model_validator(mode="after")
@@ -90,7 +105,12 @@ class NoiseMask(Params):
     )
     octaves: int = Field(4, strict=True, ge=1, le=16, description="Number of octaves summed.")
     seed: int = Field(
-        0, strict=True, ge=0, description="Any non-negative integer; same seed, same mask."
+        0,
+        strict=True,
+        ge=0,
+        le=SEED_MAX,
+        description="A non-negative integer below 2³²; same seed, same mask (the lattice hash "
+        "is 32-bit, so a larger seed would repeat a smaller one).",
     )
     lacunarity: float = Field(
         2.0, strict=True, ge=1.0, le=8.0, description="Frequency ratio of octaves."
@@ -103,9 +123,20 @@ class RampMask(Params):
 
     kind: Literal["ramp"] = "ramp"
     axis: Literal["u", "v", "radial"] = Field("u", description="Direction of the gradient.")
-    start: float = Field(0.0, strict=True, description="Coordinate where the ramp is 0.")
+    start: float = Field(
+        0.0,
+        strict=True,
+        ge=-RAMP_MAX,
+        le=RAMP_MAX,
+        description=f"Coordinate where the ramp is 0; within ±{RAMP_MAX:g} UV squares.",
+    )
     end: float = Field(
-        1.0, strict=True, description="Coordinate where the ramp is 1 (radial: radius)."
+        1.0,
+        strict=True,
+        ge=-RAMP_MAX,
+        le=RAMP_MAX,
+        description=f"Coordinate where the ramp is 1 (radial: radius); within ±{RAMP_MAX:g}, "
+        f"at least {RAMP_MIN_SPAN:g} from start so its slope 1/(end − start) stays finite.",
     )
     interpolation: Literal["linear", "smooth"] = Field(
         "linear", description="Linear, or smoothstep (C1 at both ends)."
@@ -113,8 +144,11 @@ class RampMask(Params):
 
     @model_validator(mode="after")
     def _start_differs_from_end(self) -> RampMask:
-        if self.start == self.end:
-            raise ValueError("ramp start and end are equal; the ramp would be a step")
+        if abs(self.end - self.start) < RAMP_MIN_SPAN:
+            raise ValueError(
+                f"ramp start {self.start:g} and end {self.end:g} are closer than "
+                f"{RAMP_MIN_SPAN:g}; the ramp would be a step"
+            )
         return self
 
 

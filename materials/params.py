@@ -51,6 +51,12 @@ def _unit(default: float, description: str, *, le: float | None = 1.0, ge: float
     return Field(default, ge=ge, le=le, description=description)
 
 
+SHEEN_MAX = 10.0
+"""Ceiling of Disney ``sheen`` (DESIGN.md, Ranges: every parameter has a ceiling)."""
+SCATTER_DISTANCE_MIN = 1e-6
+SCATTER_DISTANCE_MAX = 1e6
+"""Bounds of a non-zero ``scatter_distance``: σt = 1/(s·d) stays a finite float32."""
+
 Channel = Annotated[float, Field(ge=0.0, le=1.0)]
 Color = Annotated[tuple[Channel, Channel, Channel], BeforeValidator(parse_color)]
 
@@ -96,7 +102,13 @@ class DisneyParams(Params):
     specular_tint: float = _unit(0.0, "Tints the incident specular towards the base colour.")
     roughness: float = _unit(0.5, "Perceptual roughness; α = roughness².")
     anisotropic: float = _unit(0.0, "Aspect ratio of the specular highlight.")
-    sheen: float = _unit(0.0, "Additional grazing lobe for cloth; may exceed 1.", le=None)
+    sheen: float = _unit(
+        0.0,
+        "Additional grazing lobe for cloth; may exceed 1 (Burley), up to 10: ten times the "
+        "plausible range already outshines the base at grazing, and the ceiling keeps every "
+        "float32 value of the model and of its albedo integrals finite (lookdev check sweeps it).",
+        le=SHEEN_MAX,
+    )
     sheen_tint: float = _unit(0.5, "Tints the sheen towards the base colour.")
     sheen_model: Literal["disney", "conty_kulla"] = Field(
         "disney", description="Burley's Fresnel-shaped sheen or the Conty-Kulla microfacet sheen."
@@ -113,9 +125,24 @@ class DisneyParams(Params):
         None, ge=1.0, le=10.0, description="Index of refraction; the 2015 spelling of specular."
     )
     scatter_distance: float = Field(
-        0.0, ge=0.0, description="Mean free path inside solid transmissive materials (scene units)."
+        0.0,
+        ge=0.0,
+        le=SCATTER_DISTANCE_MAX,
+        description="Mean free path inside solid transmissive materials (scene units); 0: no "
+        f"medium, else {SCATTER_DISTANCE_MIN:g} .. {SCATTER_DISTANCE_MAX:g}, so the medium's "
+        "σt = 1/(s·d), s in 1.04 .. 4.14, stays a finite float32 (beyond 10⁶ the interior is "
+        "clear at any scene scale).",
     )
     thin: bool = Field(False, description="Thin-walled surface (leaves, paper): no interior.")
+
+    @model_validator(mode="after")
+    def _scatter_distance_not_tiny(self) -> DisneyParams:
+        if 0.0 < self.scatter_distance < SCATTER_DISTANCE_MIN:
+            raise ValueError(
+                f"scatter_distance {self.scatter_distance:g} is out of range; allowed 0 or "
+                f"[{SCATTER_DISTANCE_MIN:g}, {SCATTER_DISTANCE_MAX:g}]"
+            )
+        return self
 
     @model_validator(mode="after")
     def _one_spelling_of_specular(self) -> DisneyParams:

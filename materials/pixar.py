@@ -64,7 +64,15 @@ WEIGHT_NAMES = (
 )
 
 
-def _scale(description: str, le: float | None = None) -> Any:
+LOBE_SCALE_MAX = 10.0
+"""Ceiling of the lobe ``*_scale`` parameters: above 1 a lobe adds energy on purpose (Smits'
+"Additional Parameters"); 10 bounds every lobe weight at 10 (surface colour and Fresnel
+terms are ≤ 1), so weights, values and albedos stay finite float32 (lookdev check)."""
+
+
+def _scale(description: str, le: float = LOBE_SCALE_MAX) -> Any:
+    if le == LOBE_SCALE_MAX:
+        description += f" Up to {LOBE_SCALE_MAX:g}: adds energy above 1, weights stay ≤ 10."
     return Field(1.0, ge=0.0, le=le, description=description)
 
 

@@ -202,11 +202,12 @@ def web_image(src: Path, out_dir: Path, exposure: float = 0.0) -> Path:
     dst = out_dir / "frames" / ("_".join(parts) + ".png")
     if dst.exists() and dst.stat().st_mtime >= src.stat().st_mtime:
         return dst
-    buf = oiio.ImageBuf(str(src))
-    pixels = np.asarray(buf.get_pixels(oiio.FLOAT))
-    if buf.has_error or pixels.ndim != 3:
-        raise ReportError(f"cannot read frame: {buf.geterror()}", where=str(src))
-    rgb = pixels[..., :3] if pixels.shape[-1] >= 3 else np.repeat(pixels[..., :1], 3, -1)
+    from lookdev.pipeline.proof.contact import ProofImageError, read_rgb
+
+    try:
+        rgb = read_rgb(src)
+    except ProofImageError as exc:
+        raise ReportError(f"cannot read frame: {exc.message}", where=str(src)) from None
     img = to_8bit(view(rgb, exposure))
     dst.parent.mkdir(parents=True, exist_ok=True)
     out = oiio.ImageBuf(oiio.ImageSpec(img.shape[1], img.shape[0], 3, oiio.UINT8))
@@ -223,7 +224,8 @@ def material_plots(
     """``{material: {view: png}}``; the sphere also under ``ibl`` (one of the batch's).
 
     ``hubs`` are the blended materials by name; a material of the batch not among them
-    (proofed in an earlier run) gets no plots; its frames and numbers are still shown.
+    (proofed in an earlier run) keeps the plots that run drew, if they are still there;
+    its frames and numbers are shown either way.
     """
     from .plots import figure, load_environment, save_figure
 
@@ -231,6 +233,10 @@ def material_plots(
     result: dict[str, dict[str, Path]] = {}
     for name in names:
         if name not in hubs:
+            # Proofed in an earlier run into this folder: keep the plots it drew.
+            kept = {v: out_dir / "plots" / f"{_slug(name)}_{v}.png" for v in PLOT_VIEWS}
+            if all(p.is_file() for p in kept.values()):
+                result[name] = kept
             continue
         result[name] = {
             view: save_figure(

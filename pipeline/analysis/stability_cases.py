@@ -37,7 +37,10 @@ from lookdev.materials.bsdf import Model
 from lookdev.materials.errors import LookdevError
 
 ALLOWANCE = {"disney": 0.77, "sheen": 0.002, "pixar": 0.0, "pixar_layered": 0.0}
-UNBOUNDED_HIGH = 10.0  # the "pushed" value of a field with no upper bound
+UNBOUNDED_HIGH = 10.0
+"""The "pushed" value of a field with no upper bound. Every field a preset accepts has a
+ceiling (DESIGN.md, Ranges), so the sweep tests each at its ceiling; only the composited
+Pixar lobe weights (model inputs a blend produces, never written in a preset) use this."""
 
 # Named stiff combinations (DESIGN.md), applied where every named field exists.
 COMBINATIONS: tuple[dict[str, Any], ...] = (

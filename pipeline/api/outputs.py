@@ -8,12 +8,9 @@ from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import Executor
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
-from lookdev.materials.errors import LookdevError
-
-if TYPE_CHECKING:
-    pass
+from lookdev.materials.errors import LookdevError, check_range
 
 from .materials import PathLike, _materials, hub, library_for
 
@@ -215,6 +212,10 @@ def _environment_file(name_or_path: PathLike | None) -> Path | None:
     return Path(ibls.resolve(str(name_or_path)))
 
 
+FILM_MAX_SIDE = 16384
+"""Largest film width or height of an exported Mitsuba scene, in pixels."""
+
+
 def export_mitsuba(
     material: Any,
     path: PathLike,
@@ -255,11 +256,11 @@ def export_mitsuba(
     from lookdev.pipeline.export.mitsuba import MitsubaExportError, export_scene
     from lookdev.pipeline.export.mitsuba.scene import files_of, uses_our_plugins
 
-    if min(resolution) < 1:
-        raise MitsubaExportError(
-            f"{resolution[0]} {resolution[1]}: width and height must be at least 1",
-            field="--resolution",
-        )
+    if len(tuple(resolution)) != 2:
+        raise MitsubaExportError(f"{tuple(resolution)} is not W H", field="--resolution")
+    for side in resolution:
+        check_range(side, 1, FILM_MAX_SIDE, field="--resolution", error=MitsubaExportError)
+    check_range(spp, 1, 2**20, field="--spp", error=MitsubaExportError)
     material = hub(material, map_resolution, library)
     env = _environment_file(ibl)
     scene = export_scene(
@@ -365,24 +366,23 @@ def proof(
     from lookdev.pipeline.proof import batch
     from lookdev.pipeline.proof import ibl as ibl_module
 
+    check_proof_settings(resolution, frames, light_frames, spp, exposure, jobs)
     lib = library_for(library)
     if materials is None or (not isinstance(materials, str | os.PathLike) and not materials):
         materials = representative_presets(lib)
-    loaded = [hub(m, batch.MAP_RESOLUTION, lib) for m in _materials(materials, lib)]
+    # The whole batch is checked before the first frame: the output folder, every preset
+    # and every texture it names (layers a blend would prune included), every IBL.
+    output = Path(out)
+    batch.check_writable(output)
+    chosen = _materials(materials, lib)
+    for material in chosen:
+        check_textures(material)
     if isinstance(ibls, str | os.PathLike):
         ibls = [ibls]
     ibl_names = list(dict.fromkeys(ibls or ibl_module.builtin_names()))
     environments = [ibl_module.load(name, ibl_width) for name in ibl_names]
-    if resolution[0] < 8 or resolution[1] < 8:
-        raise batch.ProofError(f"resolution {tuple(resolution)} is below 8×8", field="--resolution")
-    least = {"--frames": (frames, 1), "--light-frames": (light_frames, 0), "--spp": (spp, 2)}
-    if jobs is not None:
-        least["--workers"] = (jobs, 1)
-    for name, (value, low) in least.items():
-        if value < low:
-            raise batch.ProofError(f"{value} is below {low}", field=name)
+    loaded = [hub(m, batch.MAP_RESOLUTION, lib) for m in chosen]
     settings = batch.Settings(frames, light_frames, spp, tuple(resolution), exposure)
-    output = Path(out)
     doc = batch.proof(
         loaded,
         environments,
@@ -398,6 +398,59 @@ def proof(
 
         doc["report"] = str(write_report(output, materials={m.name: m for m in loaded}))
     return doc
+
+
+def check_textures(material: Any) -> None:
+    """Every texture a material names (masks and normal maps of every layer, nested
+    layered presets included, pruned or not) exists, decodes and has its channels; else
+    the one line of :class:`~lookdev.pipeline.blend.resample.TextureError`."""
+    from lookdev.materials.layers import textures
+    from lookdev.pipeline.blend.resample import TextureFile
+
+    for i, layer in enumerate(getattr(material, "layers", None) or []):
+        if not hasattr(layer, "mask"):  # a blend's or a model's own: nothing to read
+            return
+        where = f"{material.name}: layer {layer.name or layer.material.name or i!r}"
+        for tex in textures(layer.mask):
+            TextureFile(tex, 1, where=where)
+        for tex in (layer.normal_map, layer.specular_normal_map):
+            if tex is not None:
+                TextureFile(tex, 3, where=where)
+        check_textures(layer.material)
+
+
+def check_proof_settings(
+    resolution: tuple[int, int],
+    frames: int,
+    light_frames: int,
+    spp: int,
+    exposure: float,
+    jobs: int | None,
+) -> None:
+    """Every numeric setting of a proof batch in its documented range, or one line."""
+    from lookdev.pipeline.proof import batch, tonemap
+
+    error = batch.ProofError
+    if len(tuple(resolution)) != 2:
+        raise error(f"{tuple(resolution)} is not W H", field="--resolution")
+    for side in resolution:
+        check_range(side, batch.MIN_SIDE, batch.MAX_SIDE, field="--resolution", error=error)
+    checks = {"--frames": (frames, 1, 360), "--light-frames": (light_frames, 0, 360)}
+    checks["--spp"] = (spp, 2, 65536)
+    if jobs is not None:
+        checks["--workers"] = (jobs, 1, 1024)
+    for name, (value, low, high) in checks.items():
+        check_range(value, low, high, field=name, error=error)
+    check_range(
+        exposure, -tonemap.EXPOSURE_MAX, tonemap.EXPOSURE_MAX, field="--exposure", error=error
+    )
+    samples = resolution[0] * resolution[1] * spp
+    if samples > batch.MAX_SAMPLES:
+        raise error(
+            f"{resolution[0]}×{resolution[1]} at {spp} spp is {samples:.3g} samples a frame; "
+            f"allowed ≤ {batch.MAX_SAMPLES:.3g} (lower --spp or --resolution)",
+            field="--resolution",
+        )
 
 
 # -- plots ---------------------------------------------------------------------------------------
@@ -443,6 +496,10 @@ def plot(
         )
     if view not in PLOT_VIEWS:
         raise plots.PlotError(f"unknown view {view!r}; allowed {', '.join(PLOT_VIEWS)}")
+    from lookdev.pipeline.proof.tonemap import EXPOSURE_MAX
+
+    check_range(exposure, -EXPOSURE_MAX, EXPOSURE_MAX, field="--exposure", error=plots.PlotError)
+    check_range(resolution, 8, 1024, field="--resolution", error=plots.PlotError)
     lib = library_for(library)
     if isinstance(materials, str | os.PathLike):
         materials = [materials]

@@ -77,7 +77,8 @@ class TextureFile:
     def __init__(self, tex: TextureMask, count: int = 1, *, where: str | None = None):
         self.path, self.where, self.count = Path(tex.path), where, count
         if not self.path.is_file():
-            raise TextureError(f"texture file {self.path} does not exist", where=where)
+            what = "is a folder, not an image file" if self.path.is_dir() else "does not exist"
+            raise TextureError(f"texture file {self.path} {what}", where=where)
         image = self._open()
         spec = image.spec()
         image.close()

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import json
 import sys
+import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
 from rich.console import Console
@@ -11,6 +14,19 @@ from rich.table import Table
 
 console = Console()
 err_console = Console(stderr=True)
+
+
+@contextmanager
+def quiet_numerics() -> Iterator[None]:
+    """numpy's ``RuntimeWarning`` (overflow, invalid value, divide by zero) stays off stderr.
+
+    Parameters are range-checked at load so that no derived quantity overflows; the
+    stability sweep (``lookdev check``) reports non-finite values as findings. A warning
+    on stderr in between would only break the one-line rule.
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        yield
 
 
 def print_json(obj: Any) -> None:

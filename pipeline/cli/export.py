@@ -23,9 +23,10 @@ def mitsuba(
         typer.Option("--output", "-o", help="Scene XML to write.", dir_okay=False),
     ],
     resolution: Annotated[
-        tuple[int, int], typer.Option("--resolution", help="Film width and height in pixels.")
+        tuple[int, int],
+        typer.Option("--resolution", help="Film width and height in pixels, each 1 .. 16384."),
     ] = (512, 512),
-    spp: Annotated[int, typer.Option("--spp", min=1, help="Samples per pixel.")] = 128,
+    spp: Annotated[int, typer.Option("--spp", min=1, max=2**20, help="Samples per pixel.")] = 128,
     environment: Annotated[
         str | None,
         typer.Option(

@@ -185,6 +185,9 @@ def import_usd(
             "default: print the TOML.",
         ),
     ] = None,
+    force: Annotated[
+        bool, typer.Option("--force", help="Replace preset files of the same name in -o.")
+    ] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
     """Read materials from a USD file back into presets.
@@ -199,12 +202,18 @@ def import_usd(
       lookdev import usd gold.usda
 
       lookdev import usd library.usda -o imported/
+
+    A material that cannot become a preset (a layered Pixar material) is named in one
+    line and the command exits 2 after writing the others; a value a preset would reject
+    (out of range, NaN, infinity) is refused, never clamped; an existing preset file is
+    replaced only with --force.
     """
     from lookdev.pipeline.export.usd.presets import write_presets
     from lookdev.pipeline.export.usd.reader import import_usd as read
 
-    found = read(file.expanduser())
-    written = write_presets(found, output)
+    skipped: list[str] = []
+    found = read(file.expanduser(), skipped)
+    written = write_presets(found, output, force=force)
     if as_json:
         print_json(
             {
@@ -221,17 +230,25 @@ def import_usd(
                     for m in found
                 ],
                 "written": [str(p) for p in written],
+                "skipped": skipped,
             }
         )
-        return
-    if output is None:
+    elif output is None:
         from lookdev.pipeline.export.usd.presets import preset_toml
 
         for m in found:
             typer.echo(preset_toml(m))
-        return
-    for path in written:
-        console.print(f"wrote [bold]{path}[/]")
+    else:
+        for path in written:
+            console.print(f"wrote [bold]{path}[/]")
+    if skipped:
+        from lookdev.pipeline.export.usd.network import ExportError
+
+        raise ExportError(
+            f"imported {len(found)} of {len(found) + len(skipped)} materials; skipped "
+            + ", ".join(skipped),
+            where=str(file),
+        )
 
 
 @validate_app.command("usd")

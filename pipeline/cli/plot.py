@@ -42,7 +42,13 @@ def plot(
     ] = View.slice,
     exposure: Annotated[
         float,
-        typer.Option("--exposure", "-e", help="Stops applied before display (slice, sphere)."),
+        typer.Option(
+            "--exposure",
+            "-e",
+            min=-32.0,
+            max=32.0,
+            help="Stops applied before display (slice, sphere); -32 .. 32.",
+        ),
     ] = 0.0,
     ibl: Annotated[
         str | None,

@@ -148,13 +148,22 @@ def show(
             doc["resolved"] = material_json(material)
         print_json(doc)
         return
+    if material is None and not sys.stdout.isatty():
+        # Piped or redirected (`presets show gold > mine.toml`): the file as plain TOML, the
+        # provenance as comments, no Rich wrapping, so the output parses and round-trips.
+        text = path.read_text(encoding="utf-8-sig")
+        provenance = [f"# {preset.name} from {path}", *(f"# shadows {p}" for p in others)]
+        sys.stdout.write(
+            "\n".join(provenance) + "\n" + text + ("" if text.endswith("\n") else "\n")
+        )
+        return
     console.print(f"[bold]{preset.name}[/] from {path}", highlight=False)
     for p in others:
         console.print(f"  shadows {p}", style="dim", highlight=False)
     for link, dest in links:
         console.print(f"  read through the symlink {link} -> {dest}", style="dim", highlight=False)
     if material is None:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")
         console.print(Syntax(text, "toml", theme="ansi_dark", word_wrap=True))
     else:
         print_resolved(material)

@@ -49,13 +49,22 @@ def proof(
     ] = 32,
     resolution: Annotated[
         tuple[int, int],
-        typer.Option("--resolution", "-r", metavar="W H", help="Frame size in pixels."),
+        typer.Option(
+            "--resolution", "-r", metavar="W H", help="Frame size in pixels, each 8 .. 8192."
+        ),
     ] = (192, 96),
     output: Annotated[
         Path, typer.Option("--output", "-o", help="Folder for frames, sheets and manifests.")
     ] = Path("proofs"),
     exposure: Annotated[
-        float, typer.Option("--exposure", "-e", help="Stops applied by the PNG view transform.")
+        float,
+        typer.Option(
+            "--exposure",
+            "-e",
+            min=-32.0,
+            max=32.0,
+            help="Stops applied by the PNG view transform (-32 .. 32).",
+        ),
     ] = 0.0,
     ibl_width: Annotated[
         int,
@@ -77,6 +86,7 @@ def proof(
             "--workers",
             "-j",
             min=1,
+            max=1024,
             help="Local worker processes (default 1: each renders on every core).",
         ),
     ] = None,

@@ -49,6 +49,11 @@ TICK_S = 0.5
 FORMAT_VERSION = 1
 MAP_RESOLUTION = 512
 """Texels a side of a layered material's maps in a proof (the blend the proof renders)."""
+MIN_SIDE, MAX_SIDE = 8, 8192
+"""Frame width and height of a proof, in pixels (``--resolution W H``)."""
+MAX_SAMPLES = 2**32 - 1
+"""Most samples a frame may take, width × height × spp: Dr.Jit indexes a render's
+wavefront with 32-bit integers."""
 
 
 class ProofError(LookdevError):
@@ -205,12 +210,10 @@ def _remove_strays(folder: Path, doc: dict[str, Any]) -> None:
 
 
 def _sheet(job: Job, doc: dict[str, Any]) -> Path:
-    import OpenImageIO as oiio
 
     images, labels = [], []
     for entry in doc["frames"]:
-        buf = oiio.ImageBuf(str(job.folder / entry["png"]["file"]))
-        images.append(buf.get_pixels(oiio.FLOAT)[..., :3])
+        images.append(contact.read_rgb(job.folder / entry["png"]["file"]))
         labels.append(f"{entry['kind']} {entry['angle']:.0f}°")
     title = f"{job.material.name} × {job.ibl}  ({job.settings.spp} spp)"
     columns = max(job.settings.element_frames, job.settings.light_frames)
@@ -417,7 +420,14 @@ def _given(executor: Executor) -> Iterator[Executor]:
 
 
 def summary(out: Path, jobs: list[Job], results: list[dict[str, Any]], seconds: float) -> dict:
-    """The batch manifest: one entry per job, with totals; written to ``OUT/manifest.json``."""
+    """The batch manifest: one entry per job, with totals; written to ``OUT/manifest.json``.
+
+    A folder that already holds a batch keeps it: the entries of its ``manifest.json``
+    whose proofs are still on disk (their own manifest lists frames) and that this run
+    did not redo stay listed, in their place, and stay in ``overview.png``; this run's
+    proofs replace their namesakes and follow. So a re-proof of a subset adds to the
+    batch instead of forgetting the rest.
+    """
     entries = []
     for job, doc in zip(jobs, results, strict=True):
         times = [f["seconds"] for f in doc["frames"]]
@@ -435,26 +445,61 @@ def summary(out: Path, jobs: list[Job], results: list[dict[str, Any]], seconds: 
                 "contact_sheet": str(job.folder.relative_to(out) / "contact.png"),
             }
         )
+    entries = merge_entries(out, entries)
     doc = {
         "version": FORMAT_VERSION,
         "wall_seconds": round(seconds, 3),
         "settings": jobs[0].settings.as_json() if jobs else {},
         "proofs": entries,
-        "overview": overview(out, jobs, results).name if jobs else None,
+        "overview": overview(out, entries).name if entries else None,
     }
     write_json(doc, out / MANIFEST)
     return doc
 
 
-def overview(out: Path, jobs: list[Job], results: list[dict[str, Any]]) -> Path:
-    """``OUT/overview.png``: the first frame of every proof, a row per material."""
-    import OpenImageIO as oiio
+def merge_entries(out: Path, entries: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """``entries`` merged into the batch manifest ``out`` already holds (see :func:`summary`)."""
+    try:
+        old = json.loads((out / MANIFEST).read_text(encoding="utf-8")).get("proofs", [])
+    except (OSError, ValueError, AttributeError):
+        return entries
+    new = {(e["material"], e["ibl"]): e for e in entries}
+    merged = []
+    for entry in old if isinstance(old, list) else []:
+        try:
+            key = (entry["material"], entry["ibl"])
+            kept = key not in new and bool(_first_png(out, entry))
+        except (KeyError, TypeError):
+            continue
+        if key in new:
+            merged.append(new.pop(key))
+        elif kept:
+            merged.append(entry | {"rendered": 0, "skipped": entry.get("frames", 0)})
+    return merged + list(new.values())
+
+
+def _first_png(out: Path, entry: dict[str, Any]) -> Path | None:
+    """The first frame's PNG of a batch entry, from its own manifest; None when gone."""
+    folder = out / entry["folder"]
+    try:
+        doc = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
+        first = folder / doc["frames"][0]["png"]["file"]
+    except (OSError, ValueError, KeyError, IndexError, TypeError):
+        return None
+    return first if first.is_file() else None
+
+
+def overview(out: Path, entries: list[dict[str, Any]]) -> Path:
+    """``OUT/overview.png``: the first frame of every proof the batch lists, a row per
+    material."""
 
     images, labels = [], []
-    for job, doc in zip(jobs, results, strict=True):
-        first = job.folder / doc["frames"][0]["png"]["file"]
-        images.append(oiio.ImageBuf(str(first)).get_pixels(oiio.FLOAT)[..., :3])
-        labels.append(f"{doc['material']} × {doc['ibl']}")
-    columns = len({job.ibl for job in jobs})
-    sheet = contact.contact_sheet(images, labels, f"{len(jobs)} proofs", columns)
+    for entry in entries:
+        first = _first_png(out, entry)
+        if first is None:
+            continue
+        images.append(contact.read_rgb(first))
+        labels.append(f"{entry['material']} × {entry['ibl']}")
+    columns = len({e["ibl"] for e in entries})
+    sheet = contact.contact_sheet(images, labels, f"{len(images)} proofs", columns)
     return contact.write_png(sheet, out / "overview.png")

@@ -8,6 +8,9 @@ still labels every frame, so a sheet is never unlabelled.
 
 from __future__ import annotations
 
+import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -174,3 +177,42 @@ def write_png(display: np.ndarray, path: Path) -> Path:
 
     buf = oiio.ImageBuf(np.ascontiguousarray(to_8bit(display)))
     return _atomic_write(path, ".png", lambda tmp: None if buf.write(tmp) else buf.geterror())
+
+
+@contextmanager
+def quiet_c_stderr() -> Iterator[None]:
+    """File descriptor 2 goes to /dev/null for the block: libpng and OpenImageIO print
+    some decode errors ("libpng error: …", "An ImageBuf was destroyed with a pending
+    error …") straight to it, beside the one line lookdev reports for the same problem."""
+    import sys
+
+    try:
+        sys.stderr.flush()
+        saved = os.dup(2)
+    except (OSError, ValueError, AttributeError):
+        yield
+        return
+    try:
+        with open(os.devnull, "wb") as null:
+            os.dup2(null.fileno(), 2)
+            yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+
+
+def read_rgb(path: Path) -> np.ndarray:
+    """(H, W, 3) float32 RGB of an image file (a grey one repeated), or one
+    :class:`ProofImageError` line when it does not decode; nothing reaches stderr."""
+    import OpenImageIO as oiio
+
+    with quiet_c_stderr():
+        buf = oiio.ImageBuf(str(path))
+        pixels = buf.get_pixels(oiio.FLOAT)
+        error = buf.geterror() if buf.has_error else ""
+        del buf  # its destructor prints any error left unread
+    if error or pixels is None or np.ndim(pixels) != 3:
+        first = (error or "no pixels").strip().splitlines()[0]
+        raise ProofImageError(f"cannot decode the image ({first})", where=str(path))
+    pixels = np.asarray(pixels, dtype=np.float32)
+    return pixels[..., :3] if pixels.shape[-1] >= 3 else np.repeat(pixels[..., :1], 3, -1)

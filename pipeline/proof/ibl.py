@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import logging
 import math
 import os
 import tomllib
@@ -292,6 +293,11 @@ def resolve(name_or_path: str | Path, width: int = DEFAULT_WIDTH) -> Path:
     return out
 
 
+def _cached(path: Path) -> bool:
+    """True for a generated IBL in the cache (which lookdev may delete and regenerate)."""
+    return path.parent == cache_dir() and path.suffix == ".exr"
+
+
 @dataclass(frozen=True)
 class Environment:
     """An IBL ready to render: its name, file and pixels (H, W, 3) float32."""
@@ -303,15 +309,12 @@ class Environment:
 
 def read_image(path: Path) -> np.ndarray:
     """An .exr/.hdr as (H, W, 3) float32 RGB; NaN and negative pixels become 0."""
-    import OpenImageIO as oiio
+    from .contact import ProofImageError, read_rgb
 
-    buf = oiio.ImageBuf(str(path))
-    pixels = buf.get_pixels(oiio.FLOAT) if not buf.has_error else None
-    if pixels is None or buf.has_error or pixels.ndim != 3:
-        raise IblError(
-            f"cannot decode the image ({buf.geterror() or 'no pixels'})", where=str(path)
-        )
-    pixels = pixels[..., :3] if pixels.shape[-1] >= 3 else np.repeat(pixels[..., :1], 3, -1)
+    try:
+        pixels = read_rgb(path)
+    except ProofImageError as exc:
+        raise IblError(exc.message, where=str(path)) from None
     return np.clip(np.nan_to_num(pixels, nan=0.0, posinf=0.0), 0.0, None).astype(np.float32)
 
 
@@ -334,6 +337,21 @@ def load(
     if width < 8 or width % 2:
         raise IblError(f"width {width} must be even and at least 8", field="width")
     path = resolve(name_or_path, width)
-    pixels = resample(read_image(path), width) * np.float32(2.0**exposure)
+    try:
+        image = read_image(path)
+        if _cached(path) and image.shape[:2] != (width // 2, width):
+            raise IblError(f"{image.shape[1]}×{image.shape[0]}, not {width}×{width // 2}")
+    except IblError as exc:
+        if not _cached(path):
+            raise
+        # A cached IBL that does not decode or has the wrong size (a killed write, a
+        # copied cache): regenerate it instead of failing every proof under it.
+        logging.getLogger("lookdev").warning(
+            "lookdev: note: cached IBL %s was unusable (%s); regenerated", path, exc.message
+        )
+        path.unlink(missing_ok=True)
+        path = resolve(name_or_path, width)
+        image = read_image(path)
+    pixels = resample(image, width) * np.float32(2.0**exposure)
     name = path.stem if Path(str(name_or_path)).suffix.lower() in SUFFIXES else str(name_or_path)
     return Environment(name, path, pixels)

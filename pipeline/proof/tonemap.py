@@ -22,6 +22,9 @@ import numpy as np
 from lookdev.materials.colour import srgb_encode
 
 DEFAULT_KNEE = 0.6
+EXPOSURE_MAX = 32.0
+"""Largest |exposure| in stops (proofs, plots): 2³² scales any float32 radiance of a
+proof or a plot without overflow worth showing, and a display needs far less."""
 
 
 def shoulder(m: np.ndarray, knee: float = DEFAULT_KNEE) -> np.ndarray:

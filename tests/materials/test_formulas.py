@@ -136,7 +136,10 @@ def test_one_line_edges():
     long = _message(DisneyParams.parse, {"roughness": "x" * 500})
     assert "x" * 60 not in long.message and "...)" in long.message
     unknown = _message(DisneyParams.parse, {"roughnes": 0.5})
-    assert unknown.message.startswith("unknown field; allowed: base_color, subsurface, metallic")
+    # issue 13: a near miss of a known field is named (difflib) before the allowed list
+    assert unknown.message.startswith(
+        "unknown field; did you mean 'roughness'? allowed: base_color, subsurface, metallic"
+    )
     both = _message(DisneyParams.parse, {"specular": 0.5, "ior": 1.5})
     assert both.field is None and "not both" in both.message
 

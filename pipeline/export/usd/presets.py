@@ -11,6 +11,7 @@ import re
 from pathlib import Path
 
 from lookdev.library import PresetFile, dump_preset, files
+from lookdev.library.preset import parse_preset
 
 from .network import ExportError
 from .reader import Imported
@@ -43,9 +44,16 @@ def preset_toml(material: Imported) -> str:
     return text + ("\n" + "\n".join(notes) + "\n" if notes else "")
 
 
-def write_presets(found: list[Imported], output: Path | None) -> list[Path]:
-    """Write each material to ``output`` (a .toml for one, a folder for several)."""
+def write_presets(found: list[Imported], output: Path | None, *, force: bool = False) -> list[Path]:
+    """Write each material to ``output`` (a .toml for one, a folder for several).
+
+    Every preset is validated as ``presets validate`` would before anything is written
+    (one line naming the file and field when one is not valid), and an existing preset
+    file is replaced only with ``force``.
+    """
     if output is None:
+        for m in found:
+            check_preset(preset_toml(m), f"{preset_name(m.name)}.toml")
         return []
     output = output.expanduser()
     if output.suffix == ".toml":
@@ -56,15 +64,28 @@ def write_presets(found: list[Imported], output: Path | None) -> list[Path]:
         targets = [output]
     else:
         if not output.is_dir():
-            raise ExportError("folder does not exist (or give a .toml file)", where=str(output))
+            what = "is a file, not a folder" if output.exists() else "folder does not exist"
+            raise ExportError(f"{what} (give a folder or a .toml file)", where=str(output))
         targets = [output / f"{preset_name(m.name)}.toml" for m in found]
     texts = [preset_toml(m) for m in found]
+    for path, text in zip(targets, texts, strict=True):
+        check_preset(text, str(path), stem=path.stem)
     for path in targets:
         if not path.parent.is_dir() or not os.access(path.parent, os.W_OK):
             raise ExportError("folder does not exist or is not writable", where=str(path))
+        if path.exists() and not force:
+            raise ExportError(
+                "a preset file of that name exists; give --force to replace it", where=str(path)
+            )
     for path, text in zip(targets, texts, strict=True):
         _write_atomic(path, text)
     return targets
+
+
+def check_preset(text: str, where: str, stem: str | None = None) -> None:
+    """Raise the one line ``presets validate`` would print if ``text`` is not a valid preset
+    (its own parameters: references are not resolved here)."""
+    parse_preset(text.encode("utf-8"), where=where, stem=stem)
 
 
 def _write_atomic(path: Path, text: str) -> None:

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from lookdev.materials.colour import luminance
+from lookdev.materials.errors import LookdevError
 from lookdev.materials.fresnel import SPECULAR_F0_SCALE, ior_to_specular, specular_to_ior
 
 from .lobes import DEFAULTS, active_lobes, effective
@@ -138,23 +139,52 @@ def _plain(value: Any) -> Any:
     return value
 
 
-def import_usd(path: Path) -> list[Imported]:
-    """Read every material of the USD file ``path`` into presets."""
+SKIPPED_WHY = {
+    "pixar_weights": "a layered Pixar material: composited lobe weights have no preset "
+    "parameters; import its layers' presets instead",
+}
+"""Why a material of a given ``model`` (customData) cannot be imported."""
+NO_SURFACE = "no UsdPreviewSurface, ND_disney_principled or PxrDisneyBsdf surface"
+
+
+def import_usd(path: Path, skipped: list[str] | None = None) -> list[Imported]:
+    """Read every material of the USD file ``path`` into presets.
+
+    A material that cannot become a preset (a layered Pixar material, a surface lookdev
+    does not read) is never dropped silently: its name and the reason are appended to
+    ``skipped`` when a list is given, and named in the error when nothing is readable.
+    A value a preset would reject (out of range, NaN, infinity) is refused in one line
+    naming the file, the material and the field: an import never clamps silently.
+    """
     from pxr import Tf, Usd
 
     path = Path(path)
     if not path.is_file():
-        raise ExportError("file does not exist", where=str(path))
+        what = "is a folder, not a USD file" if path.is_dir() else "file does not exist"
+        raise ExportError(what, where=str(path))
     try:
         stage = Usd.Stage.Open(str(path))
     except Tf.ErrorException:
         raise ExportError("USD cannot open it", where=str(path)) from None
-    found = [_imported(spec) for spec in read_networks(stage)]
-    found = [f for f in found if f is not None]
+    found, left = [], []
+    for spec in read_networks(stage):
+        try:
+            imported = _imported(spec)
+        except LookdevError as exc:
+            raise ExportError(
+                exc.message, where=f"{path}: material {spec.name!r}", field=exc.field
+            ) from None
+        if imported is None:
+            why = SKIPPED_WHY.get(spec.custom.get("model", "disney"), NO_SURFACE)
+            left.append(f"{spec.name!r} ({why})")
+        else:
+            found.append(imported)
+    if skipped is not None:
+        skipped.extend(left)
     if not found:
+        detail = f"; skipped {', '.join(left)}" if left else ""
         raise ExportError(
-            "no material with a UsdPreviewSurface, ND_disney_principled or PxrDisneyBsdf surface",
-            where=str(path),
+            f"no material to import: none has a {NO_SURFACE[3:]}{detail}", where=str(path)
         )
     return found
 

@@ -206,7 +206,8 @@ def check_writable(path: Path) -> None:
     """Raise :class:`ExportError` unless ``path`` can be created in an existing folder."""
     folder = path.parent
     if not folder.is_dir():
-        raise ExportError(f"folder {folder} does not exist", where=str(path))
+        what = "is a file, not a folder" if folder.exists() else "does not exist"
+        raise ExportError(f"folder {folder} {what}", where=str(path))
     if not os.access(folder, os.W_OK | os.X_OK):
         raise ExportError(f"folder {folder} is not writable", where=str(path))
     if path.exists() and path.is_dir():

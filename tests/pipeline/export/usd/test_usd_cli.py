@@ -118,7 +118,7 @@ def _one_line_error(result) -> str:
     "target, words",
     [
         ("missing/dir/out.usda", "does not exist"),
-        ("afile.txt/out.usda", "does not exist"),
+        ("afile.txt/out.usda", "is a file, not a folder"),  # issue 13: it exists
         ("out.txt", "not a USD file name"),
     ],
 )

@@ -54,7 +54,8 @@ disney = st.fixed_dictionaries(
         "spec_trans": edge_unit,
         "diff_trans": edge_unit,
         "flatness": edge_unit,
-        "scatter_distance": st.sampled_from([0.0]) | st.floats(0.0, 10.0),
+        # 0 (no medium) or at least 1e-6: a tinier one made σt infinite (issue 13)
+        "scatter_distance": st.sampled_from([0.0]) | st.floats(1e-6, 10.0),
         "thin": st.booleans(),
     },
     optional={"ior": st.floats(1.0, 3.0), "specular": st.floats(0.0, 2.0)},
