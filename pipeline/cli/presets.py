@@ -153,6 +153,7 @@ def show(
         # provenance as comments, no Rich wrapping, so the output parses and round-trips.
         text = path.read_text(encoding="utf-8-sig")
         provenance = [f"# {preset.name} from {path}", *(f"# shadows {p}" for p in others)]
+        provenance += [f"# read through the symlink {link} -> {dest}" for link, dest in links]
         sys.stdout.write(
             "\n".join(provenance) + "\n" + text + ("" if text.endswith("\n") else "\n")
         )

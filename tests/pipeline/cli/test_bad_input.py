@@ -493,6 +493,9 @@ def stubbed(monkeypatch, tmp_path):
         def to_json(self):
             return {}
 
+        def loss_rows(self):
+            return []
+
     monkeypatch.setattr(api, "export_usd", lambda *a, **k: Exported())
     monkeypatch.setattr(api, "bake", lambda *a, **k: {"sidecar": tmp_path / "x.json"})
     monkeypatch.setattr(Lib, "update", lambda self, name, changes: tmp_path / f"{name}.toml")
