@@ -18,9 +18,10 @@ do we. Three estimators:
 * :func:`albedo_tabulated`: a look-up table a model ships for layering (Conty-Kulla
   2017 §5, albedo scaling), where it has one.
 
-Directions are in the shading frame (normal +z); ``wo`` lies in the x-z plane at angle
-θ from the normal. ``hemisphere="reflect"`` integrates over the upper hemisphere only;
-``"both"`` adds transmission.
+Directions are in the shading frame (normal +z); ``wo`` lies at angle θ from the normal
+and azimuth φ from the tangent (+x), φ = 0 by default: the x-z plane (φ = 90° is the
+bitangent, where an anisotropic lobe differs). ``hemisphere="reflect"`` integrates over
+the upper hemisphere only; ``"both"`` adds transmission.
 """
 
 from __future__ import annotations
@@ -37,14 +38,19 @@ from lookdev.materials.bsdf import Model, draw, evaluate
 Hemisphere = Literal["reflect", "both"]
 
 
-def view_direction(theta: Any, dtype: Any = np.float64) -> np.ndarray:
-    """Unit vectors at polar angle ``theta`` (radians) in the x-z plane, shape (..., 3).
+def view_direction(theta: Any, dtype: Any = np.float64, phi: float = 0.0) -> np.ndarray:
+    """Unit vectors at polar angle ``theta`` and azimuth ``phi`` (radians), shape (..., 3).
+
+    φ = 0 (the default) is the x-z plane, the tangent side; φ = π/2 the bitangent.
 
     >>> view_direction(0.0).tolist()
     [0.0, 0.0, 1.0]
     """
     t = np.asarray(theta, dtype=dtype)
-    return np.stack([np.sin(t), np.zeros_like(t), np.cos(t)], axis=-1)
+    if phi == 0.0:  # exactly the x-z plane (no cos(0)·sin rounding, y exactly 0)
+        return np.stack([np.sin(t), np.zeros_like(t), np.cos(t)], axis=-1)
+    c, s = np.cos(phi), np.sin(phi)
+    return np.stack([np.sin(t) * c, np.sin(t) * s, np.cos(t)], axis=-1).astype(dtype)
 
 
 @dataclass(frozen=True)
@@ -113,8 +119,11 @@ def albedo_monte_carlo(
     seed: int = 0,
     hemisphere: Hemisphere = "reflect",
     dtype: Any = np.float64,
+    phi: float = 0.0,
 ) -> AlbedoCurve:
     """E(θ) as the mean of the sampler's weights f·|cos θi|/pdf, with its standard error.
+
+    The views lie at azimuth ``phi`` (radians) from the tangent; 0 by default.
 
     A failed sample (pdf 0) counts as zero, as it does in a renderer; so does a sample
     in the wrong hemisphere when only reflection is asked for.
@@ -122,7 +131,7 @@ def albedo_monte_carlo(
     theta = np.atleast_1d(np.asarray(theta, dtype=np.float64))
     rng = np.random.default_rng(seed)
     u = _stratified_uniforms(rng, n_samples).astype(dtype)
-    wo = view_direction(theta, dtype)
+    wo = view_direction(theta, dtype, phi)
     wi, weight, pdf = draw(model, params, wo[:, None, :], u[None, :, :], dtype=dtype)
     keep = (pdf > 0) & np.all(np.isfinite(weight), axis=-1)
     if hemisphere == "reflect":

@@ -6,8 +6,10 @@ the cases of :mod:`.stability_cases` in float32 and float64.
 It counts cases where the model raised (a finding, not a stop), queries whose output
 (f, pdf, sampled direction, weight) holds a NaN, an infinity or a negative value, and
 directional albedos (the model's own importance sampler, 2048 stratified samples per view
-at θo = 0, 45, 60, 75, 89, 89.99°, every colour white: a furnace) that exceed 1 + the
-model's allowance by more than four standard errors.
+at θo = 0, 45, 60, 75, 89, 89.99° and at azimuths φo = 0, 45, 90° from the tangent — the
+tangent, the diagonal and the bitangent, where an anisotropic lobe differs —, every colour
+white: a furnace) that exceed 1 + the model's allowance by more than four standard errors.
+The largest albedo met is reported per azimuth too.
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ from .stability_cases import (
 DTYPES = (np.float32, np.float64)
 MAPS_LABEL = "per-element maps of every field"
 FURNACE_THETA_DEG = (0.0, 45.0, 60.0, 75.0, 89.0, 89.99)
+FURNACE_PHI_DEG = (0.0, 45.0, 90.0)  # tangent, diagonal, bitangent
 FURNACE_SAMPLES = 2048
 SIGMAS = 4.0
 ROUNDING = {"float32": 1e-5, "float64": 1e-12}  # a white Lambertian sums to 1 ± this
@@ -68,6 +71,7 @@ class ModelReport:
     cases_by_dtype: dict[str, int] = field(default_factory=dict)
     failures: dict[str, Finding] = field(default_factory=dict)  # first or largest per kind
     max_albedo: Finding | None = None
+    max_albedo_by_azimuth: dict[float, Finding] = field(default_factory=dict)  # φo in degrees
 
     @property
     def failed(self) -> bool:
@@ -88,6 +92,9 @@ class ModelReport:
             **self.counts,
             "worst": worst.to_json() if worst else None,
             "allowance": self.allowance,
+            "max_albedo_by_azimuth": {
+                f"{phi:g}": f.to_json() for phi, f in sorted(self.max_albedo_by_azimuth.items())
+            },
             "by_dtype": {
                 k: {"cases": self.cases_by_dtype[k], **v} for k, v in self.by_dtype.items()
             },
@@ -171,15 +178,26 @@ def _sweep_queries(
 def _sweep_energy(
     report: ModelReport, model: Model, label: str, params: Any, dtype: Any, whiten: bool = True
 ) -> None:
+    """The furnace at every view: each θo at each azimuth of FURNACE_PHI_DEG."""
+    furnace = white(params) if whiten else params
+    for phi in FURNACE_PHI_DEG:
+        _sweep_energy_at(report, model, label, furnace, dtype, phi)
+
+
+def _sweep_energy_at(
+    report: ModelReport, model: Model, label: str, params: Any, dtype: Any, phi: float
+) -> None:
+    """The furnace views at every θo of one azimuth φo (degrees from the tangent)."""
     name = np.dtype(dtype).name
     theta = np.radians(FURNACE_THETA_DEG)
     curve = albedo_monte_carlo(
         model,
-        white(params) if whiten else params,
+        params,
         theta,
         n_samples=FURNACE_SAMPLES,
         hemisphere="both",
         dtype=dtype,
+        phi=float(np.radians(phi)),
     )
     mean, err = curve.albedo, curve.stderr
     report.cases += len(theta)
@@ -187,14 +205,19 @@ def _sweep_energy(
     excess = mean - SIGMAS * err - (1.0 + report.allowance + ROUNDING[name])
     k, c = np.unravel_index(np.argmax(mean), mean.shape)
     top = float(mean[k, c])
+    view = f"θo = {FURNACE_THETA_DEG[k]:g}°, φo = {phi:g}°"
+    case = f"{label} (white); {name}; {view} ± {err[k, c]:.2g}"
     if report.max_albedo is None or top > (report.max_albedo.value or 0.0):
-        case = f"{label} (white); {name}; θo = {FURNACE_THETA_DEG[k]:g}° ± {err[k, c]:.2g}"
         report.max_albedo = Finding("max_albedo", case, top)
+    best = report.max_albedo_by_azimuth.get(phi)
+    if best is None or top > (best.value or 0.0):
+        report.max_albedo_by_azimuth[phi] = Finding("max_albedo", case, top)
     gained = (excess > 0).any(axis=-1)
     if gained.any():
         k = int(np.argmax(excess.max(axis=-1)))
         value = float(mean[k].max())
-        case = f"{label} (white); {name}; θo = {FURNACE_THETA_DEG[k]:g}°, albedo {value:.4g}"
+        view = f"θo = {FURNACE_THETA_DEG[k]:g}°, φo = {phi:g}°"
+        case = f"{label} (white); {name}; {view}, albedo {value:.4g}"
         report._count(name, "energy_gain", int(gained.sum()), Finding("energy_gain", case, value))
 
 

@@ -16,12 +16,19 @@ The cases of DESIGN.md, "Numerics that need care", for every model:
 
 Allowances: the Conty-Kulla lobe and Smits' model conserve energy by construction (sheen
 0.002: its albedo table's measured interpolation error; pixar 0). The Disney BRDF adds
-energy by design; its allowance is 0.77: tests/test_disney.py measures each lobe's gain up
-to θo = 89° (rough white plastic 1.567, sheen +0.09, clearcoat +0.05), and with all of them
-at once and ``specular`` 1 the albedo keeps rising towards grazing: 1.721 at 89°, 1.758 at 89.9°,
-1.762 ± 0.001 at 89.99° and 89.9999° (4·10⁵ samples each). Parameters
-pushed past their plausible range (sheen 10, specular 12.5, clearcoat 4) are checked for
-NaN, infinity and sign only: Burley allows them precisely to add energy.
+energy by design (Burley 2012 fits measured looks, not energy conservation: the
+retro-reflective diffuse, the sheen and the clearcoat are added on top), so its allowance is
+a measured bound, documented here, not a tuning knob: 0.79. tests/test_disney.py measures
+each lobe's gain up to θo = 89° (rough white plastic 1.567, sheen +0.09, clearcoat +0.05).
+With all of them at once and ``specular`` 1 the albedo keeps rising towards grazing: 1.721
+at 89°, 1.758 at 89.9°, 1.762 ± 0.001 at 89.99° and 89.9999° along the tangent (φo = 0).
+The maximum is along the bitangent of an anisotropic lobe: with ``anisotropic`` 1 as well
+(roughness 1, sheen 1, clearcoat 1, clearcoat_gloss 0, specular 1), at θo = 89.9999° it is
+1.718 ± 0.001 at φo = 0, 1.722 ± 0.001 at 45° and **1.783 ± 0.0014 at 90°** (2.6·10⁵
+samples each, float64); 1.783 + 4σ < 1.79, hence 0.79. (White satin, the preset, reaches
+1.41 along the bitangent against 1.11 along the tangent.) Parameters pushed past their
+plausible range (sheen 10, specular 12.5, clearcoat 4) are checked for NaN, infinity and
+sign only: Burley allows them precisely to add energy.
 """
 
 from __future__ import annotations
@@ -36,7 +43,7 @@ from lookdev.materials import registry
 from lookdev.materials.bsdf import Model
 from lookdev.materials.errors import LookdevError
 
-ALLOWANCE = {"disney": 0.77, "sheen": 0.002, "pixar": 0.0, "pixar_layered": 0.0}
+ALLOWANCE = {"disney": 0.79, "sheen": 0.002, "pixar": 0.0, "pixar_layered": 0.0}
 UNBOUNDED_HIGH = 10.0
 """The "pushed" value of a field with no upper bound. Every field a preset accepts has a
 ceiling (DESIGN.md, Ranges), so the sweep tests each at its ceiling; only the composited
@@ -49,6 +56,18 @@ COMBINATIONS: tuple[dict[str, Any], ...] = (
     {"roughness": 1.0, "anisotropic": 1.0},  # GTR 0/0 at α → 1
     {"base_color": (0.0, 0.0, 0.0), "specular_tint": 1.0, "sheen": 1.0, "sheen_tint": 1.0},
     {"roughness": 1.0, "sheen": 1.0, "clearcoat": 1.0, "clearcoat_gloss": 0.0},
+    # every lobe on, anisotropic: the largest Disney albedo, along the bitangent
+    {
+        "roughness": 1.0,
+        "sheen": 1.0,
+        "clearcoat": 1.0,
+        "clearcoat_gloss": 0.0,
+        "specular": 1.0,
+        "anisotropic": 1.0,
+    },
+    # the satin preset's lobes (white in the furnace): 1.41 along the bitangent, 1.11 along
+    # the tangent
+    {"specular": 0.6, "roughness": 0.35, "anisotropic": 0.85, "sheen": 0.5, "sheen_tint": 0.3},
     {"clearcoat": 1.0, "clearcoat_gloss": 1.0},  # α = 0.001 clearcoat
     {"spec_trans": 1.0, "roughness": 0.0},  # smooth glass
     {"spec_trans": 1.0, "ior": 1.0, "roughness": 0.3},  # η = 1: refraction degenerates

@@ -36,7 +36,8 @@ def check(
 
     Counts outputs (f, pdf, samples) with a NaN, an infinity or a negative
     value, and white-furnace albedos above 1 + the model's allowance
-    (Disney adds energy by design: 0.77; sheen 0.002; pixar 0).
+    (Disney adds energy by design: 0.79, measured; sheen 0.002; pixar 0).
+    Furnace views: θo up to 89.99° at azimuths 0, 45, 90° (tangent to bitangent).
 
     Exit code 0 when nothing was found, 1 when anything was.
     """
@@ -79,6 +80,12 @@ def _print(reports: dict[str, stability.ModelReport], seconds: float):
             label = "worst" if r.failed else "highest albedo"
             value = f" = {worst.value:.4g}" if worst.value is not None else ""
             t.caption = f"{label}: {worst.kind}{value} at {worst.case}"
+            if r.max_albedo_by_azimuth:
+                per_phi = ", ".join(
+                    f"φo {phi:g}° {f.value:.4g}"
+                    for phi, f in sorted(r.max_albedo_by_azimuth.items())
+                )
+                t.caption += f"\nhighest albedo by azimuth: {per_phi}"
             t.caption_justify = "left"
         console.print(t)
     console.print(f"checked in {seconds:.1f} s", style="dim")

@@ -12,6 +12,15 @@ Conventions at the boundary, and only here (DESIGN.md, Conventions):
 * Mitsuba's ``sample`` draws the light side from ``sample1`` (lobe choice) and ``sample2``
   (direction): ``u = (sample1, sample2.x, sample2.y)``, and our sample weight
   ``f·|cos θi|/pdf`` is exactly Mitsuba's sample value.
+* Transport mode. The models describe radiance: a refraction into a medium of relative
+  index η carries the 1/η² of the solid angle's compression (Veach 1997 §5.2, the
+  non-symmetric BSDF). Under ``TransportMode.Importance`` (a light tracer such as
+  ``ptracer``) that factor is taken out again: ``eval`` and the sampled weight of a
+  refracting pair are multiplied by η², η = η(wo side)/η(si.wi side) — the ``bs.eta`` of
+  the sample. This is Mitsuba's own convention (mitsuba3 ``src/bsdfs/roughdielectric.cpp``:
+  ``scale = Radiance ? sqr(inv_eta) : 1`` in ``eval``, ``factor = Radiance ? sqr(eta_ti)
+  : 1`` in ``sample``), and like it the refracting component is flagged ``NonSymmetric``.
+  Reflection, thin sheets and η = 1 do not refract and are symmetric in both modes.
 
 Parameters arrive as Mitsuba properties, one per schema field: a constant (float, bool,
 string, ``rgb``) or a texture (``bitmap`` …). Constants are handed to ``prepare`` as Python
@@ -158,7 +167,14 @@ def _plugin_class(variant: str) -> type:
                 extra |= flag.SpatiallyVarying
             if getattr(self.params, "anisotropic", 0) or "anisotropic" in self.textures:
                 extra |= flag.Anisotropic
-            self.m_components = [c | extra for c in self.components if c != flag.Empty]
+            self.refracts = self._refracts(prepared)
+            """Transmission bends the path (η ≠ 1 through a solid): non-symmetric."""
+            non_symmetric = [flag.Empty, flag.NonSymmetric if self.refracts else flag.Empty]
+            self.m_components = [
+                c | extra | ns
+                for c, ns in zip(self.components, non_symmetric, strict=True)
+                if c != flag.Empty
+            ]
             self.m_flags = functools.reduce(lambda a, b: a | b, self.m_components, flag.Empty)
 
         def _placeholder(self, field: str) -> Any:
@@ -229,6 +245,7 @@ def _plugin_class(variant: str) -> type:
         def eval(self, ctx, si, wo, active=True):
             prepared = self._prepare(si, active)
             f = self.model.eval(self.xp, prepared, wo, si.wi)  # ours: wi = light, wo = viewer
+            f = self._transport(ctx, prepared, si.wi.z, wo.z, f)
             ok = active & self._hemisphere_mask(ctx, si.wi.z, wo.z)
             return dr.select(ok, self._scaled(mi.Spectrum(f) * dr.abs(wo.z)), 0.0)
 
@@ -241,6 +258,7 @@ def _plugin_class(variant: str) -> type:
         def eval_pdf(self, ctx, si, wo, active=True):
             prepared = self._prepare(si, active)
             f = self.model.eval(self.xp, prepared, wo, si.wi)
+            f = self._transport(ctx, prepared, si.wi.z, wo.z, f)
             pdf = self.model.pdf(self.xp, prepared, wo, si.wi)
             ok = active & self._hemisphere_mask(ctx, si.wi.z, wo.z)
             return (
@@ -266,9 +284,34 @@ def _plugin_class(variant: str) -> type:
                 mi.UInt32(_leading(self.components[1], flag)),
             )
             ok = active & (bs.pdf > 0) & self._hemisphere_mask(ctx, si.wi.z, bs.wo.z)
+            if self.refracts and ctx.mode == mi.TransportMode.Importance:
+                weight = self.xp.Array3(weight) * (bs.eta * bs.eta)  # see _transport
             value = dr.select(ok, self._scaled(mi.Spectrum(weight)), 0.0)
             bs.pdf = dr.select(ok, bs.pdf, 0.0)
             return bs, value
+
+        def _refracts(self, prepared: Any) -> bool:
+            """Whether a transmitted path changes medium (see :meth:`_eta`)."""
+            eta = prepared.get("eta") if isinstance(prepared, dict) else None
+            solid = not getattr(self.params, "thin", False)
+            glossy_t = bool(self.components[1] & flag.GlossyTransmission)
+            if eta is None or not solid or not glossy_t:
+                return False
+            try:
+                return float(eta) != 1.0  # a constant η = 1 does not bend the path
+            except (TypeError, RuntimeError):
+                return True  # a texture or an opaque value: it may
+
+        def _transport(
+            self, ctx: mi.BSDFContext, prepared: Any, cos_view: mi.Float, cos_light: mi.Float, f
+        ) -> Any:
+            """f for the context's transport mode: the model's radiance f, or under
+            ``Importance`` that f times η² on a refracting pair (η = η_light/η_view side,
+            Mitsuba's ``roughdielectric``: it drops its ``sqr(inv_eta)``)."""
+            if not self.refracts or ctx.mode != mi.TransportMode.Importance:
+                return f
+            eta = self._eta(prepared, cos_view, cos_view * cos_light > 0)
+            return self.xp.Array3(f) * (eta * eta)
 
         def _eta(self, prepared: Any, cos_view: mi.Float, reflected: mi.Bool) -> mi.Float:
             """Relative IOR along a sampled path (Mitsuba's Russian roulette tracks it).

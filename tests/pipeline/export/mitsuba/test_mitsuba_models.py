@@ -225,3 +225,85 @@ def test_a_black_colour_prunes_its_lobe_on_both_backends(mi):
     _, params = _case_params("sheen", {"color": [0.0, 0.0, 0.0]})
     assert BlendedMaterial.of_params(params).live_lobes == ()
     assert mi.load_dict(_plugin(mi, params)).flags() == 0
+
+
+# -- transport mode (issue 17, §5): the models describe radiance ------------------------------
+REFRACTING = [
+    ("disney", {"spec_trans": 1.0, "roughness": 0.3, "ior": 1.5}, 1.5),
+    ("pixar", {"clear": 1.0, "back": 1.0, "roughness": 0.6, "ior": 1.5}, 1.5),
+]
+SYMMETRIC = [
+    ("disney", {"spec_trans": 1.0, "roughness": 0.3, "thin": True}),
+    ("disney", {"roughness": 0.5}),
+    ("pixar", {"roughness": 0.5}),
+]  # (Disney clamps η = 1 to 1.001: that still bends the path, a little)
+
+
+def _both_sides(n, seed):
+    rng = np.random.default_rng(seed)
+    view, light = _unit(rng.normal(size=(n, 3))), _unit(rng.normal(size=(n, 3)))
+    return view, light, rng.random((3, n))
+
+
+@pytest.mark.parametrize(("model_name", "values", "ior"), REFRACTING, ids=["disney", "pixar"])
+def test_importance_transport_scales_refraction_by_eta_squared(mi, model_name, values, ior):
+    _, params = _case_params(model_name, values)
+    bsdf = mi.load_dict(_plugin(mi, params))
+    t = mi.BSDFFlags.GlossyTransmission
+    assert bsdf.flags() & mi.BSDFFlags.NonSymmetric
+    assert bsdf.flags(1) & mi.BSDFFlags.NonSymmetric and bsdf.flags(1) & t
+    assert not bsdf.flags(0) & mi.BSDFFlags.NonSymmetric  # reflection stays symmetric
+    view, light, u = _both_sides(4096, 11)
+    si = _interaction(mi, view)
+    wo = mi.Vector3f(light.astype(np.float32).T)
+    radiance, importance = mi.BSDFContext(), mi.BSDFContext(mi.TransportMode.Importance)
+    view32 = np.array(si.wi).T
+    # η = η(light side)/η(view side): Mitsuba's eta_it of si.wi; 1 for a reflection
+    crossing = view32[:, 2] * light[:, 2] < 0
+    eta = np.where(crossing, np.where(view32[:, 2] > 0, ior, 1.0 / ior), 1.0)
+    want_r = evaluate(*_case_params(model_name, values), light, view32) * np.abs(light[:, 2:3])
+    f_r = np.array(bsdf.eval(radiance, si, wo)).T
+    f_i = np.array(bsdf.eval(importance, si, wo)).T
+    scale = float(np.max(np.abs(want_r)))
+    np.testing.assert_allclose(f_r, want_r, rtol=2e-4, atol=2e-5 * scale)  # as today
+    np.testing.assert_allclose(f_i, f_r * eta[:, None] ** 2, rtol=1e-5, atol=1e-7 * scale)
+    assert np.any(crossing & (np.abs(f_r).max(axis=1) > 1e-3))
+    fp_i, p_i = bsdf.eval_pdf(importance, si, wo)
+    np.testing.assert_allclose(np.array(fp_i).T, f_i, rtol=1e-5, atol=1e-7 * scale)
+    np.testing.assert_allclose(np.array(p_i), np.array(bsdf.pdf(radiance, si, wo)), rtol=1e-6)
+    # sampling: same directions and pdfs, the weight × bs.eta² on refraction only
+    s1, s2 = mi.Float(u[0]), mi.Point2f(u[1], u[2])
+    bs_r, w_r = bsdf.sample(radiance, si, s1, s2)
+    bs_i, w_i = bsdf.sample(importance, si, s1, s2)
+    np.testing.assert_array_equal(np.array(bs_i.wo), np.array(bs_r.wo))
+    np.testing.assert_array_equal(np.array(bs_i.pdf), np.array(bs_r.pdf))
+    e = np.array(bs_r.eta)
+    refracted = (np.array(bs_r.pdf) > 0) & (view32[:, 2] * np.array(bs_r.wo)[2] < 0)
+    assert np.any(refracted) and np.any(e[refracted] != 1.0)
+    np.testing.assert_allclose(np.array(w_i).T, np.array(w_r).T * e[:, None] ** 2, rtol=1e-6)
+    from lookdev.materials.bsdf import draw
+
+    wi_np, weight_np, _ = draw(*_case_params(model_name, values), view32, u.T)
+    ok = np.array(bs_r.pdf) > 0
+    np.testing.assert_allclose(np.array(w_r).T[ok], weight_np[ok], rtol=2e-3, atol=2e-5)
+
+
+@pytest.mark.parametrize(
+    ("model_name", "values"), SYMMETRIC, ids=["disney-thin", "disney-opaque", "pixar-opaque"]
+)
+def test_transport_mode_leaves_non_refracting_lobes_alone(mi, model_name, values):
+    _, params = _case_params(model_name, values)
+    bsdf = mi.load_dict(_plugin(mi, params))
+    assert not bsdf.flags() & mi.BSDFFlags.NonSymmetric
+    view, light, u = _both_sides(1024, 12)
+    si = _interaction(mi, view)
+    wo = mi.Vector3f(light.astype(np.float32).T)
+    importance = mi.BSDFContext(mi.TransportMode.Importance)
+    np.testing.assert_array_equal(
+        np.array(bsdf.eval(importance, si, wo)), np.array(bsdf.eval(mi.BSDFContext(), si, wo))
+    )
+    s1, s2 = mi.Float(u[0]), mi.Point2f(u[1], u[2])
+    np.testing.assert_array_equal(
+        np.array(bsdf.sample(importance, si, s1, s2)[1]),
+        np.array(bsdf.sample(mi.BSDFContext(), si, s1, s2)[1]),
+    )
