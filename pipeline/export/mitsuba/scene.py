@@ -65,11 +65,22 @@ def plugin_inputs(hub: BlendedMaterial) -> tuple[dict[str, Any], dict[str, np.nd
             f"the {hub.bsdf_model.name} model",
             where=hub.name,
         )
-    constants = {k: _plain(v) for k, v in hub.constants.items() if k in given and v is not None}
+    # A constant at the schema's default is left to the default: every property the
+    # plugin gets becomes a traversed scene parameter, and each costs a frozen render's
+    # replay a check per frame (a plain preset's blend spells out all of its fields).
+    constants = {
+        k: _plain(v)
+        for k, v in hub.constants.items()
+        if k in given and v is not None and not _is_default(fields[k].default, v)
+    }
     maps = {k: np.asarray(v, dtype=np.float32) for k, v in hub.maps.items()}
     if hub.representation == LOBE_WEIGHTS:
         _drop_view_independent(constants, maps)
     return constants, maps
+
+
+def _is_default(default: Any, value: Any) -> bool:
+    return default is not None and _plain(default) == _plain(value)
 
 
 def _drop_view_independent(constants: dict[str, Any], maps: dict[str, np.ndarray]) -> None:
