@@ -19,7 +19,6 @@ now: files changed in the last seconds are re-read on purpose (see ``library.ind
 
 from __future__ import annotations
 
-import json
 import os
 import tempfile
 import time
@@ -28,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from lookdev.library import Library
+from lookdev.library import listing as listing_of
 from lookdev.library.index import INDEX_NAME
 
 TARGET_RATIO = 2.0
@@ -130,17 +130,10 @@ def report(n: int, times: dict[str, float]) -> dict[str, Any]:
 
 
 def listing(lib: Library, *, as_json: bool = False) -> str:
-    """What ``presets list`` writes for ``lib``, as near as the library API gives it: a
-    text row (or with ``as_json`` a JSON document) per preset that parses."""
-    shown = [h for h in lib.entries() if not h.error]
-    if as_json:
-        lines = ",\n".join("  " + json.dumps(h.to_json()) for h in shown)
-        return f"[\n{lines}\n]\n"
-    rows = (
-        "  ".join((h.name, h.model or "?", ", ".join(h.tags), h.library, h.description))
-        for h in shown
-    )
-    return "\n".join(rows) + "\n"
+    """What ``presets list`` writes for ``lib`` (plain text, as when piped, or JSON): the
+    command's own functions (:mod:`lookdev.library.listing`), timed without the CLI."""
+    shown = listing_of.matching(lib.entries(), [], None)
+    return listing_of.listing_json(shown, lib) if as_json else listing_of.listing_text(shown, lib)
 
 
 def run(

@@ -7,7 +7,7 @@ from typing import Any
 
 from rich.table import Table
 
-from lookdev.library import Library, Material
+from lookdev.library import Library, Material, listing
 from lookdev.library.index import Header
 from lookdev.library.library import set_by
 from lookdev.materials.layers import children
@@ -25,19 +25,8 @@ def text_table(title: str, columns: list[str], rows: list[list[str]]) -> Table:
     return t
 
 
-def plain_columns(columns: list[str], rows: list[list[str]]) -> str:
-    """Rows as left-aligned text columns, the last one unpadded (like ``ls -l``)."""
-    widths = [max(map(len, col)) for col in list(zip(columns, *rows, strict=True))[:-1]]
-    line = "  ".join([*(f"{{{i}:<{w}}}" for i, w in enumerate(widths)), f"{{{len(widths)}}}"])
-    return "\n".join(line.format(*r).rstrip() for r in [columns, *rows])
-
-
-def origin(h: Header, lib: Library) -> str:
-    return "built-in" if h.library == lib.builtin_str else h.library
-
-
 def header_json(h: Header, lib: Library) -> dict[str, Any]:
-    return h.to_json(origin(h, lib))
+    return h.to_json(listing.origin(h, lib))
 
 
 def material_json(m: Material) -> dict[str, Any]:
