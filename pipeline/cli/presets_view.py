@@ -7,8 +7,7 @@ from typing import Any
 
 from rich.table import Table
 
-from lookdev.library import Library, Material, listing
-from lookdev.library.index import Header
+from lookdev.library import Material
 from lookdev.library.library import set_by
 from lookdev.materials.layers import children
 
@@ -23,10 +22,6 @@ def text_table(title: str, columns: list[str], rows: list[list[str]]) -> Table:
     for r in rows:
         t.add_row(*r, style="dim" if r[1] == "?" else None)
     return t
-
-
-def header_json(h: Header, lib: Library) -> dict[str, Any]:
-    return h.to_json(listing.origin(h, lib))
 
 
 def material_json(m: Material) -> dict[str, Any]:
