@@ -191,4 +191,7 @@ def _progress() -> Progress:
         TimeRemainingColumn(),
         console=err_console,
         transient=False,
+        # A bar is for a person at a terminal: in a log or a pipe it would only add lines
+        # (and an error must stay the one line on stderr).
+        disable=not err_console.is_terminal,
     )

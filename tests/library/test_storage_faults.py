@@ -515,6 +515,19 @@ def test_a_full_disk_ends_in_one_line_and_leaves_nothing(
     assert not leftovers(tmp_path)
 
 
+def test_a_proof_on_a_full_disk_ends_in_one_line_and_resumes_cleanly(cli, tmp_path, env, full_disk):
+    """A batch writes frame by frame (each whole, by rename) and resumes: on a full disk it
+    stops in one line, keeps the whole frames it wrote and leaves no temporary."""
+    if fault_mode("full") != "tmpfs":
+        pytest.skip("OpenImageIO writes frames from C: only a real full disk reaches it")
+    args = ["proof", "gold", "--ibl", "studio", "--frames", "1", "--light-frames", "0"]
+    args += ["--spp", "2", "--resolution", "8", "8", "--ibl-width", "16"]
+    line = one_line_error(cli(*args, "-o", str(full_disk / "proofs")))
+    assert "No space left on device" in line, line
+    assert not leftovers(tmp_path)
+    assert not list(full_disk.rglob("*.tmp*")) and not list(full_disk.rglob("manifest.json"))
+
+
 def test_the_write_path_cleans_up_after_enospc_mid_write(tmp_path, full_disk):
     target = full_disk / "a.json"
     with pytest.raises(files.WriteError, match="No space left on device"):
