@@ -353,6 +353,7 @@ def _edited(src: Path, dst: Path, value: str) -> Path:
     return dst
 
 
+@pytest.mark.slow
 def test_import_refuses_to_overwrite_without_force(cli, exported, tmp_path):
     (tmp_path / "gold.toml").write_text("# hand-edited\n")
     r = cli("import", "usd", str(exported), "-o", str(tmp_path))
@@ -429,6 +430,7 @@ def test_an_unwritable_output_is_found_before_loading(cli, tmp_path, no_render):
     one_line_error(cli("proof", "gold", "--ibl", "studio", "-o", str(f / "out")), "not writable")
 
 
+@pytest.mark.slow
 def test_a_reproof_of_a_subset_keeps_the_rest_of_the_batch(tmp_path):
     import lookdev
 
@@ -559,6 +561,7 @@ def command_lines(draw):
     return args
 
 
+@pytest.mark.slow
 @settings(
     max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
 )
