@@ -19,6 +19,9 @@ from lookdev.pipeline.bench import eval as eval_bench
 
 from .common import console, err_console, print_json, table
 
+JsonOut = Annotated[bool, typer.Option("--json", help="Print one JSON object.")]
+Repeat = Annotated[int, typer.Option(min=1, max=20, help="Timed runs; the best counts.")]
+
 app = typer.Typer(
     help="Measure performance targets as ratios against a baseline run in the same process.",
     no_args_is_help=True,
@@ -29,8 +32,8 @@ def blend_(
     resolution: Annotated[
         int, typer.Option("--resolution", "-r", min=16, max=8192, help="Texels per side.")
     ] = 2048,
-    repeat: Annotated[int, typer.Option(min=1, max=20, help="Timed runs; the best counts.")] = 3,
-    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    repeat: Repeat = 3,
+    as_json: JsonOut = False,
 ) -> None:
     """Blend 4 texture-masked Disney layers into all parameter maps vs a numpy copy.
 
@@ -66,7 +69,7 @@ def depth_(
         int, typer.Option("--reference-depth", min=2, help="Depth of the reference renders.")
     ] = 32,
     repeat: Annotated[int, typer.Option("--repeat", min=1, help="Timed rounds.")] = 3,
-    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    as_json: JsonOut = False,
 ) -> None:
     """Time the proof scene at each material's chosen path depth against a deep reference.
 
@@ -146,7 +149,7 @@ def error_(
         typer.Option("--item", "-i", help=f"Measure only these items: {', '.join(error.ITEMS)}."),
     ] = None,
     quick: Annotated[bool, typer.Option("--quick", help="Short ladders (CI, tests).")] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    as_json: JsonOut = False,
 ) -> None:
     """Error against run time of every approximation lookdev makes, measured now.
 
@@ -199,7 +202,7 @@ def eval_(
     repeat: Annotated[
         int, typer.Option(min=1, max=20, help="Interleaved timing rounds; the best counts.")
     ] = 5,
-    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    as_json: JsonOut = False,
 ) -> None:
     """Evaluate the Disney BSDF on N direction pairs: numpy, Dr.Jit and Mitsuba's principled.
 
@@ -244,7 +247,7 @@ def eval_(
 def library_(
     n: Annotated[int, typer.Option("--n", min=1, help="Presets in the generated library.")] = 10000,
     repeat: Annotated[int, typer.Option("--repeat", min=1, help="Runs per timing (best).")] = 5,
-    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    as_json: JsonOut = False,
 ) -> None:
     """Time `presets list` over N generated presets against reading their bytes (target ≤ 2x).
 
@@ -288,7 +291,7 @@ def proof_(
     ] = (192, 96),
     repeat: Annotated[int, typer.Option("--repeat", min=1, help="Timed rounds (best).")] = 3,
     quick: Annotated[bool, typer.Option("--quick", help="Tiny frames (CI, tests).")] = False,
-    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    as_json: JsonOut = False,
 ) -> None:
     """Proof turntable vs a scene-rebuilding script and vs bare mi.render; lobe pruning.
 
@@ -374,8 +377,8 @@ def usd_(
     materials: Annotated[
         int, typer.Option("--materials", "-n", min=1, max=100_000, help="Materials per stage.")
     ] = 1000,
-    repeat: Annotated[int, typer.Option(min=1, max=20, help="Timed runs; the best counts.")] = 3,
-    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+    repeat: Repeat = 3,
+    as_json: JsonOut = False,
 ) -> None:
     """Export N materials into one stage: Sdf-level authoring vs the naive Usd API.
 
