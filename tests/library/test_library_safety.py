@@ -5,11 +5,12 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
-import sys
 import textwrap
 import time
 
 import pytest
+from _processes import spawn
+from _processes import wait_for as wait
 
 from lookdev.library import Library, PresetFile
 from lookdev.library.store import PAUSE_ENV
@@ -20,28 +21,11 @@ CLI = "import sys; from lookdev.pipeline.cli import main; main(sys.argv[1:])"
 
 
 def start(code: str, *args: str, pause: float | None = None) -> subprocess.Popen:
-    env = dict(os.environ)
-    env.pop("LOOKDEV_LIBRARY_PATH", None)
-    if pause is not None:
-        env[PAUSE_ENV] = str(pause)
-    return subprocess.Popen(
-        [sys.executable, "-c", code, *args],
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    return spawn(code, *args, env_extra=None if pause is None else {PAUSE_ENV: str(pause)})
 
 
 def wait_for(predicate, proc: subprocess.Popen, timeout: float = 60.0) -> None:
-    deadline = time.monotonic() + timeout
-    while not predicate():
-        if proc.poll() is not None:
-            raise AssertionError(f"process ended early: {proc.communicate()}")
-        if time.monotonic() > deadline:
-            proc.kill()
-            raise AssertionError("timed out")
-        time.sleep(0.01)
+    wait(predicate, proc, timeout)
 
 
 @pytest.mark.slow

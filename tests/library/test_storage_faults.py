@@ -31,11 +31,11 @@ import os
 import re
 import signal
 import subprocess
-import sys
-import time
 from pathlib import Path
 
 import pytest
+from _processes import spawn
+from _processes import wait_for as wait
 
 from lookdev.library import files
 from lookdev.library.index import INDEX_NAME, read_only_index_file
@@ -264,27 +264,11 @@ CHILD = "import sys; from lookdev.pipeline.cli import main; main(sys.argv[1:])"
 
 
 def start(*args: str, env_extra: dict[str, str] | None = None) -> subprocess.Popen:
-    env = dict(os.environ)
-    env.pop("LOOKDEV_LIBRARY_PATH", None)
-    env.update(env_extra or {})
-    return subprocess.Popen(
-        [sys.executable, "-c", CHILD, *args],
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    return spawn(CHILD, *args, env_extra=env_extra)
 
 
 def wait_for(predicate, proc: subprocess.Popen, timeout: float = 120.0) -> None:
-    deadline = time.monotonic() + timeout
-    while not predicate():
-        if proc.poll() is not None:
-            raise AssertionError(f"process ended early: {proc.communicate()}")
-        if time.monotonic() > deadline:
-            proc.kill()
-            raise AssertionError("timed out")
-        time.sleep(0.02)
+    wait(predicate, proc, timeout)
 
 
 @pytest.fixture
