@@ -1,79 +1,230 @@
-"""Colour constants and the sRGB transfer curve: the one home of each (no I/O).
+"""Colour management: the one OpenColorIO config, the working space, and every conversion.
 
-* :data:`REC709_LUMINANCE` and :func:`luminance`: the Y row of the linear Rec.709 → CIE XYZ
-  matrix (ITU-R BT.709-6 item 3.3; IEC 61966-2-1 eq. 5), the luminance of scene-linear
-  Rec.709 pixels (noise estimates, importance sampling by luminance, plots).
-* :func:`srgb_decode` / :func:`srgb_encode`: the IEC 61966-2-1 piecewise transfer curve,
-  used for ``"#rrggbb"`` preset colours and for display images. A later change moves colour
-  management to OpenColorIO; this pair is the one place that swaps over.
+lookdev is scene-linear in a *named* working space (DESIGN.md, Colour). Every conversion
+between colour spaces is an OpenColorIO processor built from one config, so no transfer
+curve or primaries matrix is written by hand anywhere in the program:
+
+* the config is ``$OCIO`` when set, else OCIO's built-in ACES studio config
+  (:data:`DEFAULT_CONFIG`, pinned so that outputs do not drift with the OCIO release);
+  :func:`use` names another one (the CLI's ``--config``) and the working space;
+* the working space is linear Rec.709 by default (:data:`WORKING_SPACES`: ``lin_rec709``
+  or ``acescg``), named by the config's own colour-space names;
+* :func:`convert` moves pixels between any two of the config's spaces, by name or alias
+  (``"sRGB - Texture"``, ``"ACEScg"``, ``"Raw"``); :func:`to_working` into the working space;
+* :func:`decode_hex` reads a preset's ``"#rrggbb"`` as sRGB-encoded (``"sRGB - Texture"``);
+* :func:`luminance` weighs linear working-space RGB by the Y row of its RGB → CIE XYZ
+  matrix, asked of the config (Rec.709: ITU-R BT.709-6 item 3.3).
 
 Burley's tint weights ``(0.3, 0.6, 0.1)`` (:data:`lookdev.materials.disney_prepare.
-TINT_WEIGHTS`) are not these: they are a rough hue normaliser inside the Disney BRDF
-(Burley 2012, BRDF Explorer's ``Cdlum``), part of the model, not a measure of luminance.
+TINT_WEIGHTS`) are not luminance: they are a hue normaliser inside the Disney BRDF, part of
+the model.
+
+OCIO reads its own config (a file named by ``$OCIO``, or one compiled into the library);
+this module opens no file itself, so ``materials`` stays free of I/O.
 
 >>> luminance((1.0, 1.0, 1.0))
 1.0
->>> round(srgb_decode(srgb_encode(0.18)), 12)
-0.18
+>>> [round(v, 5) for v in decode_hex("#808080")]
+[0.21586, 0.21586, 0.21586]
 """
 
 from __future__ import annotations
 
+import contextlib
+import functools
+import os
+from collections.abc import Iterator
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import PyOpenColorIO as ocio
 
-REC709_LUMINANCE = (0.2126, 0.7152, 0.0722)
-"""Weights of linear R, G, B in CIE Y for Rec.709 primaries and a D65 white (sum 1)."""
-_REC709_LUMINANCE = np.array(REC709_LUMINANCE)
+from .errors import LookdevError
 
-SRGB_DECODE_BREAK = 0.04045
-"""Encoded value at which the sRGB decoding switches from the line to the power law."""
-SRGB_ENCODE_BREAK = 0.0031308
-"""Linear value at which the sRGB encoding switches from the line to the power law."""
+__all__ = [
+    "DEFAULT_CONFIG",
+    "WORKING_SPACES",
+    "ColourError",
+    "Settings",
+    "settings",
+    "use",
+    "config",
+    "canonical",
+    "working_space",
+    "convert",
+    "to_working",
+    "decode_hex",
+    "luminance",
+    "luminance_weights",
+    "is_data",
+]
+
+DEFAULT_CONFIG = "ocio://studio-config-v4.0.0_aces-v2.0_ocio-v2.5"
+"""OCIO's built-in ACES 2.0 studio config (OCIO ≥ 2.5), pinned: ``studio-config-latest``
+would change every colour a release later."""
+
+WORKING_SPACES = {"lin_rec709": "Linear Rec.709 (sRGB)", "acescg": "ACEScg"}
+"""The working spaces lookdev offers, by short name → the studio config's colour space."""
+
+SRGB_TEXTURE = "sRGB - Texture"
+"""How a preset's ``"#rrggbb"`` and an 8-bit colour map are encoded by default."""
+RAW = "Raw"
+"""Data: no conversion (roughness, masks, normals, heights)."""
 
 
-def _like(out: Any, given: Any) -> Any:
-    """A Python float for a scalar input, the array otherwise."""
-    return float(out) if np.ndim(out) == 0 and not isinstance(given, np.ndarray) else out
+class ColourError(LookdevError):
+    """An unknown colour space or an OCIO config that cannot be read."""
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Which config and which working space: the whole program's colour state."""
+
+    config: str = ""
+    """Path or ``ocio://`` name; empty means ``$OCIO``, else :data:`DEFAULT_CONFIG`."""
+    working_space: str = "lin_rec709"
+    """A key of :data:`WORKING_SPACES`, or any colour-space name of the config."""
+
+    @property
+    def config_name(self) -> str:
+        return self.config or os.environ.get("OCIO", "") or DEFAULT_CONFIG
+
+
+_current = [Settings()]
+
+
+def settings() -> Settings:
+    """The colour settings in force."""
+    return _current[-1]
+
+
+@contextlib.contextmanager
+def use(config: str | None = None, working_space: str | None = None) -> Iterator[Settings]:
+    """Use another OCIO config and/or working space inside a ``with`` block.
+
+    >>> with use(working_space="acescg"):
+    ...     working_space()
+    'ACEScg'
+    >>> working_space()
+    'Linear Rec.709 (sRGB)'
+    """
+    old = settings()
+    new = Settings(config if config is not None else old.config, working_space or old.working_space)
+    _load(new.config_name)  # fail here, with the name, not at the first conversion
+    _current.append(new)
+    try:
+        canonical(WORKING_SPACES.get(new.working_space, new.working_space))
+        yield new
+    finally:
+        _current.pop()
+
+
+@functools.cache
+def _load(name: str) -> ocio.Config:
+    try:
+        return ocio.Config.CreateFromFile(name)
+    except Exception as exc:  # OCIO raises its own Exception type for every failure
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise ColourError(f"cannot read the OCIO config {name!r}: {first}") from None
+
+
+def config() -> ocio.Config:
+    """The OCIO config in force (see :class:`Settings`)."""
+    return _load(settings().config_name)
+
+
+def canonical(space: str) -> str:
+    """The config's name for ``space`` (a name or an alias); a :class:`ColourError` if none.
+
+    >>> canonical("srgb_tx"), canonical("lin_ap1")
+    ('sRGB Encoded Rec.709 (sRGB)', 'ACEScg')
+    """
+    found = config().getColorSpace(space)
+    if found is None:
+        known = ", ".join(sorted(config().getColorSpaceNames())[:6])
+        raise ColourError(
+            f"unknown colour space {space!r} in the OCIO config {settings().config_name!r} "
+            f"(e.g. {known}, …; `lookdev colour spaces` lists them)"
+        )
+    return found.getName()
+
+
+def working_space() -> str:
+    """The config's name of the working space (scene-linear; every parameter lives in it)."""
+    ws = settings().working_space
+    return canonical(WORKING_SPACES.get(ws, ws))
+
+
+def is_data(space: str) -> bool:
+    """True for a data space (``Raw``): values pass through every conversion unchanged."""
+    cs = config().getColorSpace(space)
+    return bool(cs is not None and cs.isData())
+
+
+@functools.cache
+def _cpu(config_name: str, src: str, dst: str) -> Any:
+    # OCIO's default optimisation approximates pow() (sRGB white decodes to 1.000024, out
+    # of a colour's range); lossless keeps every 8-bit code within 8e-7 of IEC 61966-2-1.
+    processor = _load(config_name).getProcessor(src, dst)
+    return processor.getOptimizedCPUProcessor(ocio.OPTIMIZATION_LOSSLESS)
+
+
+def convert(pixels: Any, src: str, dst: str | None = None) -> np.ndarray:
+    """``pixels`` (…, 3) from colour space ``src`` to ``dst`` (default: the working space).
+
+    Float32 out, the input untouched. Data spaces on either side mean no conversion.
+
+    >>> [round(float(v), 5) for v in convert(np.array([0.5, 0.5, 0.5]), "sRGB - Texture")]
+    [0.21404, 0.21404, 0.21404]
+    """
+    src = canonical(src)
+    dst = working_space() if dst is None else canonical(dst)
+    out = np.array(pixels, dtype=np.float32, copy=True, order="C")
+    if src == dst or is_data(src) or is_data(dst):
+        return out
+    if out.shape[-1:] != (3,):
+        raise ColourError(f"colour conversion needs (…, 3) RGB, not shape {out.shape}")
+    _cpu(settings().config_name, src, dst).applyRGB(out.reshape(-1))
+    return out
+
+
+def to_working(pixels: Any, space: str) -> np.ndarray:
+    """``pixels`` (…, 3) in ``space`` → the working space (float32)."""
+    return convert(pixels, space)
+
+
+def decode_hex(value: str, space: str = SRGB_TEXTURE) -> tuple[float, float, float]:
+    """``"#rrggbb"`` (8 bits per channel, encoded in ``space``) → working-space linear RGB."""
+    h = value.strip().lstrip("#")
+    rgb = [int(h[i : i + 2], 16) / 255.0 for i in (0, 2, 4)]
+    return tuple(float(x) for x in convert(rgb, space))
+
+
+@functools.cache
+def _weights(config_name: str, space: str) -> np.ndarray:
+    xyz = _load(config_name).getColorSpace("CIE XYZ-D65 - Display-referred") or None
+    target = xyz.getName() if xyz is not None else None
+    if target is None:  # a config without an XYZ space: fall back to its luminance coefficients
+        return np.array(_load(config_name).getDefaultLumaCoefs(), dtype=np.float64)
+    basis = np.eye(3, dtype=np.float32)
+    _cpu(config_name, space, target).applyRGB(basis.reshape(-1))
+    y = basis[:, 1].astype(np.float64)
+    return y / y.sum()
+
+
+def luminance_weights() -> np.ndarray:
+    """The Y weights of linear working-space R, G, B (sum 1): the XYZ matrix's Y row."""
+    return _weights(settings().config_name, working_space())
 
 
 def luminance(rgb: Any) -> Any:
-    """Rec.709 luminance Y of linear RGB over the last axis (length 3); 0 for black.
+    """Luminance Y of linear working-space RGB over the last axis; 0 for black.
 
     Summed in float64 (float32 images too); a plain triple gives a float.
 
-    >>> luminance((0.0, 0.0, 0.0)), luminance((0.0, 1.0, 0.0))
+    >>> luminance((0.0, 0.0, 0.0)), round(luminance((0.0, 1.0, 0.0)), 4)
     (0.0, 0.7152)
-    >>> luminance(np.ones((2, 4, 3), np.float32)).shape
-    (2, 4)
     """
-    return _like(np.asarray(rgb) @ _REC709_LUMINANCE, rgb)
-
-
-def srgb_decode(v: Any) -> Any:
-    """IEC 61966-2-1 sRGB decoding (encoded 0..1 → linear 0..1), per element.
-
-    ``v / 12.92`` up to 0.04045, ``((v + 0.055) / 1.055)^2.4`` above; values outside 0..1
-    (the curve's domain) are clipped to it.
-
-    >>> round(srgb_decode(0.5), 6), srgb_decode(0.0), srgb_decode(1.0)
-    (0.214041, 0.0, 1.0)
-    """
-    x = np.clip(v, 0.0, 1.0)
-    lin = np.where(x <= SRGB_DECODE_BREAK, x / 12.92, ((x + 0.055) / 1.055) ** 2.4)
-    return _like(lin, v)
-
-
-def srgb_encode(x: Any) -> Any:
-    """IEC 61966-2-1 sRGB encoding (linear 0..1 → encoded 0..1), per element.
-
-    ``12.92 x`` up to 0.0031308, ``1.055 x^(1/2.4) − 0.055`` above; values outside 0..1
-    are clipped to it (a display cannot show them; a view transform rolls them off first).
-
-    >>> [round(float(v), 4) for v in srgb_encode(np.array([0.0, 0.0031308, 0.18, 1.0]))]
-    [0.0, 0.0404, 0.4614, 1.0]
-    """
-    c = np.clip(x, 0.0, 1.0)
-    enc = np.where(c <= SRGB_ENCODE_BREAK, 12.92 * c, 1.055 * np.power(c, 1.0 / 2.4) - 0.055)
-    return _like(enc, x)
+    out = np.asarray(rgb) @ luminance_weights()
+    return float(out) if np.ndim(out) == 0 and not isinstance(rgb, np.ndarray) else out

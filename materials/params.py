@@ -3,8 +3,8 @@
 Ranges follow Burley's principles (§5.1): parameters are 0..1 over their plausible range,
 may be pushed beyond it where that makes sense, and are rejected where meaningless
 (NaN, infinity, negative roughness …) with a one-line :class:`ParameterError` naming the
-field and the allowed range. Colours are scene-linear Rec.709; a ``"#rrggbb"`` string is
-taken as sRGB-encoded and decoded once, here.
+field and the allowed range. Colours are scene-linear in the working space
+(:mod:`.colour`); a ``"#rrggbb"`` string is taken as sRGB-encoded and decoded once, here.
 
 >>> DisneyParams(base_color="#ffffff", metallic=1.0).base_color
 (1.0, 1.0, 1.0)
@@ -26,7 +26,7 @@ from pydantic import (
     model_validator,
 )
 
-from .colour import srgb_decode
+from .colour import decode_hex
 from .errors import ParameterError as ParameterError  # re-exported
 from .errors import one_line, register_schema
 from .fresnel import SPECULAR_F0_SCALE, ior_to_specular, specular_to_ior
@@ -40,8 +40,7 @@ def parse_color(value: Any) -> Any:
         m = _HEX.match(value.strip())
         if not m:
             raise ValueError(f"colour {value!r} is neither '#rrggbb' nor [r, g, b]")
-        h = m.group(1)
-        return tuple(srgb_decode(int(h[i : i + 2], 16) / 255.0) for i in (0, 2, 4))
+        return decode_hex(m.group(1))
     if isinstance(value, int | float) and not isinstance(value, bool):
         return (float(value),) * 3
     return value

@@ -60,6 +60,11 @@ class BlendedMaterial:
     """True when the preset was a layer stack (``model = "layered"``)."""
     origin: Any = None
     """What was blended (the resolved library material), for exporters that carry it."""
+    textures: dict[str, Any] = field(default_factory=dict)
+    """Parameters read straight from one image that blending did not change, by name →
+    :class:`lookdev.materials.textures.TextureInput` (path absolute): exporters reference
+    the original file (and its colour space) instead of baking :attr:`maps`, which still
+    holds the decoded values for every other consumer."""
 
     @classmethod
     def of_params(cls, params: Any, name: str | None = None) -> BlendedMaterial:

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from lookdev.materials.colour import srgb_encode
+from lookdev.materials import colour
 
 DEFAULT_KNEE = 0.6
 EXPOSURE_MAX = 32.0
@@ -54,7 +54,8 @@ def view(rgb: np.ndarray, exposure: float = 0.0, knee: float = DEFAULT_KNEE) -> 
     rgb = np.maximum(rgb, 0.0) * 2.0**exposure
     m = rgb.max(axis=-1, keepdims=True)
     scale = np.divide(shoulder(m, knee), m, out=np.ones_like(m), where=m > 0)
-    return srgb_encode(rgb * scale)
+    encoded = colour.convert(rgb * scale, colour.working_space(), colour.SRGB_TEXTURE)
+    return np.clip(encoded, 0.0, 1.0)
 
 
 def to_8bit(display: np.ndarray) -> np.ndarray:

@@ -1,73 +1,101 @@
-"""The one home of the colour constants and the sRGB curve (materials/colour.py), at its edges."""
+"""The one colour module (materials/colour.py): OCIO conversions checked against colour-science.
+
+colour-science is an independent implementation of the same standards (IEC 61966-2-1's
+sRGB curve, ITU-R BT.709 and ACES AP1 primaries), so agreement here is agreement with the
+standards, not with ourselves.
+"""
 
 from __future__ import annotations
 
+import colour as colour_science
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
-from lookdev.materials.colour import (
-    REC709_LUMINANCE,
-    SRGB_DECODE_BREAK,
-    SRGB_ENCODE_BREAK,
-    luminance,
-    srgb_decode,
-    srgb_encode,
-)
+from lookdev.materials import colour
 from lookdev.materials.disney_prepare import TINT_WEIGHTS
 
 
+def srgb_decode(v):
+    return colour_science.models.eotf_sRGB(np.asarray(v, dtype=np.float64))
+
+
 def test_luminance_of_black_is_zero_and_of_white_is_one():
-    assert luminance((0.0, 0.0, 0.0)) == 0.0
-    assert luminance(np.zeros((4, 5, 3), np.float32)).tolist() == np.zeros((4, 5)).tolist()
-    assert luminance((1.0, 1.0, 1.0)) == pytest.approx(1.0, abs=1e-15)
-    assert sum(REC709_LUMINANCE) == pytest.approx(1.0, abs=1e-15)
+    assert colour.luminance((0.0, 0.0, 0.0)) == 0.0
+    assert colour.luminance(np.zeros((4, 5, 3), np.float32)).tolist() == np.zeros((4, 5)).tolist()
+    assert colour.luminance((1.0, 1.0, 1.0)) == pytest.approx(1.0, abs=1e-12)
+
+
+@pytest.mark.parametrize(("space", "reference"), [("lin_rec709", "sRGB"), ("acescg", "ACEScg")])
+def test_luminance_weights_are_the_xyz_matrix_y_row(space, reference):
+    y_row = colour_science.RGB_COLOURSPACES[reference].matrix_RGB_to_XYZ[1]
+    with colour.use(working_space=space):
+        # OCIO adapts AP1's ACES white to D65 (Bradford); colour-science's row is unadapted
+        np.testing.assert_allclose(colour.luminance_weights(), y_row / y_row.sum(), atol=6e-3)
+    if space == "lin_rec709":
+        np.testing.assert_allclose(colour.luminance_weights(), y_row, atol=5e-5)  # IEC prints 4 digits
 
 
 def test_luminance_is_per_pixel_and_a_float_for_a_triple():
     rgb = np.random.default_rng(1).random((6, 3))
-    np.testing.assert_allclose(luminance(rgb), rgb @ np.array(REC709_LUMINANCE), rtol=0)
-    assert isinstance(luminance([0.2, 0.3, 0.4]), float)
+    np.testing.assert_allclose(colour.luminance(rgb), rgb @ colour.luminance_weights(), rtol=0)
+    assert isinstance(colour.luminance([0.2, 0.3, 0.4]), float)
 
 
-def test_burleys_tint_weights_are_not_rec709_luminance():
-    assert TINT_WEIGHTS == (0.3, 0.6, 0.1) and TINT_WEIGHTS != REC709_LUMINANCE
+def test_burleys_tint_weights_are_not_luminance():
+    assert TINT_WEIGHTS == (0.3, 0.6, 0.1)
+    assert not np.allclose(TINT_WEIGHTS, colour.luminance_weights(), atol=1e-2)
 
 
-@pytest.mark.parametrize("v", [0.0, 1.0])
-def test_srgb_ends_are_fixed_points(v):
-    assert srgb_decode(v) == v
-    assert srgb_encode(v) == pytest.approx(v, abs=2e-16)  # 1.055 − 0.055 rounds to 1 − ulp
+def test_srgb_texture_decodes_every_8bit_code_as_iec_61966_2_1():
+    codes = np.repeat((np.arange(256) / 255.0)[:, None], 3, axis=1)
+    ours = colour.convert(codes, "sRGB - Texture")
+    np.testing.assert_allclose(ours, srgb_decode(codes), atol=1e-6)
+    assert ours[0].tolist() == [0.0, 0.0, 0.0] and ours[-1] == pytest.approx(1.0, abs=1e-7)
 
 
-def test_srgb_decode_breakpoint_is_continuous():
-    below = np.nextafter(SRGB_DECODE_BREAK, 0.0)
-    above = np.nextafter(SRGB_DECODE_BREAK, 1.0)
-    assert srgb_decode(SRGB_DECODE_BREAK) == SRGB_DECODE_BREAK / 12.92  # the line includes it
-    assert srgb_decode(below) == pytest.approx(below / 12.92, rel=1e-15)
-    assert srgb_decode(above) == pytest.approx(srgb_decode(SRGB_DECODE_BREAK), rel=1e-6)
+def test_acescg_working_space_matches_colour_science_primaries():
+    rgb = np.random.default_rng(2).random((32, 3))
+    with colour.use(working_space="acescg"):
+        ours = colour.convert(rgb, "lin_rec709")
+    reference = colour_science.RGB_to_RGB(
+        rgb, "sRGB", "ACEScg", chromatic_adaptation_transform="Bradford"
+    )
+    np.testing.assert_allclose(ours, reference, atol=2e-3)  # CAT rounding differs by < 0.2 %
 
 
-def test_srgb_encode_breakpoint_is_continuous():
-    above = np.nextafter(SRGB_ENCODE_BREAK, 1.0)
-    assert srgb_encode(SRGB_ENCODE_BREAK) == 12.92 * SRGB_ENCODE_BREAK
-    assert srgb_encode(above) == pytest.approx(srgb_encode(SRGB_ENCODE_BREAK), rel=1e-6)
+def test_data_spaces_pass_through_untouched_and_input_is_not_changed():
+    rgb = np.array([[0.25, 2.0, -1.0]], np.float32)
+    out = colour.convert(rgb, "Raw", "ACEScg")
+    assert out.tolist() == rgb.tolist() and out is not rgb
+    assert colour.is_data("Raw") and not colour.is_data("ACEScg")
 
 
-def test_srgb_encode_of_decode_round_trips_on_8bit_codes_and_linear_values():
-    codes = np.arange(256) / 255.0
-    np.testing.assert_allclose(srgb_encode(srgb_decode(codes)), codes, atol=1e-12)
-    lin = np.linspace(0.0, 1.0, 1001)
-    np.testing.assert_allclose(srgb_decode(srgb_encode(lin)), lin, atol=1e-12)
+def test_aliases_resolve_and_unknown_spaces_fail_in_one_line():
+    assert colour.canonical("srgb_tx") == colour.canonical("sRGB - Texture")
+    with pytest.raises(colour.ColourError, match="unknown colour space 'sRGB-ish'") as e:
+        colour.convert([0.5, 0.5, 0.5], "sRGB-ish")
+    assert "\n" not in str(e.value)
 
 
-def test_srgb_clips_to_its_domain_and_keeps_shapes_and_scalars():
-    np.testing.assert_allclose(srgb_encode(np.array([-1.0, 2.0, np.inf])), [0, 1, 1], atol=2e-16)
-    np.testing.assert_array_equal(srgb_decode(np.array([-1.0, 2.0])), [0.0, 1.0])
-    assert srgb_encode(np.zeros((2, 3, 3))).shape == (2, 3, 3)
-    assert isinstance(srgb_decode(0.5), float) and isinstance(srgb_encode(0.5), float)
+def test_an_unreadable_config_fails_in_one_line(tmp_path):
+    with pytest.raises(colour.ColourError, match="cannot read the OCIO config") as e:
+        with colour.use(config=str(tmp_path / "missing.ocio")):
+            pass
+    assert "\n" not in str(e.value)
+    assert colour.working_space() == "Linear Rec.709 (sRGB)"  # nothing left in force
 
 
-def test_hex_colours_decode_through_the_one_curve():
-    from lookdev.materials.params import parse_color
+def test_ocio_environment_variable_names_the_config(monkeypatch):
+    monkeypatch.setenv("OCIO", "ocio://cg-config-v4.0.0_aces-v2.0_ocio-v2.5")
+    assert colour.config().getName().startswith("cg-config")
+    monkeypatch.delenv("OCIO")
+    assert colour.config().getName().startswith("studio-config")
 
-    assert parse_color("#808080") == (srgb_decode(128 / 255),) * 3
+
+@given(st.integers(0, 0xFFFFFF))
+def test_hex_colours_decode_as_srgb_texture(code):
+    text = f"#{code:06x}"
+    expected = srgb_decode([int(text[i : i + 2], 16) / 255.0 for i in (1, 3, 5)])
+    np.testing.assert_allclose(colour.decode_hex(text), expected, atol=1e-6)

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from lookdev.materials.colour import srgb_encode
+import colour as colour_science
 from lookdev.pipeline.proof import contact, shaderball, tonemap
 
 MODULES = ["ibl", "tonemap", "contact", "shaderball", "turntable", "batch"]
@@ -54,6 +54,11 @@ def test_view_is_the_identity_below_the_knee_and_rolls_off_above():
     assert np.all(np.diff(big) >= 0) and big.max() <= 1.0 and big[-1] == pytest.approx(1.0)
 
 
+def srgb_encode(v):
+    """IEC 61966-2-1 encoding, from colour-science (an independent implementation)."""
+    return colour_science.models.eotf_inverse_sRGB(np.clip(np.asarray(v, np.float64), 0, 1))
+
+
 def test_a_hot_saturated_highlight_stays_saturated():
     """Burley §6.2: clipping "forces the core to always go to white"; this must not."""
     hot_red = np.array([200.0, 20.0, 2.0])
@@ -77,7 +82,7 @@ def test_a_hot_saturated_highlight_stays_saturated():
 def test_view_at_its_edges(grey, shown):
     out = tonemap.view(np.full((1, 3), grey))
     assert np.isfinite(out).all()
-    np.testing.assert_allclose(out, np.full((1, 3), shown), rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(out, np.full((1, 3), shown), atol=2e-7)  # OCIO: float32
 
 
 def test_view_survives_nan_inf_and_negative_pixels():
