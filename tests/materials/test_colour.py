@@ -34,7 +34,8 @@ def test_luminance_weights_are_the_xyz_matrix_y_row(space, reference):
         # OCIO adapts AP1's ACES white to D65 (Bradford); colour-science's row is unadapted
         np.testing.assert_allclose(colour.luminance_weights(), y_row / y_row.sum(), atol=6e-3)
     if space == "lin_rec709":
-        np.testing.assert_allclose(colour.luminance_weights(), y_row, atol=5e-5)  # IEC prints 4 digits
+        # IEC 61966-2-1 prints the matrix to 4 digits
+        np.testing.assert_allclose(colour.luminance_weights(), y_row, atol=5e-5)
 
 
 def test_luminance_is_per_pixel_and_a_float_for_a_triple():

@@ -5,12 +5,12 @@ from __future__ import annotations
 import doctest
 import importlib
 
+import colour as colour_science
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import colour as colour_science
 from lookdev.pipeline.proof import contact, shaderball, tonemap
 
 MODULES = ["ibl", "tonemap", "contact", "shaderball", "turntable", "batch"]
