@@ -45,7 +45,9 @@ def diffuse_lobes(model: Model, prepared: Any) -> tuple[str, ...]:
     """The kept lobes of ``prepared`` that the registry calls diffuse (Mitsuba's
     ``DiffuseReflection`` / ``DiffuseTransmission`` flags)."""
     kept = prepared["lobes"]
-    return tuple(lobe.name for lobe in model.lobes if lobe.scattering == "diffuse" and lobe.name in kept)
+    return tuple(
+        lobe.name for lobe in model.lobes if lobe.scattering == "diffuse" and lobe.name in kept
+    )
 
 
 def guide_albedo(xp: Any, model: Model, prepared: Any, wo: Any) -> Any:

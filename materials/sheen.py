@@ -265,6 +265,8 @@ def _sample(xp: Any, prepared: dict[str, Any], wo: Any, u: Any) -> tuple[Any, An
 # [without, with] terminator softening, each (n_r, n_mu).
 _TABLES = np.asarray(_TABLE_VALUES, dtype=np.float64).reshape(2, _N_R, _N_MU)
 SHEEN_LOBES = (Lobe("sheen", "glossy", params=("color", "roughness", "terminator_softening")),)
+
+
 def _guide(xp: Any, prepared: dict[str, Any], wo: Any) -> Any:
     """A denoiser's albedo guide (:mod:`.guides`): the cloth's colour times the lobe's
     directional albedo E(θo) from the table (OIDN: the surface's approximate colour)."""
@@ -274,9 +276,7 @@ def _guide(xp: Any, prepared: dict[str, Any], wo: Any) -> Any:
     return prepared["color"] * e
 
 
-MODEL = Model(
-    "sheen", SheenParams, _prepare, _eval, _pdf, _sample, lobes=SHEEN_LOBES, guide=_guide
-)
+MODEL = Model("sheen", SheenParams, _prepare, _eval, _pdf, _sample, lobes=SHEEN_LOBES, guide=_guide)
 
 
 # -- public numpy API ----------------------------------------------------------------------

@@ -188,6 +188,24 @@ def error_(
                     [_error_row(r) for r in rows],
                 )
             )
+    if report.denoise:
+        from lookdev.pipeline.bench import denoise as denoise_bench
+
+        console.print(
+            table(
+                "denoise: equal wall time (guides and denoiser included); † = extrapolated "
+                "along relMSE ∝ 1/spp",
+                denoise_bench.EQUAL_TIME_COLUMNS,
+                denoise_bench.equal_time_rows(report.denoise),
+            )
+        )
+        for case in report.denoise:
+            verdict = "met" if case.summary["claim_met"] else "NOT met"
+            console.print(
+                f"{case.preset} × {case.ibl}: {case.summary['claim']}: {verdict}; "
+                f"reference {case.reference_spp} spp, its own relMSE {case.reference_floor:.2g}",
+                highlight=False,
+            )
     for what, why in report.skipped.items():
         console.print(f"[yellow]skipped[/] {what}: {why}")
     console.print(
