@@ -319,6 +319,7 @@ def proof(
     report: bool = False,
     library: Any = None,
     progress: Callable[[Any], None] | None = None,
+    denoise: bool = False,
 ) -> dict[str, Any]:
     """Render turntable proofs (Burley §6.1): every material under every IBL.
 
@@ -352,6 +353,11 @@ def proof(
         Also write ``out/index.html``, a static review page.
     library
         See :func:`load`.
+    denoise
+        Also write every frame denoised by Intel Open Image Denoise (``pyoidn``), guided
+        by albedo and normal images rendered with it, beside the raw frame
+        (:mod:`lookdev.pipeline.proof.denoise`); a :class:`DenoiseError` when ``pyoidn``
+        is not installed.
     progress
         Called with a :class:`lookdev.pipeline.proof.batch.Progress` about twice a second
         and as each proof finishes (``frames_done``, ``frames_total``, ``finished``).
@@ -367,6 +373,10 @@ def proof(
     from lookdev.pipeline.proof import ibl as ibl_module
 
     check_proof_settings(resolution, frames, light_frames, spp, exposure, jobs)
+    if denoise:
+        from lookdev.pipeline.proof.denoise import oidn
+
+        oidn()  # missing: one line before anything is loaded or rendered
     lib = library_for(library)
     if materials is None or (not isinstance(materials, str | os.PathLike) and not materials):
         materials = representative_presets(lib)
@@ -382,7 +392,9 @@ def proof(
     ibl_names = list(dict.fromkeys(ibls or ibl_module.builtin_names()))
     environments = [ibl_module.load(name, ibl_width) for name in ibl_names]
     loaded = [hub(m, batch.MAP_RESOLUTION, lib) for m in chosen]
-    settings = batch.Settings(frames, light_frames, spp, tuple(resolution), exposure)
+    settings = batch.Settings(
+        frames, light_frames, spp, tuple(resolution), exposure, denoise=denoise
+    )
     doc = batch.proof(
         loaded,
         environments,

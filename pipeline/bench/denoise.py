@@ -55,7 +55,7 @@ class DenoiseSettings:
     raw_ladder: tuple[int, ...] = (4, 8, 16, 32, 64)
     denoised_ladder: tuple[int, ...] = (4, 8, 16, 32)
     reference_spp: int = 4096
-    seeds: int = 3
+    seeds: int = 4
     resolution: tuple[int, int] = (192, 96)
     ibl_width: int = 256
 

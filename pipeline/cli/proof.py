@@ -97,6 +97,15 @@ def proof(
     as_json: Annotated[
         bool, typer.Option("--json", help="Print the batch manifest as one JSON object.")
     ] = False,
+    denoise: Annotated[
+        bool,
+        typer.Option(
+            "--denoise",
+            help="Also write each frame denoised by Intel Open Image Denoise (CPU, guided by "
+            "albedo and normal images rendered with it): frame_NNN_denoised.exr/.png beside "
+            "the raw frame, which is kept.",
+        ),
+    ] = False,
     report: Annotated[
         bool,
         typer.Option(
@@ -156,6 +165,7 @@ def proof(
             report=report,
             library=library,
             progress=show,
+            denoise=denoise,
         )
     if as_json:
         print_json(doc)

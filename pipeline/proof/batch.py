@@ -7,6 +7,9 @@ Layout of an output folder::
     OUT/<material>/<ibl>/frame_NNN.exr   scene-linear frames
     OUT/<material>/<ibl>/frame_NNN.png   the same through the proof view transform
     OUT/<material>/<ibl>/contact.png     all frames of the turntable, labelled
+    OUT/<material>/<ibl>/frame_NNN_denoised.exr/.png, contact_denoised.png
+                                         with ``--denoise``: the frames denoised by
+                                         OIDN (:mod:`.denoise`), the raw ones kept
     OUT/<material>/<ibl>/manifest.json   every frame: files (size, SHA-256), render
                                          time, noise estimate; the settings' key
 
@@ -69,6 +72,7 @@ class Settings:
     spp: int = 32
     resolution: tuple[int, int] = (192, 96)
     exposure: float = 0.0  # display only: applied by the view transform, not the render
+    denoise: bool = False  # also write each frame denoised (OIDN), the raw frame kept
 
     def frames(self) -> list[Frame]:
         return frames(self.element_frames, self.light_frames)
@@ -122,10 +126,19 @@ def read_manifest(folder: Path, key: str) -> dict[int, dict[str, Any]]:
         return {}
     done = {}
     for entry in doc.get("frames", []):
-        files = [entry.get("exr"), entry.get("png")]
+        files = [entry.get(k) for k in ("exr", "png", *_denoised_keys(entry))]
         if all(isinstance(f, dict) and _still_valid(folder, f) for f in files):
             done[int(entry["index"])] = entry
     return done
+
+
+def _denoised_keys(entry: dict[str, Any]) -> tuple[str, ...]:
+    """The denoised files' keys of a frame entry that has them."""
+    return DENOISED_FILES if "denoise" in entry else ()
+
+
+DENOISED_FILES = ("denoised_exr", "denoised_png")
+"""Frame-entry keys of a denoised frame's files (file, size, SHA-256), as ``exr``/``png``."""
 
 
 def frames_done(job: Job) -> int:
@@ -173,6 +186,9 @@ def run_job(job: Job) -> dict[str, Any]:
             rendered += 1
     _remove_strays(folder, doc)
     doc["contact_sheet"] = file_entry(_sheet(job, doc))
+    if job.settings.denoise:
+        sheet = _sheet(job, doc, "denoised_png", "contact_denoised.png")
+        doc["contact_sheet_denoised"] = file_entry(sheet)
     write_json(doc, folder / MANIFEST)
     return doc | {"rendered": rendered, "skipped": len(done)}
 
@@ -183,13 +199,14 @@ def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
 
     bsdf, depth = material_bsdf(job.material)
     table = Turntable(bsdf, job.environment, job.settings.resolution, depth)
+    guides = _guide_renderer(table, job.settings) if job.settings.denoise else None
     for frame in todo:
         r = render_frame(table, frame, job.settings.spp, seed=frame.index)
         stem = job.folder / f"frame_{frame.index:03d}"
         exr = contact.write_exr(r.image, stem.with_suffix(".exr"))
         display = tonemap.view(r.image, job.settings.exposure)
         png = contact.write_png(display, stem.with_suffix(".png"))
-        yield {
+        entry = {
             "index": frame.index,
             "kind": frame.kind,
             "angle": frame.angle,
@@ -199,26 +216,53 @@ def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
             "noise_rmse": r.noise_rmse,
             "noise_relative": r.noise_relative,
         }
+        if guides is not None:
+            entry.update(_denoised(job, guides, r.image, stem, frame.index))
+        yield entry
+
+
+def _guide_renderer(table: Any, settings: Settings) -> Any:
+    from .denoise import GUIDE_SPP, GuideRenderer
+
+    return GuideRenderer(table.scene, table.camera_index, min(settings.spp, GUIDE_SPP))
+
+
+def _denoised(job: Job, guides: Any, image: np.ndarray, stem: Path, seed: int) -> dict:
+    """Denoise a frame at the pose it was rendered in; write ``*_denoised.exr/png`` beside
+    the raw frame; the entry's files, ``images`` names and ``denoise`` timings."""
+    d = guides.denoise(image, seed=seed)
+    exr = contact.write_exr(d.image, stem.with_name(stem.name + "_denoised.exr"))
+    display = tonemap.view(d.image, job.settings.exposure)
+    png = contact.write_png(display, stem.with_name(stem.name + "_denoised.png"))
+    names = {"raw": stem.name + ".exr", "png": stem.name + ".png"}
+    return {
+        "denoised_exr": file_entry(exr),
+        "denoised_png": file_entry(png),
+        "images": names | {"denoised": exr.name, "denoised_png": png.name},
+        "denoise": d.timings(),
+    }
 
 
 def _remove_strays(folder: Path, doc: dict[str, Any]) -> None:
     """Delete frame files the manifest does not list (left by a run with more frames)."""
-    keep = {f[kind]["file"] for f in doc["frames"] for kind in ("exr", "png")}
+    keep = {f[kind]["file"] for f in doc["frames"] for kind in ("exr", "png", *_denoised_keys(f))}
     for path in folder.glob("frame_*"):
         if path.name not in keep:
             path.unlink(missing_ok=True)
 
 
-def _sheet(job: Job, doc: dict[str, Any]) -> Path:
+def _sheet(job: Job, doc: dict[str, Any], key: str = "png", name: str = "contact.png") -> Path:
 
     images, labels = [], []
     for entry in doc["frames"]:
-        images.append(contact.read_rgb(job.folder / entry["png"]["file"]))
+        images.append(contact.read_rgb(job.folder / entry[key]["file"]))
         labels.append(f"{entry['kind']} {entry['angle']:.0f}°")
     title = f"{job.material.name} × {job.ibl}  ({job.settings.spp} spp)"
+    if key != "png":
+        title += "  denoised"
     columns = max(job.settings.element_frames, job.settings.light_frames)
     sheet = contact.contact_sheet(images, labels, title, columns)
-    return contact.write_png(sheet, job.folder / "contact.png")
+    return contact.write_png(sheet, job.folder / name)
 
 
 # -- a batch (runs in the parent) ----------------------------------------------------------
