@@ -109,11 +109,14 @@ class GuideRenderer:
         self.sensor = sensor
         self.spp = int(spp)
         self.integrator = mi.load_dict({"type": "aov", "aovs": AOVS})
-        integrator = self.integrator
+        spp = self.spp
 
-        def launch(scene: Any, seed: Any) -> Any:
-            return mi.render(scene, sensor=sensor, integrator=integrator, spp=self.spp, seed=seed)
+        # The integrator is an argument, not a closure: a frozen function must see every
+        # Dr.Jit value it reads among its inputs.
+        def launch(scene: Any, integrator: Any, seed: Any) -> Any:
+            return mi.render(scene, sensor=sensor, integrator=integrator, spp=spp, seed=seed)
 
+        self._plain = launch
         self._launch = dr.freeze(launch) if dr.is_jit_v(mi.Float) else launch
 
     def render(self, seed: int = 0) -> Guides:
@@ -121,7 +124,16 @@ class GuideRenderer:
         import mitsuba as mi
 
         t0 = time.perf_counter()
-        out = np.array(self._launch(self.scene, mi.UInt32(seed)), dtype=np.float32)
+        try:
+            image = self._launch(self.scene, self.integrator, mi.UInt32(seed))
+        except RuntimeError:
+            if self._launch is self._plain:
+                raise
+            # Some sensors cannot be frozen (Mitsuba 3.9's orthographic camera): the
+            # guides of such a scene are traced on every call instead.
+            self._launch = self._plain
+            image = self._launch(self.scene, self.integrator, mi.UInt32(seed))
+        out = np.array(image, dtype=np.float32)
         albedo = np.clip(out[..., 0:3], 0.0, 1.0)
         normal = np.clip(np.nan_to_num(out[..., 3:6]), -1.0, 1.0)
         return Guides(albedo, normal, time.perf_counter() - t0)
