@@ -44,7 +44,7 @@ import numpy as np
 from lookdev.library import files
 from lookdev.materials.errors import LookdevError
 
-from . import contact, tonemap
+from . import contact, denoise, tonemap
 from .turntable import Frame, frames
 
 MANIFEST = "manifest.json"
@@ -199,7 +199,7 @@ def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
 
     bsdf, depth = material_bsdf(job.material)
     table = Turntable(bsdf, job.environment, job.settings.resolution, depth)
-    guides = _guide_renderer(table, job.settings) if job.settings.denoise else None
+    guides = denoise.guide_renderer(table, job.settings.spp) if job.settings.denoise else None
     for frame in todo:
         r = render_frame(table, frame, job.settings.spp, seed=frame.index)
         stem = job.folder / f"frame_{frame.index:03d}"
@@ -217,30 +217,9 @@ def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
             "noise_relative": r.noise_relative,
         }
         if guides is not None:
-            entry.update(_denoised(job, guides, r.image, stem, frame.index))
+            exposure = job.settings.exposure
+            entry.update(denoise.write_denoised(guides, r.image, stem, exposure, frame.index))
         yield entry
-
-
-def _guide_renderer(table: Any, settings: Settings) -> Any:
-    from .denoise import GUIDE_SPP, GuideRenderer
-
-    return GuideRenderer(table.scene, table.camera_index, min(settings.spp, GUIDE_SPP))
-
-
-def _denoised(job: Job, guides: Any, image: np.ndarray, stem: Path, seed: int) -> dict:
-    """Denoise a frame at the pose it was rendered in; write ``*_denoised.exr/png`` beside
-    the raw frame; the entry's files, ``images`` names and ``denoise`` timings."""
-    d = guides.denoise(image, seed=seed)
-    exr = contact.write_exr(d.image, stem.with_name(stem.name + "_denoised.exr"))
-    display = tonemap.view(d.image, job.settings.exposure)
-    png = contact.write_png(display, stem.with_name(stem.name + "_denoised.png"))
-    names = {"raw": stem.name + ".exr", "png": stem.name + ".png"}
-    return {
-        "denoised_exr": file_entry(exr),
-        "denoised_png": file_entry(png),
-        "images": names | {"denoised": exr.name, "denoised_png": png.name},
-        "denoise": d.timings(),
-    }
 
 
 def _remove_strays(folder: Path, doc: dict[str, Any]) -> None:

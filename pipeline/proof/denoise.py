@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -48,7 +49,9 @@ __all__ = [
     "GuideRenderer",
     "Guides",
     "denoise",
+    "guide_renderer",
     "oidn",
+    "write_denoised",
 ]
 
 GUIDE_SPP = 16
@@ -165,3 +168,37 @@ def denoise(image: np.ndarray, guides: Guides | None = None) -> np.ndarray:
         return pyoidn.denoise(color, hdr=True, quality="high", **kwargs)
     except (RuntimeError, ValueError, TypeError) as exc:
         raise DenoiseError(f"Open Image Denoise failed: {exc}") from None
+
+
+# -- proofs ------------------------------------------------------------------------------
+def guide_renderer(table: Any, spp: int) -> GuideRenderer:
+    """The guides of a :class:`~.turntable.Turntable` (its single-frame camera), rendered
+    with ``min(spp, GUIDE_SPP)`` samples: a 4-spp preview does not pay for 16-spp guides."""
+    return GuideRenderer(table.scene, table.camera_index, min(int(spp), GUIDE_SPP))
+
+
+def write_denoised(
+    guides: GuideRenderer, image: np.ndarray, stem: Path, exposure: float, seed: int = 0
+) -> dict[str, Any]:
+    """Denoise a frame at the pose it was just rendered in and write
+    ``<stem>_denoised.exr`` and ``.png`` beside the raw ``<stem>.exr``; the frame entry's
+    additions: the two files (name, size, SHA-256, as ``exr``/``png``), ``images`` (the
+    raw and denoised file names) and ``denoise`` (seconds of guides and denoiser)."""
+    from . import contact, tonemap
+    from .batch import file_entry
+
+    d = guides.denoise(image, seed=seed)
+    exr = contact.write_exr(d.image, stem.with_name(stem.name + "_denoised.exr"))
+    display = tonemap.view(d.image, exposure)
+    png = contact.write_png(display, stem.with_name(stem.name + "_denoised.png"))
+    return {
+        "denoised_exr": file_entry(exr),
+        "denoised_png": file_entry(png),
+        "images": {
+            "raw": stem.name + ".exr",
+            "png": stem.name + ".png",
+            "denoised": exr.name,
+            "denoised_png": png.name,
+        },
+        "denoise": d.timings(),
+    }
