@@ -58,10 +58,11 @@ class DenoiseSettings:
     seeds: int = 4
     resolution: tuple[int, int] = (192, 96)
     ibl_width: int = 256
+    cases: tuple[tuple[str, str], ...] = CASES
 
     @classmethod
     def quick(cls) -> DenoiseSettings:
-        return cls((2, 4, 8), (2, 4), 64, 1, (32, 16), 64)
+        return cls((2, 4, 8), (2, 4), 64, 1, (32, 16), 64, CASES)
 
 
 @dataclass(frozen=True)

@@ -264,7 +264,7 @@ def run(
 def _denoise_tasks(
     settings: denoise_bench.DenoiseSettings, report: Report
 ) -> list[tuple[str, Callable[[], list[Row]]]]:
-    """One task per (preset, IBL) of :data:`.denoise.CASES`; each adds its Case."""
+    """One task per (preset, IBL) of ``settings.cases``; each adds its Case."""
     from lookdev.library import load_material
     from lookdev.pipeline.blend import blend
     from lookdev.pipeline.export.mitsuba import register_plugins
@@ -283,7 +283,7 @@ def _denoise_tasks(
 
     return [
         (f"denoise {preset} × {name}", lambda p=preset, n=name: task(p, n))
-        for preset, name in denoise_bench.CASES
+        for preset, name in settings.cases
     ]
 
 

@@ -53,9 +53,9 @@ def test_the_table_has_a_row_per_denoised_point_and_marks_extrapolation():
 
 @pytest.mark.slow
 @pytest.mark.render
-def test_cli_json_carries_the_equal_time_table(cli, tmp_path, monkeypatch):
-    monkeypatch.setattr(D, "CASES", (("plastic_glossy", "sky"),))
-    res = cli("bench", "error", "--quick", "--item", "denoise", "-o", str(tmp_path), "--json")
+def test_cli_json_carries_the_equal_time_table(cli, tmp_path):
+    res = cli("bench", "error", "--quick", "--item", "denoise", "--denoise-case",
+              "plastic_glossy:sky", "-o", str(tmp_path), "--json")  # fmt: skip
     assert res.code == 0, res.err
     data = json.loads(res.out)
     (case,) = data["denoise"]
