@@ -468,6 +468,9 @@ def summary(out: Path, jobs: list[Job], results: list[dict[str, Any]], seconds: 
                 "contact_sheet": str(job.folder.relative_to(out) / "contact.png"),
             }
         )
+        if "contact_sheet_denoised" in doc:
+            sheet = job.folder.relative_to(out) / doc["contact_sheet_denoised"]["file"]
+            entries[-1]["contact_sheet_denoised"] = str(sheet)
     entries = merge_entries(out, entries)
     doc = {
         "version": FORMAT_VERSION,
