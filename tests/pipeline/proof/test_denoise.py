@@ -153,7 +153,7 @@ def test_api_proof_passes_denoise_through(mi, tmp_path):
     from lookdev.pipeline import api
 
     with ThreadPoolExecutor(1) as pool:
-        api.proof(
+        doc = api.proof(
             "plaster",
             "studio",
             tmp_path,
@@ -166,6 +166,8 @@ def test_api_proof_passes_denoise_through(mi, tmp_path):
             denoise=True,
         )
     assert (tmp_path / "plaster" / "studio" / "frame_000_denoised.exr").is_file()
+    (entry,) = doc["proofs"]
+    assert (tmp_path / entry["contact_sheet_denoised"]).is_file()
 
 
 def test_missing_pyoidn_is_one_line_exit_2(cli, tmp_path, monkeypatch):
