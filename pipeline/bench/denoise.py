@@ -56,7 +56,7 @@ class DenoiseSettings:
     raw_ladder: tuple[int, ...] = (4, 8, 16, 32, 64)
     denoised_ladder: tuple[int, ...] = (4, 8, 16, 32)
     reference_spp: int = 4096
-    seeds: int = 4
+    seeds: int = 8
     resolution: tuple[int, int] = (96, 48)
     ibl_width: int = 256
     cases: tuple[tuple[str, str], ...] = CASES
