@@ -313,6 +313,7 @@ def proof(
     resolution: tuple[int, int] = (192, 96),
     exposure: float = 0.0,
     ibl_width: int = 512,
+    rig: str = "full",
     jobs: int | None = None,
     scheduler: str | None = None,
     executor: Executor | None = None,
@@ -341,6 +342,9 @@ def proof(
         ``(width, height)``, and stops applied by the PNG view transform.
     ibl_width
         Every IBL is resampled to this width (× ½ high) so render kernels are reused.
+    rig
+        The calibrated rig beside the material (:mod:`lookdev.pipeline.proof.rig`):
+        ``full`` (chrome ball, 18 % grey ball, ColorChecker chart), ``balls``, ``none``.
     jobs
         Local worker processes (default 1: each renders on every core). They are spawned,
         so a script calling :func:`proof` does so under ``if __name__ == "__main__":``.
@@ -367,6 +371,10 @@ def proof(
     from lookdev.pipeline.proof import ibl as ibl_module
 
     check_proof_settings(resolution, frames, light_frames, spp, exposure, jobs)
+    from lookdev.pipeline.proof.rig import RIGS
+
+    if rig not in RIGS:
+        raise batch.ProofError(f"unknown rig {rig!r}; use {', '.join(RIGS)}", field="--rig")
     lib = library_for(library)
     if materials is None or (not isinstance(materials, str | os.PathLike) and not materials):
         materials = representative_presets(lib)
@@ -382,7 +390,7 @@ def proof(
     ibl_names = list(dict.fromkeys(ibls or ibl_module.builtin_names()))
     environments = [ibl_module.load(name, ibl_width) for name in ibl_names]
     loaded = [hub(m, batch.MAP_RESOLUTION, lib) for m in chosen]
-    settings = batch.Settings(frames, light_frames, spp, tuple(resolution), exposure)
+    settings = batch.Settings(frames, light_frames, spp, tuple(resolution), exposure, rig)
     doc = batch.proof(
         loaded,
         environments,
@@ -393,6 +401,9 @@ def proof(
         executor=executor,
         progress=progress,
     )
+    from lookdev.pipeline.proof.material_info import write_material_info
+
+    write_material_info(output, loaded)
     if report:
         from lookdev.pipeline.analysis.report import write_report
 
