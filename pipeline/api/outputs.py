@@ -221,6 +221,7 @@ def export_mitsuba(
     path: PathLike,
     *,
     ibl: PathLike | None = None,
+    ibl_rotation: float = 0.0,
     resolution: tuple[int, int] = (512, 512),
     spp: int = 128,
     map_resolution: int = 512,
@@ -238,6 +239,10 @@ def export_mitsuba(
     ibl
         A built-in IBL name (``studio``, ``sky``, ``overcast``, ``sunset``) or an
         ``.exr``/``.hdr`` file; None: a constant white sky (the white furnace).
+    ibl_rotation
+        Degrees the IBL turns about +y, with the proofs' orientation convention
+        (:data:`lookdev.pipeline.proof.ibl.ORIENTATION`, stated in the XML): the scene
+        lit as a proof's lighting frame at that angle.
     resolution, spp
         Film size in pixels and samples per pixel.
     map_resolution
@@ -261,6 +266,7 @@ def export_mitsuba(
     for side in resolution:
         check_range(side, 1, FILM_MAX_SIDE, field="--resolution", error=MitsubaExportError)
     check_range(spp, 1, 2**20, field="--spp", error=MitsubaExportError)
+    check_range(ibl_rotation, -360.0, 360.0, field="--ibl-rotation", error=MitsubaExportError)
     material = hub(material, map_resolution, library)
     env = _environment_file(ibl)
     scene = export_scene(
@@ -269,6 +275,7 @@ def export_mitsuba(
         resolution=tuple(resolution),
         spp=spp,
         environment=env,
+        ibl_rotation=ibl_rotation,
         force_all_lobes=force_all_lobes,
     )
     bsdf = scene["ball"]["bsdf"]

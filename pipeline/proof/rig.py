@@ -88,9 +88,7 @@ def _patches(space: str) -> tuple[tuple[str, tuple[float, float, float]], ...]:
     )
     if known != space:
         rgb = lcolour.convert(rgb, known, space).astype(np.float64)
-    return tuple(
-        (n, tuple(float(c) for c in row)) for n, row in zip(names, rgb, strict=True)
-    )
+    return tuple((n, tuple(float(c) for c in row)) for n, row in zip(names, rgb, strict=True))
 
 
 def patch_values(space: str | None = None) -> dict[str, tuple[float, float, float]]:
@@ -215,4 +213,3 @@ def manifest_entry(rig: str) -> dict[str, Any]:
         entry["chart_space"] = lcolour.working_space()
         entry["chart_adaptation"] = CAT
     return entry
-
