@@ -183,12 +183,13 @@ class Page:
             time.sleep(0.05)
 
     def screenshot(self, selector: str | None = None) -> bytes:
-        """A PNG of the element matching ``selector`` (scrolled into view), or the page."""
+        """A PNG of the element matching ``selector`` (scrolled to the middle of the view,
+        clear of the page's sticky toolbar), or of the whole page."""
         params: dict = {"format": "png", "captureBeyondViewport": True}
         if selector is not None:
             box = self.js(
                 f"(() => {{ const e = document.querySelector({json.dumps(selector)}); "
-                "e.scrollIntoView(); const r = e.getBoundingClientRect(); "
+                "e.scrollIntoView({block: 'center'}); const r = e.getBoundingClientRect(); "
                 "return [r.x + scrollX, r.y + scrollY, r.width, r.height]; })()"
             )
             x, y, w, h = box

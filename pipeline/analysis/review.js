@@ -30,7 +30,7 @@
   function num(v, digits) {
     if (v === null || v === undefined) return "–";
     if (typeof v !== "number") return String(v);
-    return Number.isInteger(v) ? String(v) : v.toPrecision(digits || 3);
+    return Number.isInteger(v) ? String(v) : String(Number(v.toPrecision(digits || 3)));
   }
 
   function statsText(f) {
