@@ -284,14 +284,22 @@ def _img(src: Path, base: Path, alt: str, cls: str = "") -> str:
     return f'<img{c} src="{html.escape(review.url(src, base))}" alt="{html.escape(alt)}">'
 
 
-def render_page(batch_dir: Path, entries: list[Entry], sheets: list[Path], plots: dict) -> str:
+def render_page(
+    batch_dir: Path,
+    entries: list[Entry],
+    sheets: list[Path],
+    plots: dict,
+    hubs: Mapping[str, Any] | None = None,
+) -> str:
     """The HTML text of the review page: a sticky raw/denoised toggle, the comparison
     and a turntable player per proof (built by ``report/review.js`` from the page's JSON,
     :mod:`.review`), then the time/noise table and the contact sheets."""
     out = batch_dir / REPORT_DIR
     esc = html.escape
     materials = list(dict.fromkeys(e.material for e in entries))
-    data = review.page_data(batch_dir, entries, lambda p: web_image(p, out), plots)
+    data = review.page_data(
+        batch_dir, entries, lambda p: web_image(p, out), plots, dict(hubs or {})
+    )
     parts = [
         "<!doctype html><html lang=en><head><meta charset=utf-8>",
         '<meta name="viewport" content="width=device-width, initial-scale=1">',
@@ -342,6 +350,6 @@ def write_report(
     names = dict.fromkeys(e.material for e in entries)
     made = material_plots(names, materials or {}, out, entries[0].ibl) if plots else {}
     review.copy_assets(out)
-    page = render_page(batch_dir, entries, contact_sheets(batch_dir), made)
+    page = render_page(batch_dir, entries, contact_sheets(batch_dir), made, materials)
     index = batch_dir / "index.html"
     return files.atomic_write(index, page)

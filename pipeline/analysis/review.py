@@ -134,19 +134,28 @@ def proof_data(entry: Any, web: Any, base: Path) -> dict[str, Any]:
 
 
 def page_data(
-    batch_dir: Path, entries: list[Any], web: Any, plots: dict[str, dict[str, Path]]
+    batch_dir: Path,
+    entries: list[Any],
+    web: Any,
+    plots: dict[str, dict[str, Path]],
+    hubs: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """Everything the page's script shows; image paths as URLs relative to ``batch_dir``.
 
     ``web(path)`` turns a frame file into a browser-viewable image (EXR → PNG thumbnail).
+    A material's description is its ``material.json``, else that of its blended material
+    in ``hubs`` when given, else None (the page says it was not recorded).
     """
-    from lookdev.pipeline.proof.material_info import read_material_info
+    from lookdev.pipeline.proof.material_info import describe, read_material_info
 
     proofs = [proof_data(e, web, batch_dir) for e in entries]
-    materials = {}
+    materials: dict[str, Any] = {}
     for e in entries:
         if e.material not in materials:
-            materials[e.material] = read_material_info(e.path.parent.parent)
+            info = read_material_info(e.path.parent.parent)
+            if info is None and e.material in (hubs or {}):
+                info = describe(hubs[e.material])
+            materials[e.material] = info
     return {
         "batch": batch_dir.name,
         "proofs": proofs,

@@ -332,9 +332,10 @@ def proof(
 
     Each proof turns the element through ``frames`` frames, then the lighting through
     ``light_frames``, and writes under ``out/MATERIAL/IBL/``: EXR frames, view-transformed
-    PNGs, a labelled ``contact.png`` and a ``manifest.json``. Calling again with the same
-    arguments renders only the frames the manifests do not vouch for (size and SHA-256),
-    so an interrupted batch resumes.
+    PNGs, a labelled ``contact.png`` and a ``manifest.json``; and
+    ``out/MATERIAL/material.json`` (resolved parameters, source, USD loss notes) for the
+    review page. Calling again with the same arguments renders only the frames the
+    manifests do not vouch for (size and SHA-256), so an interrupted batch resumes.
 
     Parameters
     ----------
@@ -360,7 +361,8 @@ def proof(
     executor
         Any ``concurrent.futures.Executor`` to run the proofs on (it is not shut down).
     report
-        Also write ``out/index.html``, a static review page.
+        Also write ``out/index.html``, a static review page: turntable players, a
+        synchronised comparison, raw/denoised, each material's parameters and losses.
     library
         See :func:`load`.
     progress

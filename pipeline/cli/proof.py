@@ -118,8 +118,10 @@ def proof(
         bool,
         typer.Option(
             "--report",
-            help="Also write OUTPUT/index.html: contact sheets, time/noise table, each "
-            "material's BRDF plots and its frames; static, opens from disk.",
+            help="Also write OUTPUT/index.html, the review page: turntable players, a "
+            "synchronised comparison across materials or IBLs, raw/denoised, each "
+            "material's parameters, source, USD losses and BRDF plots, every frame's "
+            "spp/noise/time; static, opens from disk, offline.",
         ),
     ] = False,
 ) -> None:
