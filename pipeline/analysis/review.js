@@ -47,6 +47,27 @@
     return parts.join(" · ");
   }
 
+  /* Frames are fetched once by a cached Image and put on screen only when loaded: the
+   * shown image then never has a load pending that the next frame would abort, and a
+   * playing turntable does not flicker. */
+  const cache = new Map();
+  function setFrame(img, src) {
+    img.dataset.want = src;
+    if (img.getAttribute("src") === src) return;
+    let pre = cache.get(src);
+    if (!pre) {
+      pre = new Image();
+      pre.src = src;
+      cache.set(src, pre);
+    }
+    const put = () => { if (img.dataset.want === src) img.src = src; };
+    if (pre.complete) put();
+    else {
+      pre.addEventListener("load", put, { once: true });
+      pre.addEventListener("error", put, { once: true }); // shown broken: a test sees it
+    }
+  }
+
   function source(f) {
     const denoised = state.denoised && f.denoised;
     return { src: denoised ? f.denoised : f.raw, which: denoised ? "denoised" : "raw" };
@@ -121,7 +142,7 @@
         p.index = Math.min(Math.max(0, i), frames.length - 1);
         const f = frames[p.index];
         const s = source(f);
-        if (img.getAttribute("src") !== s.src) img.src = s.src;
+        setFrame(img, s.src);
         img.dataset.which = s.which;
         which.textContent = s.which;
         which.className = "which " + s.which;
@@ -200,7 +221,7 @@
           if (!frames.length) continue;
           const f = frames[Math.min(c.index, frames.length - 1)];
           const s = source(f);
-          if (x.img.getAttribute("src") !== s.src) x.img.src = s.src;
+          setFrame(x.img, s.src);
           x.img.dataset.which = s.which;
           x.which.textContent = s.which;
           x.which.className = "which " + s.which;
@@ -216,8 +237,13 @@
     mode.addEventListener("change", c.fill);
     pick.addEventListener("change", c.build);
     views.push(c);
+    const orientation = (data.proofs.find((p) => p.orientation) || {}).orientation;
+    const convention = orientation
+      ? el("details", { class: "meta" }, el("summary", {}, "IBL orientation"),
+        ...Object.entries(orientation).map(([k, v]) => el("div", {}, k + ": " + v)))
+      : null;
     c.node = el("section", { id: "compare" }, el("h2", {}, "Compare"),
-      el("div", { class: "controls" }, mode, pick, play, scrub, label), grid);
+      el("div", { class: "controls" }, mode, pick, play, scrub, label), grid, convention);
     c.fill();
     return c;
   }

@@ -137,7 +137,11 @@ def _wait(page: Page, expression: str, timeout: float = 10.0) -> None:
 
 def _shown(page: Page, selector: str) -> tuple[int, int, int]:
     """The colour at the centre of the image ``selector`` as Chromium paints it."""
-    _wait(page, f"(i => i.complete && i.naturalWidth > 0)(document.querySelector({selector!r}))")
+    _wait(
+        page,
+        "(i => i.getAttribute('src') === i.dataset.want && i.complete && i.naturalWidth > 0)"
+        f"(document.querySelector({selector!r}))",
+    )
     shot = page.screenshot(selector)
     path = Path(os.environ.get("TMPDIR", "/tmp")) / f"lookdev-shot-{os.getpid()}.png"
     path.write_bytes(shot)
