@@ -97,7 +97,7 @@ def patch_values(space: str | None = None) -> dict[str, tuple[float, float, floa
 
     >>> v = patch_values("Linear Rec.709 (sRGB)")
     >>> len(v), [round(c, 4) for c in v["neutral 5 (.70 D)"]]
-    (24, [0.1901, 0.1903, 0.1899])
+    (24, [0.1901, 0.1908, 0.1898])
     """
     from lookdev.materials import colour as lcolour
 
