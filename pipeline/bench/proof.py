@@ -102,7 +102,7 @@ def time_pipeline(bsdf: dict, depth: int, env: Any, s: Settings, rig: str = "ful
     from lookdev.pipeline.proof.turntable import Turntable, render_frame
 
     with Clock() as clock:
-        table = Turntable(bsdf, env.pixels, s.resolution, depth, rig)
+        table = Turntable(bsdf, env.pixels, s.resolution, depth, rig=rig)
         noise = [render_frame(table, f, s.spp, seed=f.index) for f in _frames(s.frames)]
     mean_noise = float(np.mean([r.noise_relative or 0.0 for r in noise]))
     return Timing(clock.timing.wall, clock.timing.cpu, mean_noise)

@@ -72,6 +72,7 @@ class Turntable:
         environment: np.ndarray,
         resolution: tuple[int, int],
         max_depth: int,
+        *,
         rig: str = DEFAULT_RIG,
     ):
         import mitsuba as mi
