@@ -23,9 +23,11 @@ from . import mtlx, preview, ri
 from .names import PREVIEW_OPACITY
 from .network import (
     CONTEXT_OUTPUT,
+    DISPLACEMENT_OUTPUT,
     Connection,
     ExportError,
     Image,
+    Interface,
     MaterialSpec,
     Source,
     prim_name,
@@ -74,6 +76,7 @@ def value_types() -> dict[str, Any]:
         "float2": t.Float2,
         "float3": t.Float3,
         "float4": t.Float4,
+        "color4f": t.Color4f,
         "color3f": t.Color3f,
         "normal3f": t.Normal3f,
         "vector3f": t.Vector3f,
@@ -94,7 +97,7 @@ def usd_value(kind: str, value: Any, base: Path) -> Any:
         return Gf.Vec3f(*value)
     if kind == "float2":
         return Gf.Vec2f(*value)
-    if kind == "float4":
+    if kind in ("float4", "color4f"):
         return Gf.Vec4f(*value)
     if kind == "float":
         return float(value)
@@ -147,11 +150,19 @@ def _author_material(layer, scope, spec: MaterialSpec, base: Path, types: dict[s
         _attribute(
             layer, version, types["string"], Sdf.VariabilityUniform
         ).default = mtlx.mtlx_version()
+    for name, (kind, value) in spec.interface().items():
+        attr = _attribute(layer, path.AppendProperty(f"inputs:{name}"), types[kind])
+        attr.default = usd_value(kind, value, base)
     for net in spec.networks:
         output = path.AppendProperty(f"outputs:{CONTEXT_OUTPUT[net.context]}")
         _attribute(layer, output, types["token"]).connectionPathList.explicitItems = [
             _output_path(path, net.terminal)
         ]
+        if net.displacement is not None:
+            output = path.AppendProperty(f"outputs:{DISPLACEMENT_OUTPUT[net.context]}")
+            _attribute(layer, output, types["token"]).connectionPathList.explicitItems = [
+                _output_path(path, net.displacement)
+            ]
         for node in net.nodes:
             shader = Sdf.PrimSpec(prim, node.name, Sdf.SpecifierDef, "Shader")
             if any(node.custom.values()):
@@ -163,8 +174,17 @@ def _author_material(layer, scope, spec: MaterialSpec, base: Path, types: dict[s
                 attr = _attribute(layer, at(f"inputs:{name}"), types[kind])
                 if isinstance(value, Connection):
                     attr.connectionPathList.explicitItems = [_output_path(path, value)]
+                elif isinstance(value, Interface):
+                    # Connected to the Material's interface (which wins); the value
+                    # stays here too for readers that do not follow connections.
+                    attr.connectionPathList.explicitItems = [
+                        path.AppendProperty(f"inputs:{value.name}")
+                    ]
+                    attr.default = usd_value(kind, value.value, base)
                 else:
                     attr.default = usd_value(kind, value, base)
+                if name in node.color_spaces:
+                    attr.SetInfo("colorSpace", node.color_spaces[name])
             for name, kind in node.outputs.items():
                 Sdf.JustCreatePrimAttributeInLayer(layer, at(f"outputs:{name}"), types[kind])
     return path

@@ -117,14 +117,18 @@ def test_plain_diffuse_has_no_clearcoat_sheen_or_transmission(tmp_path):
         "inputs:roughness",
         "outputs:bxdf_out",
     ]
-    # the Material: three outputs and MaterialXConfigAPI's config:mtlx:version
+    # the Material: its interface (the values every context reads, one override for
+    # all), three outputs and MaterialXConfigAPI's config:mtlx:version
     assert attrs["/Materials/plaster"] == [
         "config:mtlx:version",
+        "inputs:base_color",
+        "inputs:ior",
+        "inputs:roughness",
         "outputs:mtlx:surface",
         "outputs:ri:surface",
         "outputs:surface",
     ]
-    assert sum(len(v) for v in attrs.values()) == 4 + 4 + 4 + 5
+    assert sum(len(v) for v in attrs.values()) == 4 + 4 + 5 + 7
 
 
 @pytest.mark.parametrize("specular", [0.0, 0.3, 0.5, 2.0])
