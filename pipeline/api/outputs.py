@@ -81,6 +81,8 @@ def export_usd(
     library: Any = None,
     progress: Callable[[int, int, str], None] | None = None,
     preview_opacity: str = "keep",
+    collect: bool = False,
+    preview_geometry: bool = False,
 ) -> UsdExport:
     """Write materials as UsdShade materials under ``/Materials`` of ``path``.
 
@@ -88,7 +90,7 @@ def export_usd(
     ----------
     materials
         One or several preset names, paths or :class:`~lookdev.library.Material` s;
-        several make a library whose ``/Look`` prim switches between them.
+        several make a library whose ``/Materials/Look`` prim switches between them.
     path
         ``.usda``, ``.usdc``, ``.usd``, or ``.usdz`` (packaged with its textures).
     contexts
@@ -116,6 +118,12 @@ def export_usd(
         transmissive materials (DCCs read ``opacity`` as alpha) and names the loss;
         ``"transmission"``: the UsdPreviewSurface spec's reading, ``opacity = 1 −
         spec_trans`` (``1 − clear`` for Pixar).
+    collect
+        Copy every texture file a preset reads into ``<name>_textures`` beside ``path``
+        (UDIM tiles included), referenced by relative paths; otherwise the files are
+        referenced where they are, relative to ``path`` where possible.
+    preview_geometry
+        Add a sphere per material, bound to it, in a grid under ``/Materials/Geometry``.
 
     Returns
     -------
@@ -158,6 +166,8 @@ def export_usd(
         split=split,
         progress=progress,
         preview_opacity=preview_opacity,
+        collect=collect,
+        preview_geometry=preview_geometry,
     )
     return UsdExport(
         result.files[0],

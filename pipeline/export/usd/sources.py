@@ -152,7 +152,8 @@ def referenced_image(hub: BlendedMaterial, name: str, ti: Any, texture_dir: Path
         channel=CHANNEL_OUTPUTS.get(channel, "") if channel is not None else "",
         scale=float(scale),
         bias=float(bias),
-        fallback=None if array is None or name == "normal_map" else _mean(array),
+        # A missing normal or height map reads as no perturbation, not as the mean.
+        fallback=None if array is None or name in ("normal_map", "height") else _mean(array),
         wrap=ti.wrap,
         flip_y=bool(getattr(ti, "flip_y", False)),
         derived_dir=texture_dir,

@@ -186,7 +186,7 @@ def test_variant_set_switches_presets_on_one_prim(tmp_path):
     out = tmp_path / "lib.usda"
     export_usd(sources, out, contexts=("universal",))
     stage = Usd.Stage.Open(str(out))
-    look = stage.GetPrimAtPath("/Look")
+    look = stage.GetPrimAtPath("/Materials/Look")
     vset = look.GetVariantSets().GetVariantSet("preset")
     assert sorted(vset.GetVariantNames()) == ["blue", "red"]
     for name, colour in (("red", (1, 0, 0)), ("blue", (0, 0, 1))):
