@@ -329,6 +329,7 @@ def proof(
     report: bool = False,
     library: Any = None,
     progress: Callable[[Any], None] | None = None,
+    geometry: PathLike | None = None,
 ) -> dict[str, Any]:
     """Render turntable proofs (Burley §6.1): every material under every IBL.
 
@@ -365,6 +366,9 @@ def proof(
     progress
         Called with a :class:`lookdev.pipeline.proof.batch.Progress` about twice a second
         and as each proof finishes (``frames_done``, ``frames_total``, ``finished``).
+    geometry
+        A mesh (PLY, OBJ, or USD geometry) rendered in the cup's place beside the ball,
+        with its own UVs (:mod:`lookdev.pipeline.proof.geometry`).
 
     Returns
     -------
@@ -384,6 +388,11 @@ def proof(
     # and every texture it names (layers a blend would prune included), every IBL.
     output = Path(out)
     batch.check_writable(output)
+    mesh = None
+    if geometry is not None:
+        from lookdev.pipeline.proof.geometry import proof_mesh
+
+        mesh = str(proof_mesh(geometry))
     chosen = _materials(materials, lib)
     for material in chosen:
         check_textures(material)
@@ -392,7 +401,7 @@ def proof(
     ibl_names = list(dict.fromkeys(ibls or ibl_module.builtin_names()))
     environments = [ibl_module.load(name, ibl_width) for name in ibl_names]
     loaded = [hub(m, batch.MAP_RESOLUTION, lib) for m in chosen]
-    settings = batch.Settings(frames, light_frames, spp, tuple(resolution), exposure)
+    settings = batch.Settings(frames, light_frames, spp, tuple(resolution), exposure, mesh)
     doc = batch.proof(
         loaded,
         environments,

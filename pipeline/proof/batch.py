@@ -69,6 +69,9 @@ class Settings:
     spp: int = 32
     resolution: tuple[int, int] = (192, 96)
     exposure: float = 0.0  # display only: applied by the view transform, not the render
+    geometry: str | None = None
+    """A mesh in the cup's place (the cached PLY of :func:`.geometry.proof_mesh`: its
+    name holds the hash of the user's file, so the proof key follows the mesh)."""
 
     def frames(self) -> list[Frame]:
         return frames(self.element_frames, self.light_frames)
@@ -182,7 +185,7 @@ def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
     from .turntable import Turntable, material_bsdf, render_frame
 
     bsdf, depth = material_bsdf(job.material)
-    table = Turntable(bsdf, job.environment, job.settings.resolution, depth)
+    table = Turntable(bsdf, job.environment, job.settings.resolution, depth, job.settings.geometry)
     for frame in todo:
         r = render_frame(table, frame, job.settings.spp, seed=frame.index)
         stem = job.folder / f"frame_{frame.index:03d}"

@@ -66,10 +66,11 @@ class Turntable:
         environment: np.ndarray,
         resolution: tuple[int, int],
         max_depth: int,
+        geometry: str | None = None,
     ):
         import mitsuba as mi
 
-        scene = shaderball.scene_dict(bsdf, environment, resolution, max_depth)
+        scene = shaderball.scene_dict(bsdf, environment, resolution, max_depth, geometry)
         scene["sensor_pair"] = _sensor_pair(scene["sensor"])
         self.scene = mi.load_dict(scene)
         self.width = int(resolution[0])

@@ -257,7 +257,9 @@ def test_package_holds_stage_and_textures(tmp_path):
     with zipfile.ZipFile(tmp_path / "r.usdz") as z:
         names = z.namelist()
     assert names[0].endswith(".usdc")
-    assert sum(n.endswith(".exr") for n in names) == len(result.images)
+    # ARKit reads PNG and JPEG only: maps go in as PNG, none as EXR
+    assert sum(n.endswith(".png") for n in names) == len(result.images)
+    assert not any(n.endswith(".exr") for n in names)
     assert all(n.startswith("tex/") for n in names[1:])  # packaged by their path from the stage
     assert validate_usd(tmp_path / "r.usdz").ok
 
