@@ -18,6 +18,8 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
+from lookdev.materials import colour
+
 from .live import mixed_input
 from .names import SURFACE_IDS, Slot, mapped_params, table_for
 from .network import (
@@ -34,7 +36,7 @@ from .network import (
     surface_inputs,
 )
 from .preview import SPECULAR_WORKFLOW
-from .textures import MTLX_ADDRESS, affine, converted, mtlx_color_space, output_of
+from .textures import MTLX_ADDRESS, affine, converted, output_of
 
 SURFACE = "mtlx_surface"
 MX_TYPES = {
@@ -61,6 +63,32 @@ def _library():
     lib = mx.createDocument()
     mx.loadLibraries(mx.getDefaultDataLibraryFolders(), mx.getDefaultDataSearchPath(), lib)
     return lib
+
+
+@cache
+def _mtlx_spaces() -> frozenset[str]:
+    """MaterialX's colour-space names: its ``cmlib`` conversions' sources, and the
+    default working space ``lin_rec709``."""
+    names = {"lin_rec709"}
+    for nodedef in _library().getNodeDefs():
+        n = nodedef.getName()
+        if n.startswith("ND_") and "_to_" in n:
+            names.add(n[3:].split("_to_")[0])
+    return frozenset(names)
+
+
+def mtlx_color_space(space: str | None) -> str | None:
+    """The MaterialX ``colorspace`` of a file in OCIO ``space`` (None for data): the
+    space's name or an alias MaterialX knows, else the OCIO name (read by MaterialX's
+    OCIO colour management)."""
+    if space is None or colour.is_data(space):
+        return None
+    cs = colour.config().getColorSpace(colour.canonical(space))
+    known = {n.lower(): n for n in _mtlx_spaces()}
+    for name in (cs.getName(), *cs.getAliases()):
+        if name.lower() in known:
+            return known[name.lower()]
+    return cs.getName()
 
 
 @cache

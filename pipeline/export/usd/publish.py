@@ -54,6 +54,17 @@ def lookdev_version() -> str:
         return "0+unknown"
 
 
+def tile_files(path: Path) -> list[Path]:
+    """The files a texture path stands for: itself, or a ``<UDIM>`` set's tiles."""
+    from lookdev.pipeline.blend.errors import TextureError
+    from lookdev.pipeline.blend.surface_maps import udim_tiles
+
+    try:
+        return sorted(udim_tiles(path).values())
+    except TextureError:
+        return []
+
+
 def write_texture(target: Path, image: Image, shown: Path | None = None) -> None:
     """``image`` as a half-float, tiled, mip-mapped EXR at ``target`` (deterministic).
 
@@ -122,8 +133,6 @@ def targets_of(image: Image, target: Path) -> list[Path]:
     """The files writing ``image`` to ``target`` makes (a UDIM set: one per tile)."""
     if not (image.reference and image.udim):
         return [target]
-    from .writer import tile_files
-
     head, tail = image.origin.name.split("<UDIM>", 1)
     return [
         target.with_name(target.name.replace("<UDIM>", t.name[len(head) : len(t.name) - len(tail)]))

@@ -12,7 +12,6 @@ a texture node's scale and bias, so the exporter writes a converted copy of the 
 
 from __future__ import annotations
 
-from functools import cache
 from pathlib import Path
 
 import numpy as np
@@ -64,34 +63,6 @@ def preview_color_space(space: str | None) -> tuple[str, str]:
     if colour.is_data(name) or name == colour.canonical(colour.working_space()):
         return "raw", ""
     return "raw", f"a UsdPreviewSurface reader reads {space} as raw (only its colorSpace names it)"
-
-
-@cache
-def _mtlx_spaces() -> frozenset[str]:
-    """MaterialX's colour-space names: its ``cmlib`` conversions' sources, and the
-    default working space ``lin_rec709``."""
-    from .mtlx import _library
-
-    names = {"lin_rec709"}
-    for nodedef in _library().getNodeDefs():
-        n = nodedef.getName()
-        if n.startswith("ND_") and "_to_" in n:
-            names.add(n[3:].split("_to_")[0])
-    return frozenset(names)
-
-
-def mtlx_color_space(space: str | None) -> str | None:
-    """The MaterialX ``colorspace`` of a file in OCIO ``space`` (None for data): the
-    space's name or an alias MaterialX knows, else the OCIO name (read by MaterialX's
-    OCIO colour management)."""
-    if space is None or colour.is_data(space):
-        return None
-    cs = colour.config().getColorSpace(colour.canonical(space))
-    known = {n.lower(): n for n in _mtlx_spaces()}
-    for name in (cs.getName(), *cs.getAliases()):
-        if name.lower() in known:
-            return known[name.lower()]
-    return cs.getName()
 
 
 def usd_color_space(image: Image, slot_type: str) -> str | None:

@@ -266,21 +266,10 @@ def check_images(images: list[Image]) -> None:
         path = image.origin if image.reference and image.write else image.path
         if image.write and not image.reference:
             continue
-        if image.udim and not tile_files(path):
+        if image.udim and not publish.tile_files(path):
             raise ExportError("no UDIM tile of this texture exists", where=str(path))
         if not image.udim and not path.is_file():
             raise ExportError("texture does not exist", where=str(path))
-
-
-def tile_files(path: Path) -> list[Path]:
-    """The files a texture path stands for: itself, or a ``<UDIM>`` set's tiles."""
-    from lookdev.pipeline.blend.errors import TextureError
-    from lookdev.pipeline.blend.surface_maps import udim_tiles
-
-    try:
-        return sorted(udim_tiles(path).values())
-    except TextureError:
-        return []
 
 
 @dataclass
