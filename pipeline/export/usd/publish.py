@@ -180,14 +180,8 @@ def for_package(specs: list[MaterialSpec]) -> None:
     def change(image: Image, node: Any, name: str) -> Image:
         if image.path.suffix.lower() in (".png", ".jpg", ".jpeg"):
             return image
-        if image.reference:
-            raise ExportError(
-                f"{image.path.name} cannot go into a .usdz (ARKit reads PNG and JPEG); "
-                "convert it to PNG, or export .usda with --collect",
-                where=str(image.path),
-            )
         if image.path not in done:
-            done[image.path] = _png_of(image)
+            done[image.path] = _png_of(_with_file_pixels(image) if image.reference else image)
         png, lo, span = done[image.path]
         if node.id == "UsdUVTexture":
             _fold_range(node, lo, span)
@@ -209,6 +203,29 @@ def for_package(specs: list[MaterialSpec]) -> None:
         return png
 
     _retarget(specs, change)
+
+
+def _with_file_pixels(image: Image) -> Image:
+    """A preset's own file (not PNG or JPEG) with its stored pixels, row 0 = top, colour
+    converted to the working space; the texture node's scale and bias still apply."""
+    import OpenImageIO as oiio
+
+    source = image.origin or image.path
+    if image.udim:
+        raise ExportError(
+            f"the UDIM set {source.name} cannot go into a .usdz as it is (ARKit reads PNG "
+            "and JPEG); convert its tiles to PNG, or export .usda with --collect",
+            where=str(source),
+        )
+    buf = oiio.ImageBuf(str(source))
+    px = buf.get_pixels(oiio.FLOAT)
+    if buf.has_error or px is None:
+        raise ExportError(f"cannot read {source}: {buf.geterror()}", where=str(source))
+    px = np.asarray(px, dtype=np.float32)
+    if image.colorspace is not None and not colour.is_data(image.colorspace) and px.ndim == 3:
+        px = colour.convert(px[..., :3], image.colorspace, colour.working_space())
+        return dataclasses.replace(image, pixels=px, colorspace=colour.working_space())
+    return dataclasses.replace(image, pixels=px)
 
 
 def _png_of(image: Image) -> tuple[Image, float, float]:

@@ -335,3 +335,10 @@ def test_texture_mask_and_normal_map_live(tmp_path):
     assert normal.GetAttribute("inputs:sourceColorSpace").Get() == "raw"
     loss = stage.GetPrimAtPath("/Materials/scuffed/mtlx_surface").GetCustomDataByKey("lookdev:loss")
     assert "no normal input" in loss
+    # --collect: the mask file is copied beside the export, referenced relatively
+    export_usd([source], out_dir / "c.usda", collect=True)
+    assert (out_dir / "c_textures" / "mask.exr").read_bytes() == (src / "mask.exr").read_bytes()
+    stage = Usd.Stage.Open(str(out_dir / "c.usda"))
+    mask = stage.GetPrimAtPath("/Materials/scuffed/mtlx_mask_1").GetAttribute("inputs:file")
+    assert mask.Get().path == "./c_textures/mask.exr"
+    assert validate_usd(out_dir / "c.usda").ok
