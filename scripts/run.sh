@@ -26,6 +26,7 @@ ASSET="$OUT/asset"
 python scripts/make_example_asset.py "$ASSET/source"
 lookdev proof "$ASSET/source/pebble.toml" --geometry "$ASSET/source/pebble.obj" \
     --ibl studio --frames 4 --light-frames 4 -o "$ASSET"
-lookdev export usd "$ASSET/source/pebble.toml" -o "$ASSET/pebble.usda" --collect --preview-geometry
+lookdev export usd "$ASSET/source/pebble.toml" -o "$ASSET/pebble.usda" --collect --preview-geometry \
+    --map-resolution 256
 echo "review page: $OUT/index.html; proofs: $OUT/*/*/contact.png; USD: $OUT/proofed.usda"
 echo "example asset: $ASSET/pebble/studio/contact.png; USD: $ASSET/pebble.usda"
