@@ -65,6 +65,32 @@ def tile_files(path: Path) -> list[Path]:
         return []
 
 
+def write_image(image: Image, temp_for, shown: Path) -> list[Path]:
+    """Write ``image`` through ``temp_for(final path)``; returns the final paths."""
+    if image.reference:  # a preset's own file (each tile of a set), copied as it is
+        finals = targets_of(image, image.path)
+        for final in finals:
+            copy_texture(
+                dataclasses.replace(image, path=final, origin=tile_of(image, final)),
+                temp_for(final),
+            )
+        return finals
+    if image.path.suffix.lower() == ".png":
+        write_png(temp_for(image.path), image, shown)
+    else:
+        write_texture(temp_for(image.path), image, shown)
+    return [image.path]
+
+
+def tile_of(image: Image, final: Path) -> Path:
+    """The source tile of a collected file ``final`` (the file itself when not UDIM)."""
+    if not image.udim:
+        return image.origin
+    head, tail = image.path.name.split("<UDIM>", 1)
+    number = final.name[len(head) : len(final.name) - len(tail)]
+    return image.origin.with_name(image.origin.name.replace("<UDIM>", number))
+
+
 def write_texture(target: Path, image: Image, shown: Path | None = None) -> None:
     """``image`` as a half-float, tiled, mip-mapped EXR at ``target`` (deterministic).
 

@@ -8,7 +8,6 @@ succeeded, so a failure leaves no partial file (:class:`Staging`).
 
 from __future__ import annotations
 
-import dataclasses
 import os
 import tempfile
 from dataclasses import dataclass, field
@@ -380,7 +379,7 @@ def _write_all(specs, images, out, split_dir, staging, layout) -> list[Path]:
     for image in images:
         if image.write:
             staging.folder(image.path.parent)
-            files += _write_image(image, staging.temp_for, image.path)
+            files += publish.write_image(image, staging.temp_for, image.path)
     if split_dir is not None:
         staging.folder(Path(split_dir))
         return files + _write_split(specs, out, Path(split_dir), staging, layout)
@@ -396,7 +395,7 @@ def _write_package(specs, images, out: Path, workdir: Path, staging: Staging, la
     for image in images:
         if image.write:
             image.path.parent.mkdir(parents=True, exist_ok=True)
-            _write_image(image, lambda p: p, image.path)
+            publish.write_image(image, lambda p: p, image.path)
     root = workdir / f"{out.stem}.usdc"  # the package's root layer keeps the output's name
     if root.exists():  # not a private folder: never overwrite what is there
         fd, name = tempfile.mkstemp(prefix=f".{out.stem}.", suffix=".usdc", dir=workdir)
@@ -426,32 +425,6 @@ def _finish(layer, paths: list[str], layout: dict[str, Any]) -> None:
     publish.asset_metadata(layer, ROOT, layout["name"], len(paths))
     if layout["geometry"]:
         publish.add_preview_geometry(layer, ROOT, paths)
-
-
-def _write_image(image: Image, temp_for, shown: Path) -> list[Path]:
-    """Write ``image`` through ``temp_for(final path)``; returns the final paths."""
-    if image.reference:  # a preset's own file (each tile of a set), copied as it is
-        finals = publish.targets_of(image, image.path)
-        for final in finals:
-            publish.copy_texture(
-                dataclasses.replace(image, path=final, origin=_tile_of(image, final)),
-                temp_for(final),
-            )
-        return finals
-    if image.path.suffix.lower() == ".png":
-        publish.write_png(temp_for(image.path), image, shown)
-    else:
-        publish.write_texture(temp_for(image.path), image, shown)
-    return [image.path]
-
-
-def _tile_of(image: Image, final: Path) -> Path:
-    """The source tile of a collected file ``final`` (the file itself when not UDIM)."""
-    if not image.udim:
-        return image.origin
-    head, tail = image.path.name.split("<UDIM>", 1)
-    number = final.name[len(head) : len(final.name) - len(tail)]
-    return image.origin.with_name(image.origin.name.replace("<UDIM>", number))
 
 
 def _write_split(specs, out: Path, folder: Path, staging: Staging, layout) -> list[Path]:
