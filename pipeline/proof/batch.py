@@ -44,7 +44,8 @@ import numpy as np
 from lookdev.library import files
 from lookdev.materials.errors import LookdevError
 
-from . import contact, denoise, tonemap
+from . import contact, denoise, ibl, rig, tonemap
+from .rig import DEFAULT_RIG
 from .turntable import Frame, frames
 
 MANIFEST = "manifest.json"
@@ -72,6 +73,10 @@ class Settings:
     spp: int = 32
     resolution: tuple[int, int] = (192, 96)
     exposure: float = 0.0  # display only: applied by the view transform, not the render
+    geometry: str | None = None
+    """A mesh in the cup's place (the cached PLY of :func:`.geometry.proof_mesh`: its
+    name holds the hash of the user's file, so the proof key follows the mesh)."""
+    rig: str = DEFAULT_RIG  # the calibrated rig beside the material (.rig)
     denoise: bool = False  # also write each frame denoised (OIDN), the raw frame kept
 
     def frames(self) -> list[Frame]:
@@ -176,6 +181,8 @@ def run_job(job: Job) -> dict[str, Any]:
         "key": job.key,
         "variant": variant,
         "settings": job.settings.as_json(),
+        "rig": rig.manifest_entry(job.settings.rig),
+        "ibl_orientation": ibl.ORIENTATION,
         "frames": [done[i] for i in sorted(done)],
     }
     rendered = 0
@@ -198,7 +205,14 @@ def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
     from .turntable import Turntable, material_bsdf, render_frame
 
     bsdf, depth = material_bsdf(job.material)
-    table = Turntable(bsdf, job.environment, job.settings.resolution, depth)
+    table = Turntable(
+        bsdf,
+        job.environment,
+        job.settings.resolution,
+        depth,
+        job.settings.geometry,
+        rig=job.settings.rig,
+    )
     guides = denoise.guide_renderer(table, job.settings.spp) if job.settings.denoise else None
     for frame in todo:
         r = render_frame(table, frame, job.settings.spp, seed=frame.index)
@@ -476,6 +490,7 @@ def summary(out: Path, jobs: list[Job], results: list[dict[str, Any]], seconds: 
         "version": FORMAT_VERSION,
         "wall_seconds": round(seconds, 3),
         "settings": jobs[0].settings.as_json() if jobs else {},
+        "ibl_orientation": ibl.ORIENTATION,
         "proofs": entries,
         "overview": overview(out, entries).name if entries else None,
     }
