@@ -232,7 +232,10 @@ def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
         }
         if guides is not None:
             exposure = job.settings.exposure
-            entry.update(denoise.write_denoised(guides, r.image, stem, exposure, frame.index))
+            written = denoise.write_denoised(
+                guides, r.image, stem, exposure, frame.index, file_entry
+            )
+            entry.update(written)
         yield entry
 
 

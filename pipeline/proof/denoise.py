@@ -33,6 +33,7 @@ is always kept beside the denoised one.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -99,11 +100,13 @@ class Denoised:
 class GuideRenderer:
     """Renders the guides of a loaded scene's current pose with the ``aov`` integrator.
 
-    The launch is frozen (``dr.freeze``) like the turntable's own renders, so after the
-    first frame a pose costs the kernels, not the tracing of our Python plugins again.
+    With ``freeze`` the launch is frozen (``dr.freeze``) like the turntable's own renders,
+    so after the first frames a pose costs the kernels, not the tracing again. Mitsuba
+    3.9's orthographic camera cannot be frozen, and a failed recording leaves Dr.Jit
+    unable to record other frozen functions in the process: pass ``freeze=False`` there.
     """
 
-    def __init__(self, scene: Any, sensor: int = 0, spp: int = GUIDE_SPP):
+    def __init__(self, scene: Any, sensor: int = 0, spp: int = GUIDE_SPP, freeze: bool = True):
         import drjit as dr
         import mitsuba as mi
 
@@ -119,23 +122,14 @@ class GuideRenderer:
         def launch(scene: Any, integrator: Any, seed: Any) -> Any:
             return mi.render(scene, sensor=sensor, integrator=integrator, spp=spp, seed=seed)
 
-        self._plain = launch
-        self._launch = dr.freeze(launch) if dr.is_jit_v(mi.Float) else launch
+        self._launch = dr.freeze(launch) if freeze and dr.is_jit_v(mi.Float) else launch
 
     def render(self, seed: int = 0) -> Guides:
         """The guides at the scene's current pose (the same seed gives the same images)."""
         import mitsuba as mi
 
         t0 = time.perf_counter()
-        try:
-            image = self._launch(self.scene, self.integrator, mi.UInt32(seed))
-        except RuntimeError:
-            if self._launch is self._plain:
-                raise
-            # Some sensors cannot be frozen (Mitsuba 3.9's orthographic camera): the
-            # guides of such a scene are traced on every call instead.
-            self._launch = self._plain
-            image = self._launch(self.scene, self.integrator, mi.UInt32(seed))
+        image = self._launch(self.scene, self.integrator, mi.UInt32(seed))
         out = np.array(image, dtype=np.float32)
         albedo = np.clip(out[..., 0:3], 0.0, 1.0)
         normal = np.clip(np.nan_to_num(out[..., 3:6]), -1.0, 1.0)
@@ -174,18 +168,26 @@ def denoise(image: np.ndarray, guides: Guides | None = None) -> np.ndarray:
 def guide_renderer(table: Any, spp: int) -> GuideRenderer:
     """The guides of a :class:`~.turntable.Turntable` (its single-frame camera), rendered
     with ``min(spp, GUIDE_SPP)`` samples: a 4-spp preview does not pay for 16-spp guides."""
-    return GuideRenderer(table.scene, table.camera_index, min(int(spp), GUIDE_SPP))
+    # Not frozen: tracing the aov integrator is cheap (≈ 0.03-0.1 s a frame, measured on
+    # 32×16 proofs), and a second frozen launch over the turntable's scene is one more
+    # recording that can fail (see GuideRenderer); lookdev bench error times frozen guides.
+    return GuideRenderer(table.scene, table.camera_index, min(int(spp), GUIDE_SPP), freeze=False)
 
 
 def write_denoised(
-    guides: GuideRenderer, image: np.ndarray, stem: Path, exposure: float, seed: int = 0
+    guides: GuideRenderer,
+    image: np.ndarray,
+    stem: Path,
+    exposure: float,
+    seed: int,
+    file_entry: Callable[[Path], dict[str, Any]],
 ) -> dict[str, Any]:
     """Denoise a frame at the pose it was just rendered in and write
     ``<stem>_denoised.exr`` and ``.png`` beside the raw ``<stem>.exr``; the frame entry's
     additions: the two files (name, size, SHA-256, as ``exr``/``png``), ``images`` (the
-    raw and denoised file names) and ``denoise`` (seconds of guides and denoiser)."""
+    raw and denoised file names) and ``denoise`` (seconds of guides and denoiser).
+    ``file_entry`` describes a written file (the batch's, passed in: no import cycle)."""
     from . import contact, tonemap
-    from .batch import file_entry
 
     d = guides.denoise(image, seed=seed)
     exr = contact.write_exr(d.image, stem.with_name(stem.name + "_denoised.exr"))
