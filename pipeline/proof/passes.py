@@ -127,6 +127,7 @@ def render_frame(
     time_budget: float | None = None,
     pass_spp: int = PASS_SPP,
     clock: Callable[[], float] = time.perf_counter,
+    on_pass: Callable[[int, Estimate, float], None] | None = None,
 ) -> RenderedFrame:
     """Render ``frame``: ``spp`` samples in one pass, or passes of ``pass_spp`` until the
     estimated relative noise is at most ``noise``.
@@ -135,8 +136,9 @@ def render_frame(
     within ``max_spp`` (the last pass is shortened to fit) and, with a ``time_budget``
     (seconds of this frame's rendering), the next pass is not expected to end past it —
     expected from the mean duration of the passes so far. The first pass always runs.
-    ``clock`` is injectable so that tests need no timing. An odd spp is rounded down to
-    even (the halves share it), and never below 2.
+    ``clock`` is injectable so that tests need no timing; ``on_pass(spp, estimate,
+    seconds)`` is called after every pass (progress, benchmarks). An odd spp is rounded
+    down to even (the halves share it), and never below 2.
     """
     if (spp is None) == (noise is None):
         raise ValueError("give exactly one of spp (a fixed count) and noise (a target)")
@@ -156,6 +158,8 @@ def render_frame(
         passes += 1
         est = estimate(sum_a / (done / 2.0), sum_b / (done / 2.0))
         elapsed = clock() - t0
+        if on_pass is not None:
+            on_pass(done, est, elapsed)
         stop = _stop(spp, noise, est, done, cap, time_budget, elapsed, elapsed / passes)
         if stop is not None:
             break
