@@ -237,10 +237,10 @@ def proof(
             e["ibl"],
             f"{e['rendered']} + {e['skipped']}",
             e["render_seconds"],
-            e["mean_spp"],
-            e["mean_noise_relative"],
-            ", ".join(f"{k} {v}" for k, v in sorted(e["stops"].items())),
-            e["max_firefly_share"],
+            e.get("mean_spp"),  # .get: a kept entry may come from an older batch
+            e.get("mean_noise_relative"),
+            ", ".join(f"{k} {v}" for k, v in sorted((e.get("stops") or {}).items())),
+            e.get("max_firefly_share"),
         ]
         for e in doc["proofs"]
     ]

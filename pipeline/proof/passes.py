@@ -49,8 +49,8 @@ would have overrun its ``time_budget``, or was asked for a fixed ``spp``."""
 
 PASS_SPP = 8
 """Samples per pixel a pass adds (half to each of A and B) when rendering to a target.
-One size for every pass, so every pass replays one frozen recording; at 480×240 a pass
-of 8 costs ≈ 8 × a pass of 1 spp's samples plus ≈ 2 % (measured, see the README)."""
+One size for every pass (but a last one shortened to fit ``max_spp``), so the passes
+replay one frozen recording."""
 
 FIREFLY_FRACTION = 0.001
 """The hottest 0.1 % of a frame's pixels are its fireflies (issue 16)."""
@@ -151,9 +151,10 @@ def render_frame(
     size = first
     while True:
         a, b = table.render_halves(size // 2, seed=seed_for(frame, passes))
-        weight = size / 2.0
-        sum_a = a * weight if sum_a is None else sum_a + a * weight
-        sum_b = b * weight if sum_b is None else sum_b + b * weight
+        weight = size / 2.0  # samples per pixel of each half: a shortened pass weighs less
+        a, b = a.astype(np.float64) * weight, b.astype(np.float64) * weight
+        sum_a = a if sum_a is None else sum_a + a
+        sum_b = b if sum_b is None else sum_b + b
         done += size
         passes += 1
         est = estimate(sum_a / (done / 2.0), sum_b / (done / 2.0))

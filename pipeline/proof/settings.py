@@ -158,7 +158,7 @@ def check(settings: Settings, jobs: int | None = None) -> Settings:
     if samples > MAX_SAMPLES:
         raise ProofError(
             f"{s.resolution[0]}×{s.resolution[1]} at {spp} spp is {samples:.3g} samples a "
-            f"render; allowed ≤ {MAX_SAMPLES:.3g} (lower --spp or --resolution)",
+            f"frame; allowed ≤ {MAX_SAMPLES:.3g} (lower --spp or --resolution)",
             field="--resolution",
         )
     return s
