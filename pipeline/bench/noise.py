@@ -115,14 +115,14 @@ def filter_cost(s: Settings) -> list[dict[str, Any]]:
     return rows
 
 
-def _write_cost(image: np.ndarray, folder: Path) -> float:
-    """Seconds to write a frame as a proof does: EXR, and PNG through the view."""
+def _write_cost(image: np.ndarray, folder: Path) -> list[float]:
+    """[wall, CPU] seconds to write a frame as a proof does: EXR, and PNG through the view."""
     from lookdev.pipeline.proof import contact, tonemap
 
     with _Clock() as c:
         contact.write_exr(image, folder / "f.exr")
         contact.write_png(tonemap.view(image), folder / "f.png")
-    return c.wall
+    return [c.wall, c.cpu]
 
 
 def traces(s: Settings) -> list[dict[str, Any]]:
@@ -139,7 +139,8 @@ def traces(s: Settings) -> list[dict[str, Any]]:
                 old = _setup(preset, ibl_name, s, s.old_resolution, s.old_filter, first, folder)
                 with _Clock() as c:
                     r = passes.render_frame(old.pop("table"), steady, spp=s.old_spp)
-                old |= {"frame_s": [c.wall + old["write_s"], c.cpu], "noise": r.noise}
+                write = old["write_s"]
+                old |= {"frame_s": [c.wall + write[0], c.cpu + write[1]], "noise": r.noise}
                 new = _setup(preset, ibl_name, s, s.resolution, "box", first, folder)
                 trace = _trace(new.pop("table"), steady, s)
                 rows.append(
@@ -204,7 +205,7 @@ def candidates(rows: list[dict[str, Any]], s: Settings) -> list[dict[str, Any]]:
             for row in rows:
                 p = _stop_at(row["trace"], target, cap)
                 stops.append({"preset": row["preset"], "ibl": row["ibl"]} | p)
-                frame = np.array([p["wall_s"] + row["new"]["write_s"], p["cpu_s"]])
+                frame = np.array([p["wall_s"], p["cpu_s"]]) + row["new"]["write_s"]
                 new += np.array(row["new"]["setup_s"]) + (s.frames - 1) * frame
                 old += np.array(row["old"]["setup_s"]) + (s.frames - 1) * np.array(
                     row["old"]["frame_s"]
