@@ -98,7 +98,7 @@ def test_passes_stop_at_the_target_with_new_seeds_and_one_pass_size():
     first = passes.estimate(*table.render_halves(4, seed=passes.seed_for(FRAME, 0))).relative
     table.calls.clear()
     target = first / 3.0  # needs ≈ 9 passes of 8: 1/√9
-    r = passes.render_frame(table, FRAME, noise=target, max_spp=1024)
+    r = passes.render_frame(table, FRAME, noise=target, max_spp=1024, pass_spp=8)
     assert r.stop == "target" and r.noise <= target
     assert 6 <= r.passes <= 14 and r.spp == 8 * r.passes
     assert {spp for spp, _ in table.calls} == {4}  # one size: one frozen recording
@@ -108,7 +108,7 @@ def test_passes_stop_at_the_target_with_new_seeds_and_one_pass_size():
 
 def test_passes_stop_at_max_spp_shortening_the_last_pass():
     table = FakeTable(sigma=1.0)
-    r = passes.render_frame(table, FRAME, noise=1e-6, max_spp=20)
+    r = passes.render_frame(table, FRAME, noise=1e-6, max_spp=20, pass_spp=8)
     assert (r.stop, r.spp, r.passes) == ("max_spp", 20, 3)
     assert [spp for spp, _ in table.calls] == [4, 4, 2]
     assert r.noise > 1e-6
