@@ -184,7 +184,7 @@ def proof(
 
       lookdev proof copper --noise 0.02 --max-spp 4096 --resolution 960 480
 
-      lookdev proof gold --ibl sky --spp 16 --clamp 20 -r 240 120   # a quick preview
+      lookdev proof gold --ibl sky --spp 16 --clamp 20 -r 240 120   # preview
 
       lookdev proof copper --spp 256 --resolution 640 320 --scheduler tcp://farm:8786
     """
