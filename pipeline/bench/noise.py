@@ -8,6 +8,8 @@ Three measurements, each a ratio within one run (the machine may be shared):
   passes (:func:`lookdev.pipeline.proof.passes.render_frame`), its estimated relative
   noise, firefly share, wall and CPU seconds after every pass; from these, for each
   candidate (target, cap), where a frame would stop, with how many samples and what noise.
+- **pass cost**: one pass of ``trace_spp`` against passes of ``pass_spp`` adding up to
+  it, interleaved: what a pass costs beyond its samples.
 - **main job, new default vs old**: the same jobs also load and render the old default
   (192×96, 32 spp, Gaussian) interleaved with the new; a job's time is its scene load and
   first frame (kernels compile, the frozen render records) plus (frames − 1) × a steady
@@ -25,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["Settings", "candidates", "filter_cost", "run", "traces"]
+__all__ = ["Settings", "candidates", "filter_cost", "pass_cost", "run", "traces"]
 
 
 @dataclass(frozen=True)
@@ -113,6 +115,34 @@ def filter_cost(s: Settings) -> list[dict[str, Any]]:
             }
         )
     return rows
+
+
+def pass_cost(s: Settings) -> dict[str, Any]:
+    """One pass of ``trace_spp`` against passes of ``pass_spp`` adding up to it, on the
+    first preset × IBL, interleaved, best of ``repeat``: the fixed cost of a pass."""
+    from lookdev.pipeline.proof import passes, turntable
+
+    table = _table(s.presets[0], s.ibls[0], s, s.resolution, "box")
+    frame = turntable.Frame(s.frames - 1, "light", 180.0)
+    ways = {
+        "one": {"spp": s.trace_spp},
+        "passes": {"noise": 1e-9, "max_spp": s.trace_spp, "pass_spp": s.pass_spp},
+    }
+    best = {k: [np.inf, np.inf] for k in ways}
+    for rep in range(s.repeat + 1):
+        for k, kw in ways.items():
+            with _Clock() as c:
+                passes.render_frame(table, frame, **kw)
+            if rep:  # the first round compiles and records
+                best[k] = [min(best[k][0], c.wall), min(best[k][1], c.cpu)]
+    return {
+        "preset": s.presets[0],
+        "ibl": s.ibls[0],
+        "spp": s.trace_spp,
+        "pass_spp": s.pass_spp,
+        "passes_over_one_wall": best["passes"][0] / best["one"][0],
+        "passes_over_one_cpu": best["passes"][1] / best["one"][1],
+    }
 
 
 def _write_cost(image: np.ndarray, folder: Path) -> list[float]:
@@ -237,6 +267,7 @@ def run(s: Settings | None = None, *, filters: bool = True) -> dict[str, Any]:
         "settings": asdict(s),
         "load_average": list(_load()),
         "filter": filter_cost(s) if filters else [],
+        "pass_cost": pass_cost(s),
         "traces": rows,
         "candidates": candidates(rows, s),
     }

@@ -405,6 +405,12 @@ def noise_(
         for r in report["filter"]
     ]
     console.print(table("Gaussian pixel filter / box", ["frame", "wall", "CPU"], rows))
+    pc = report["pass_cost"]
+    console.print(
+        f"{pc['spp'] // pc['pass_spp']} passes of {pc['pass_spp']} spp / one of {pc['spp']}: "
+        f"wall {pc['passes_over_one_wall']:.3g}, CPU {pc['passes_over_one_cpu']:.3g}",
+        highlight=False,
+    )
     rows = [
         [f"{r['preset']} × {r['ibl']}", p["spp"], p["noise"], p["firefly_share"], p["cpu_s"]]
         for r in report["traces"]

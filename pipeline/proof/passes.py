@@ -47,12 +47,12 @@ Stop = Literal["target", "max_spp", "time_budget", "spp"]
 """Why a frame stopped adding samples: it met its noise target, reached ``max_spp``,
 would have overrun its ``time_budget``, or was asked for a fixed ``spp``."""
 
-PASS_SPP = 4
+PASS_SPP = 8
 """Samples per pixel a pass adds (half to each of A and B) when rendering to a target.
 One size for every pass (but a last one shortened to fit ``max_spp``), so the passes
-replay one frozen recording. Small, so that a frame stops near the spp it needs: at
-480×240 each pass of 4 costs the same CPU time as the one before (``lookdev bench noise``
-traces), so a pass's fixed cost is negligible there."""
+replay one frozen recording. A pass has a fixed cost beyond its samples (at 480×240,
+four passes of 4 spp took 1.19× the CPU time of one pass of 16: ``lookdev bench noise``),
+so passes are not smaller than the main job's cap: its frames render in one pass."""
 
 FIREFLY_FRACTION = 0.001
 """The hottest 0.1 % of a frame's pixels are its fireflies (issue 16)."""

@@ -17,6 +17,8 @@ def test_bench_noise_quick_json_reports_filter_traces_and_candidates(cli, tmp_pa
     doc = json.loads(r.out)
     (f,) = doc["filter"]
     assert f["gaussian_over_box_wall"] > 0 and f["gaussian_over_box_cpu"] > 0
+    pc = doc["pass_cost"]
+    assert (pc["spp"], pc["pass_spp"]) == (8, 4) and pc["passes_over_one_cpu"] > 0
     (row,) = doc["traces"]
     assert [p["spp"] for p in row["trace"]] == [4, 8]  # passes of 4 up to trace_spp
     assert all(p["noise"] > 0 and 0 < p["firefly_share"] <= 1 for p in row["trace"])
