@@ -71,7 +71,7 @@ def firefly_share(squared_error: np.ndarray, fraction: float = FIREFLY_FRACTION)
     """Share of ``squared_error``'s sum held by its largest ``fraction`` of pixels
     (at least one pixel); None when the sum is 0.
 
-    >>> firefly_share(np.array([1.0] * 999 + [1001.0]))
+    >>> firefly_share(np.array([1.0] * 999 + [999.0]))
     0.5
     """
     flat = np.asarray(squared_error, dtype=np.float64).ravel()
