@@ -246,8 +246,9 @@ def scene_dict(
     shown instead of the cup, turning about the same centre.
 
     ``environment`` is a lat-long (H, W, 3) float32 array, used as it is (exposure is
-    already in its pixels, see :mod:`.ibl`) and oriented by :data:`.ibl.ORIENTATION`. ``clamp``: each camera sample's radiance is
-    limited to that value (:mod:`.clamp`; biased, for previews); None renders unclamped.
+    already in its pixels, see :mod:`.ibl`) and oriented by :data:`.ibl.ORIENTATION`.
+    ``clamp``: each camera sample's radiance is limited to that value (:mod:`.clamp`;
+    biased, for previews); None renders unclamped.
     """
     import mitsuba as mi
 
