@@ -11,6 +11,7 @@ curve or primaries matrix is written by hand anywhere in the program:
   or ``acescg``), named by the config's own colour-space names;
 * :func:`convert` moves pixels between any two of the config's spaces, by name or alias
   (``"sRGB - Texture"``, ``"ACEScg"``, ``"Raw"``); :func:`to_working` into the working space;
+* :func:`texture_space` names the colour space a texture is read in (the file rule);
 * :func:`decode_hex` reads a preset's ``"#rrggbb"`` as sRGB-encoded (``"sRGB - Texture"``);
 * :func:`luminance` weighs linear working-space RGB by the Y row of its RGB → CIE XYZ
   matrix, asked of the config (Rec.709: ITU-R BT.709-6 item 3.3).
@@ -58,6 +59,7 @@ __all__ = [
     "luminance",
     "luminance_weights",
     "is_data",
+    "texture_space",
 ]
 
 DEFAULT_CONFIG = "ocio://studio-config-v4.0.0_aces-v2.0_ocio-v2.5"
@@ -228,3 +230,38 @@ def luminance(rgb: Any) -> Any:
     """
     out = np.asarray(rgb) @ luminance_weights()
     return float(out) if np.ndim(out) == 0 and not isinstance(rgb, np.ndarray) else out
+
+
+def texture_space(
+    bits_are_integer: bool, drives_colour: bool, declared: str | None, path: str | None = None
+) -> str:
+    """The colour space a texture file is read in, by the config's name.
+
+    The rule, first match wins:
+
+    1. ``declared`` (the texture's ``colorspace``) when given;
+    2. a data map (anything but a colour: roughness, metallic, masks, normals, heights)
+       is ``Raw``: it is never colour-converted by default;
+    3. the config's own file rules, when the config in force is not lookdev's default
+       (``$OCIO`` or ``--config`` named one) and ``path`` matches one of its rules other
+       than ``Default``: a studio that wrote rules for its texture names gets them. The
+       built-in studio config's rules are for plates (EXR → ACES2065-1), not textures,
+       so they are not consulted;
+    4. an integer colour map (8 or 16 bits) is ``sRGB - Texture`` (painted maps are
+       display-encoded), a float colour map (half, float EXR) is the working space
+       (scene-linear maps are written linear, in the space the look is built in).
+
+    >>> texture_space(True, True, None), texture_space(False, True, None)
+    ('sRGB Encoded Rec.709 (sRGB)', 'Linear Rec.709 (sRGB)')
+    >>> texture_space(True, False, None), texture_space(True, False, "ACEScg")
+    ('Raw', 'ACEScg')
+    """
+    if declared is not None:
+        return canonical(declared)
+    if not drives_colour:
+        return canonical(RAW)
+    if path is not None and settings().config_name != DEFAULT_CONFIG:
+        cfg = config()
+        if not cfg.filepathOnlyMatchesDefaultRule(path):
+            return canonical(cfg.getColorSpaceFromFilepath(path))
+    return canonical(SRGB_TEXTURE) if bits_are_integer else working_space()

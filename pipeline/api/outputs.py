@@ -404,8 +404,8 @@ def check_textures(material: Any) -> None:
     """Every texture a material names (masks and normal maps of every layer, nested
     layered presets included, pruned or not) exists, decodes and has its channels; else
     the one line of :class:`~lookdev.pipeline.blend.resample.TextureError`."""
+    from lookdev.library.images import TextureFile
     from lookdev.materials.layers import textures
-    from lookdev.pipeline.blend.resample import TextureFile
 
     for i, layer in enumerate(getattr(material, "layers", None) or []):
         if not hasattr(layer, "mask"):  # a blend's or a model's own: nothing to read

@@ -11,6 +11,7 @@ import pytest
 from _blend_helpers import disney, layer, layered, write_image
 
 from lookdev.materials.layers import TextureMask
+from lookdev.library import images
 from lookdev.pipeline.blend import MaskSampler, TextureError, blend, resample
 from lookdev.pipeline.blend.masks import BoxReduced
 from lookdev.pipeline.blend.resample import TextureFile, read_channels
@@ -46,7 +47,7 @@ def test_rows_read_in_chunks_equal_openimageio_whole_image(
 ):
     """Chunks of 32 rows (the smallest) across runs of every length: each chunk lands
     flipped in its place, as stored; the reference is ImageBuf's whole decode."""
-    monkeypatch.setattr(resample, "_CHUNK_BYTES", 1)
+    monkeypatch.setattr(images, "_CHUNK_BYTES", 1)
     rng = np.random.default_rng(11)
     pixels = rng.random((101, 19, 3), dtype=np.float32)
     pixels[:7] = 0.0  # exactly 0 and 1 survive every format
