@@ -178,5 +178,3 @@ def oiio_error(image: oiio.ImageInput | None = None) -> str:
     own = image.geterror() if image is not None else ""
     message = " ".join(own.split()) or " ".join(oiio.geterror().split()) or "unknown format"
     return message[:200]
-
-

@@ -26,6 +26,7 @@ from lookdev.library.images import TextureFile, as_float, channel_index, read_ch
 
 __all__ = ["TextureFile", "as_float", "channel_index", "read_channels", "resample", "taps"]
 
+
 def taps(
     n_out: int, n_src: int, scale: float, offset: float, wrap: str, rows: slice | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
