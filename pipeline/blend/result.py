@@ -9,8 +9,12 @@ live), and asks the model registry (:mod:`lookdev.materials.registry`) which mod
 it and which of its lobes are live.
 
 Maps are float32 ``(H, W)`` scalars and ``(H, W, 3)`` colours and normals, in UV order:
-``map[r, c]`` is the texel centred on ``(u, v) = ((c + ½)/W, (r + ½)/H)``. Normal maps are
-unit tangent-space vectors (decoded, not 0..1 encoded).
+``map[r, c]`` is the texel centred on ``(u, v) = (u0 + (c + ½)/W · (u1 − u0),
+v0 + (r + ½)/H · (v1 − v0))`` over :attr:`BlendedMaterial.uv_extent` ``(u0, v0, u1, v1)``,
+which is the unit square ``(0, 0, 1, 1)`` unless the material's textures are UDIM tile
+sets: then the maps span every UV square the tiles cover (a 2 × 2 set: ``(0, 0, 2, 2)``,
+each tile's square ``W/2 × H/2`` texels, tile 1001 bottom-left). Normal maps are unit
+tangent-space vectors (decoded, not 0..1 encoded).
 """
 
 from __future__ import annotations
@@ -62,9 +66,15 @@ class BlendedMaterial:
     """What was blended (the resolved library material), for exporters that carry it."""
     textures: dict[str, Any] = field(default_factory=dict)
     """Parameters read straight from one image that blending did not change, by name →
-    :class:`lookdev.materials.textures.TextureInput` (path absolute): exporters reference
+    :class:`lookdev.materials.textures.TextureInput` (path absolute, ``<UDIM>`` kept, its
+    ``colorspace`` the one it was read in, by the config's name): exporters reference
     the original file (and its colour space) instead of baking :attr:`maps`, which still
     holds the decoded values for every other consumer."""
+    uv_extent: tuple[int, int, int, int] = (0, 0, 1, 1)
+    """(u0, v0, u1, v1), whole UV squares the maps span (see module doc)."""
+    tiles: tuple[int, ...] = ()
+    """The UDIM tiles the material's textures cover (1001, 1002, …); empty when none is a
+    UDIM set. A square of :attr:`uv_extent` with no tile holds the layer constants."""
 
     @classmethod
     def of_params(cls, params: Any, name: str | None = None) -> BlendedMaterial:
@@ -128,7 +138,7 @@ class BlendedMaterial:
     def digest(self) -> str:
         """A SHA-256 of everything that shapes the material's look (resumable proofs)."""
         h = hashlib.sha256()
-        head = [self.name, self.model, self.representation, self.resolution]
+        head = [self.name, self.model, self.representation, self.resolution, self.uv_extent]
         head.append(sorted((k, repr(_plain(v))) for k, v in self.constants.items()))
         h.update(json.dumps(head).encode())
         for name, array in sorted(self.arrays.items()):
