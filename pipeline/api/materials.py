@@ -254,9 +254,7 @@ def _texels(blended: Any, uv: Any, lead: tuple[int, ...]) -> tuple[np.ndarray, n
     uv = np.broadcast_to(np.asarray(uv, dtype=np.float64), (*lead, 2))
     if not np.isfinite(uv).all():
         raise MaterialError("uv holds NaN or infinite values", where=blended.name, field="uv")
-    width, height = blended.resolution
-    cols = np.floor(uv[..., 0] * width).astype(np.intp) % width
-    rows = np.floor(uv[..., 1] * height).astype(np.intp) % height
+    rows, cols = blended.texel(uv)
     return rows, cols
 
 

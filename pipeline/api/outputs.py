@@ -479,8 +479,12 @@ def plot(
     ibl: str | None = None,
     resolution: int = 128,
     library: Any = None,
+    uv: tuple[float, float] | None = None,
 ) -> Plot:
     """Draw materials side by side as one BRDF-explorer view (Burley §3.2) to an image.
+
+    ``uv``: draw a texture-driven material as it is at that UV (its parameters at the
+    texel there, as :func:`lookdev.evaluate` takes them); by default the centre texel.
 
     ``view``: ``slice`` (f(θh, θd) at φd = 90°), ``albedo`` (directional albedo per
     channel), ``polar`` (f in the plane of incidence) or ``sphere`` (a lit sphere, also
@@ -504,6 +508,8 @@ def plot(
     if isinstance(materials, str | os.PathLike):
         materials = [materials]
     hubs = [hub(m, plots.MAP_RESOLUTION, lib) for m in _materials(materials, lib)]
+    if uv is not None:
+        hubs = [plots.at_uv(h, uv) for h in hubs]
     environment = None
     if ibl is not None:
         if view != "sphere":

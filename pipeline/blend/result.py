@@ -161,6 +161,26 @@ class BlendedMaterial:
         """Bytes held by the maps (the size of the output)."""
         return sum(a.nbytes for a in self.arrays.values())
 
+    def texel(self, uv: Any) -> tuple[np.ndarray, np.ndarray]:
+        """(rows, cols) of the texels under ``uv`` (…, 2), nearest texel. Over the unit
+        square the maps repeat (a bitmap's ``repeat``); over a UDIM extent each (u, v)
+        picks its own tile's square and is clamped to the extent outside it."""
+        uv = np.asarray(uv, dtype=np.float64)
+        width, height = self.resolution
+        u0, v0, u1, v1 = self.uv_extent
+        cols = np.floor((uv[..., 0] - u0) / (u1 - u0) * width).astype(np.intp)
+        rows = np.floor((uv[..., 1] - v0) / (v1 - v0) * height).astype(np.intp)
+        if tuple(self.uv_extent) == (0, 0, 1, 1):
+            return rows % height, cols % width
+        return np.clip(rows, 0, height - 1), np.clip(cols, 0, width - 1)
+
+    def params_at_uv(self, u: float, v: float):
+        """The model's parameters at UV ``(u, v)`` (see :meth:`texel`, :meth:`params_at`)."""
+        if not self.maps:
+            return self.params if self.representation == PARAMS else dict(self.constants)
+        row, col = self.texel((u, v))
+        return self.params_at(int(row), int(col))
+
     def values_at(self, row: int, col: int) -> dict[str, Any]:
         """Every constant and map value at texel ``(row, col)``, by name (plain Python)."""
         values = dict(self.constants)

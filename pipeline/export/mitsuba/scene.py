@@ -154,7 +154,7 @@ def bsdf_dict(
 
     def normal_texture(normals: np.ndarray, name: str) -> dict[str, Any]:
         encoded = _encode_normals(np.asarray(normals, dtype=np.float32))
-        return _bitmap(encoded, True, hub.name, name, texture_dir)
+        return _bitmap(encoded, True, hub.name, name, texture_dir, hub.uv_extent)
 
     frames = (hub.normal_map, hub.specular_normal_map)
     return with_normals(out, model, lobes, frames, normal_texture)
@@ -169,7 +169,7 @@ def _plugin_dict(hub: BlendedMaterial, texture_dir: str | Path | None) -> dict[s
         out[key] = _constant(value)
     for key, array in maps.items():
         colour = is_color_field(model.params_type, key)
-        out[key] = _bitmap(array, colour, hub.name, key, texture_dir)
+        out[key] = _bitmap(array, colour, hub.name, key, texture_dir, hub.uv_extent)
     return out
 
 
@@ -187,8 +187,16 @@ def _encode_normals(normals: np.ndarray) -> np.ndarray:
 
 
 def _bitmap(
-    array: np.ndarray, color: bool, name: str, key: str, texture_dir: str | Path | None
+    array: np.ndarray,
+    color: bool,
+    name: str,
+    key: str,
+    texture_dir: str | Path | None,
+    extent: tuple[int, int, int, int] = (0, 0, 1, 1),
 ) -> dict[str, Any]:
+    """A ``bitmap`` of a hub map. A map spanning a UDIM extent (u0, v0, u1, v1) gets the
+    ``to_uv`` that brings the mesh's UVs onto it, ``(uv − (u0, v0)) / (Δu, Δv)``, so each
+    tile's square of the map lands on that tile's UV square of the mesh."""
     import mitsuba as mi
 
     data = np.asarray(array, dtype=np.float32)
@@ -202,6 +210,11 @@ def _bitmap(
             field=key,
         )
     tex: dict[str, Any] = {"type": "bitmap", "raw": True, "wrap_mode": "repeat"}
+    if tuple(extent) != (0, 0, 1, 1):
+        u0, v0, u1, v1 = extent
+        tex["wrap_mode"] = "clamp"  # outside the tiles: the edge texels, not another tile
+        scale = mi.ScalarTransform4f().scale([1.0 / (u1 - u0), 1.0 / (v1 - v0), 1.0])
+        tex["to_uv"] = scale @ mi.ScalarTransform4f().translate([-u0, -v0, 0.0])
     if texture_dir is None:
         tex["data"] = mi.TensorXf(np.ascontiguousarray(data))
     else:
