@@ -16,10 +16,12 @@ import numpy as np
 
 from lookdev.materials.pixar_scatter import LOBES, PREFIX
 
+from .errors import BlendError
 from .masks import MaskSampler
 from .pixar_composite import GROUP, Lobes, Part, composite, layer_lobes, unit
 from .result import LOBE_WEIGHTS, TILE_TEXELS, BlendedMaterial
 from .stack import Entry, prune_stack
+from .textures import sample
 
 VIEWS = {"": 1.0, "_grazing": 0.0}
 """Map-name suffix → cos θ of the view the weights are composited for."""
@@ -59,9 +61,15 @@ def blend_stack(
     """
     resolution = (sampler.width, sampler.height)
     if not layered:
-        params = entries[0].params
-        constants = {k: v for k, v in params.model_dump().items() if v is not None}
-        return BlendedMaterial(name, "pixar", resolution, constants, decisions=[])
+        return _plain(name, entries[0], sampler, resolution)
+    textured = [e.label for e in entries if e.decoded]
+    if textured:
+        raise BlendError(
+            f"layer {textured[0]!r} drives parameters by textures; layered Pixar stacks take "
+            "constant layers for now (textures work in a plain Pixar preset and in Disney "
+            "stacks)",
+            where=entries[0].source,
+        )
     kept, decisions = prune_stack(
         entries,
         sampler,
@@ -86,6 +94,22 @@ def blend_stack(
         else:
             out.maps[key] = value.astype(np.float32)
     out.constants["layering"] = mode
+    return out
+
+
+def _plain(name: str, entry: Entry, sampler: MaskSampler, resolution) -> BlendedMaterial:
+    """A plain Pixar material: its constants, and each textured parameter as a map read
+    straight from its texture (so also in :attr:`BlendedMaterial.textures`)."""
+    params = entry.params
+    constants = {
+        k: v for k, v in params.model_dump().items() if v is not None and k not in entry.decoded
+    }
+    out = BlendedMaterial(name, "pixar", resolution, constants, decisions=[])
+    every_row = slice(0, sampler.height)
+    for key, texture in entry.decoded.items():
+        values = sample(sampler, entry, key, every_row)
+        out.maps[key] = values[..., 0] if texture.count == 1 else values
+        out.textures[key] = texture.tex.model_copy(update={"colorspace": texture.space})
     return out
 
 
