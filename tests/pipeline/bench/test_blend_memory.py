@@ -10,8 +10,8 @@ import OpenImageIO as oiio
 import pytest
 from _blend_helpers import disney, layer, layered, write_image
 
-from lookdev.materials.layers import TextureMask
 from lookdev.library import images
+from lookdev.materials.layers import TextureMask
 from lookdev.pipeline.blend import MaskSampler, TextureError, blend, resample
 from lookdev.pipeline.blend.masks import BoxReduced
 from lookdev.pipeline.blend.resample import TextureFile, read_channels

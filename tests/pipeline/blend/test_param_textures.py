@@ -118,3 +118,31 @@ def test_udim_quadrants_render_in_mitsuba(tmp_path):
         got = np.array(bsdf.eval(ctx, si, mi.Vector3f(WI)), dtype=np.float64).ravel()
         expected = lookdev.evaluate(hub, WI, WO, uv=uv) * WI[2]  # Mitsuba's f·cos
         np.testing.assert_allclose(got, expected, rtol=2e-3, atol=1e-5)
+
+
+def test_a_textured_pixar_layer_composites_per_texel_as_its_constant_twin(tmp_path):
+    from lookdev.library import Layer
+    from lookdev.materials.pixar import PixarParams
+
+    rough = np.linspace(0.1, 0.9, 16, dtype=np.float32).reshape(4, 4)
+    col = np.random.default_rng(1).random((4, 4, 3)).astype(np.float32)
+    write_image(tmp_path / "r.exr", rough)
+    write_image(tmp_path / "c.exr", col)
+    textures = {
+        "roughness": TextureInput(texture=str(tmp_path / "r.exr")),
+        "surface_color": TextureInput(texture=str(tmp_path / "c.exr")),
+    }
+    base = Material(name="b", model="pixar", params=PixarParams(metallic=0.2), textures=textures)
+    stack = Material(name="s", model="layered", layers=[Layer(material=base, name="base")])
+    plain, layered_hub = blend(base, 4), blend(stack, 4)
+    assert set(plain.textures) == set(textures) and layered_hub.representation == "lobe_weights"
+    for row, col_ in [(0, 0), (2, 3), (3, 1)]:
+        texel = PixarParams(
+            metallic=0.2,
+            roughness=float(rough[::-1][row, col_]),
+            surface_color=tuple(float(x) for x in col[::-1][row, col_]),
+        )
+        uv = ((col_ + 0.5) / 4, (row + 0.5) / 4)
+        expected = lookdev.evaluate(texel, WI, WO)
+        for hub in (plain, layered_hub):
+            np.testing.assert_allclose(lookdev.evaluate(hub, WI, WO, uv=uv), expected, rtol=1e-5)
