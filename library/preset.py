@@ -239,7 +239,39 @@ def dump_preset(preset: PresetFile) -> str:
     roughness = 0.3
     <BLANKLINE>
     """
-    return _compact_arrays(tomli_w.dumps(preset_document(preset)))
+    doc = preset_document(preset)
+    return _compact_arrays(_inline_textures(doc) or tomli_w.dumps(doc))
+
+
+def _inline_textures(doc: dict[str, Any]) -> str | None:
+    """The document with each texture of ``[params]`` as one inline table, as people write
+    it (``roughness = { texture = "r.png", channel = "r" }``; tomli_w would write a
+    ``[params.roughness]`` section; layers keep their sections); None when there is none,
+    or when the rewrite would not read back as the same document."""
+    tables: list[dict[str, Any]] = []
+
+    def mark(params: dict[str, Any]) -> dict[str, Any]:
+        out = {}
+        for key, value in params.items():
+            if isinstance(value, dict) and is_texture_input(value):
+                tables.append(value)
+                value = f"\x00texture{len(tables) - 1}\x00"
+            out[key] = value
+        return out
+
+    marked = dict(doc)
+    if "params" in doc:
+        marked["params"] = mark(doc["params"])
+    if not tables:
+        return None
+    text = tomli_w.dumps(marked)
+    for i, table in enumerate(tables):
+        items = [tomli_w.dumps({k: v}).strip() for k, v in table.items()]
+        text = text.replace(f'"\\u0000texture{i}\\u0000"', "{ " + ", ".join(items) + " }")
+    try:
+        return text if tomllib.loads(text) == doc else None
+    except tomllib.TOMLDecodeError:
+        return None
 
 
 def preset_document(preset: PresetFile) -> dict[str, Any]:

@@ -139,3 +139,25 @@ def test_texture_space_rule():
     assert colour.texture_space(False, True, "ACEScg") == "ACEScg"
     with colour.use(working_space="acescg"):
         assert colour.texture_space(False, True, None) == "ACEScg"
+
+
+def test_presets_set_takes_a_texture_and_writes_it_inline(tmp_path, capsys):
+    write_image(tmp_path / "rough.png", np.full((2, 2), 0.5, dtype=np.float32), fmt=oiio.UINT8)
+    preset(tmp_path, "roughness = 0.3", name="teal")
+    main(
+        [
+            "presets",
+            "set",
+            "teal",
+            'roughness={texture="rough.png", channel="r"}',
+            "-L",
+            str(tmp_path),
+        ]
+    )
+    text = (tmp_path / "teal.toml").read_text()
+    assert 'roughness = { texture = "rough.png", channel = "r" }' in text
+    before = text
+    with pytest.raises(SystemExit) as exit_:
+        main(["presets", "set", "teal", 'roughness={texture="nope.png"}', "-L", str(tmp_path)])
+    assert exit_.value.code == 2 and "nope.png does not exist" in capsys.readouterr().err
+    assert (tmp_path / "teal.toml").read_text() == before  # nothing half-written
