@@ -172,10 +172,13 @@ class ParamTexture:
     # -- values ----------------------------------------------------------------------------
     def decode(self, stored: np.ndarray, clamp: bool = True) -> np.ndarray:
         """Stored texels (n, w, read_count) → the parameter's values (n, w, count), float32."""
-        a = as_float(stored)
-        if a.shape[-1] != self.count:  # one channel as grey
-            a = np.repeat(a, self.count, axis=-1)
-        return self.tex.values(a, self.space, self.bounds if clamp else None)
+        if stored.shape[-1] != self.count:  # one channel as grey
+            stored = np.repeat(stored, self.count, axis=-1)
+        bounds = self.bounds if clamp else None
+        if self.count == 3 and stored.dtype.kind == "u" and not colour.is_data(self.space):
+            linear = colour.convert_codes(stored, self.space)  # integer codes: by table
+            return self.tex.values(linear, colour.RAW, bounds)
+        return self.tex.values(as_float(stored), self.space, bounds)
 
     def source(self, tile: int | None) -> Decoded:
         """The parameter's values on one tile, decoded a run of rows at a time."""
@@ -200,8 +203,9 @@ class ParamTexture:
             for f in self.files.values():
                 for _, rows in f.chunks():
                     v = self.decode(rows, clamp=False).reshape(-1, self.count)
-                    if v.size:
-                        lo, hi = np.minimum(lo, v.min(axis=0)), np.maximum(hi, v.max(axis=0))
+                    if v.size:  # per channel: numpy reduces a (N, 3) axis 0 slowly
+                        lo = np.minimum(lo, [v[:, c].min() for c in range(self.count)])
+                        hi = np.maximum(hi, [v[:, c].max() for c in range(self.count)])
             _STATS[key] = (lo, hi)
         return _STATS[key]
 
