@@ -21,7 +21,14 @@ import OpenImageIO as oiio
 
 from .errors import TextureError
 
-__all__ = ["TextureFile", "as_float", "channel_index", "oiio_error", "read_channels"]
+__all__ = [
+    "RANDOM_ACCESS",
+    "TextureFile",
+    "as_float",
+    "channel_index",
+    "oiio_error",
+    "read_channels",
+]
 
 _AS_DATA = oiio.ImageSpec()
 _AS_DATA.attribute("oiio:UnassociatedAlpha", 1)
@@ -39,6 +46,11 @@ _STORED = {
 _CHUNK_BYTES = 1 << 20
 """Bytes of scanlines decoded per OpenImageIO call (rounded to 32 rows, OpenEXR's largest
 common block), the transient a read costs on top of the rows it returns."""
+
+RANDOM_ACCESS = ("openexr", "tiff", "dpx", "cineon")
+"""OpenImageIO formats whose scanlines can be read in any order at the cost of those rows.
+Others (PNG, JPEG, Targa …) decode from the top each time a read goes backwards, and a
+blend reads UV rows bottom to top, so streaming them costs the square of their rows."""
 
 _ALIASES = {"r": 0, "g": 1, "b": 2, "a": 3, "x": 0, "y": 1, "z": 2}
 """Channel letters understood when a file does not name its channels that way."""
@@ -76,6 +88,8 @@ class TextureFile:
             raise TextureError(f"texture file {self.path} {what}", where=where)
         image = self._open()
         spec = image.spec()
+        self.random_access = image.format_name() in RANDOM_ACCESS
+        """True when rows may be streamed (:data:`RANDOM_ACCESS`)."""
         image.close()
         self.first = channel_index(tex.channel, list(spec.channelnames))
         if self.first is None or self.first + count > spec.nchannels:
@@ -141,9 +155,18 @@ class TextureFile:
             out[n - top - rows : n - top] = pixels[::-1]
 
     def chunks(self, rows: int = 256):
-        """(first UV row, its rows as stored) in runs of ``rows``, bottom to top."""
-        for lo in range(0, self.shape[0], rows):
-            yield lo, self[np.arange(lo, min(lo + rows, self.shape[0]))]
+        """(first UV row, its rows as stored) in runs of ``rows``, in the file's order (top
+        to bottom, so UV rows descending) through one open file: a sequential format (PNG)
+        is decoded once, not once per run."""
+        h = self.shape[0]
+        image = self._open()
+        try:
+            for lo in reversed(range(0, h, rows)):
+                out = np.empty((min(rows, h - lo), *self.shape[1:]), dtype=self.dtype)
+                self._run(image, lo, out)
+                yield lo, out
+        finally:
+            image.close()
 
 
 def as_float(a: np.ndarray) -> np.ndarray:

@@ -48,7 +48,7 @@ from .errors import TextureError
 from .images import TextureFile, as_float, channel_index
 from .index import warn
 
-__all__ = ["FileChannel", "ParamTexture", "Tiles", "udim_tiles"]
+__all__ = ["Decoded", "FileChannel", "ParamTexture", "Tiles", "udim_tiles"]
 
 Tiles = dict[int | None, Path]
 """UDIM tile number → file; the key ``None`` for a plain (not UDIM) texture."""
@@ -248,9 +248,10 @@ class ParamTexture:
 
 class Decoded:
     """One tile's parameter values, indexed by UV rows like a :class:`.images.TextureFile`
-    (``decoded[rows]`` → (n, w, count) float32), converted a run of rows at a time."""
+    (``decoded[rows]`` → (n, w, count) float32), converted a run of rows at a time from
+    ``file``: the :class:`.images.TextureFile`, or its texels as stored, already read."""
 
-    def __init__(self, texture: ParamTexture, file: TextureFile):
+    def __init__(self, texture: ParamTexture, file: Any):
         self.texture, self.file = texture, file
         self.shape = (*file.shape[:2], texture.count)
         self.dtype = np.dtype(np.float32)
@@ -260,8 +261,9 @@ class Decoded:
         return self.texture.decode(self.file[rows])
 
     def chunks(self, rows: int = 256):
-        for lo, stored in self.file.chunks(rows):
-            yield lo, self.texture.decode(stored)
+        """(first UV row, its values) in runs of ``rows``, bottom to top."""
+        for lo in range(0, self.shape[0], rows):
+            yield lo, self[np.arange(lo, min(lo + rows, self.shape[0]))]
 
 
 _STATS: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}

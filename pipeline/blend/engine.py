@@ -111,7 +111,7 @@ def _channels_bound(entries: list[Entry]) -> float:
         any(getattr(e, which) is not None for e in entries)
         for which in ("normal_map", "specular_normal_map")
     )
-    return sum(np.size(values[0][k]) for k in differing) + 3 * normals
+    return sum(3 if k == disney.COLOR else 1 for k in differing) + 3 * normals
 
 
 class Textured:

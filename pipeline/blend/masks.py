@@ -56,7 +56,9 @@ class MaskSampler:
     :data:`WHOLE_BUDGET` of the output, ``output_channels`` float32 channels at its
     resolution (the engine's bound on what a blend writes); larger ones stay in their
     files (:class:`.resample.TextureFile`) and each tile reads the rows it needs, so a
-    4096² float mask that varies one 2048² map costs rows, not 64 MB.
+    4096² float mask that varies one 2048² map costs rows, not 64 MB. A file whose format
+    cannot be read by rows (PNG, JPEG: :data:`lookdev.library.images.RANDOM_ACCESS`) is
+    held whole as stored, a byte per 8-bit channel, whatever its size.
     """
 
     def __init__(
@@ -84,12 +86,16 @@ class MaskSampler:
         key = (str(tex.path), tex.channel, count)
         return self.source(key, lambda: TextureFile(tex, count, where=where))
 
-    def source(self, key: tuple, opener: Any) -> Any:
+    def source(self, key: tuple, opener: Any, *, lazy: bool = False) -> Any:
         """The source cached under ``key`` (``opener()`` makes it: a :class:`.TextureFile`
-        or anything indexed by rows like one), decoded whole while it fits the budget."""
+        or anything indexed by rows like one), decoded whole while it fits the budget;
+        ``lazy`` keeps it as it is (a view that decodes rows of a source held here)."""
         if key not in self._images:
             source = opener()
-            if self._whole_bytes() + source.nbytes <= self._budget:
+            fits = self._whole_bytes() + source.nbytes <= self._budget
+            # A file that cannot be read rows at a time is held whole, as stored (a byte per
+            # 8-bit channel): streaming it would decode it again from the top for every tile.
+            if not lazy and (fits or not getattr(source, "random_access", True)):
                 source = source[np.arange(source.shape[0])]
             self._images[key] = source
         return self._images[key]

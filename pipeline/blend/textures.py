@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from lookdev.library.textures import ParamTexture
+from lookdev.library.textures import Decoded, ParamTexture
 from lookdev.materials import colour
 from lookdev.materials.fresnel import ior_to_specular
 from lookdev.materials.textures import udim_tile
@@ -73,8 +73,7 @@ def sample(sampler: MaskSampler, entry: Entry, key: str, rows: slice) -> np.ndar
     n = len(range(*rows.indices(sampler.height)))
     if None in texture.tiles:  # a plain texture repeats over the extent by its wrap
         tex = texture.tex
-        cache = _key(texture, None)
-        sampler.source(cache, lambda: texture.source(None))
+        cache = _decoded(sampler, texture, None)
         scale, offset = sampler.extent_map(tex.uv_scale, tex.uv_offset)
         shape = (sampler.height, sampler.width)
         return sampler.filtered(cache, shape, scale, offset, tex.wrap, rows)
@@ -95,13 +94,20 @@ def sample(sampler: MaskSampler, entry: Entry, key: str, rows: slice) -> np.ndar
             if tile not in texture.files:
                 out[dest, cols] = fallback
                 continue
-            cache = _key(texture, tile)
-            sampler.source(cache, lambda t=tile: texture.source(t))
+            cache = _decoded(sampler, texture, tile)
             block = (per_v, per_u)
             out[dest, cols] = sampler.filtered(cache, block, (1, 1), (0, 0), "clamp", local)
     return out
 
 
-def _key(texture: ParamTexture, tile: int | None) -> tuple[Any, ...]:
-    """Cache key of one tile's decoded values: its file, the rule, the colour settings."""
-    return ("param", texture.tex, texture.count, texture.bounds, tile, colour.settings())
+def _decoded(sampler: MaskSampler, texture: ParamTexture, tile: int | None) -> tuple[Any, ...]:
+    """The cache key under which ``sampler`` holds one tile's values, made ready: the file's
+    texels as stored (whole while they fit the sampler's budget, a uint8 texel costing a
+    byte, else streamed by rows), decoded to float32 a run of rows at a time as tiles of
+    the output ask for them (so an 8-bit 4K tile costs 16 MB a channel, not 64)."""
+    file = texture.files[tile]
+    stored = ("stored", str(file.path), file.first, file.count)
+    sampler.source(stored, lambda: file)
+    key = ("param", texture.tex, texture.count, texture.bounds, tile, colour.settings())
+    sampler.source(key, lambda: Decoded(texture, sampler.source(stored, None)), lazy=True)
+    return key
