@@ -4,7 +4,7 @@ A parameter written as a texture (:class:`~lookdev.materials.textures.TextureInp
 opened here as a :class:`ParamTexture`: its tiles found (``<UDIM>`` → ``1001 + u + 10 v``),
 its channels chosen, its colour space named (:func:`lookdev.materials.colour.texture_space`),
 and its values checked against the parameter's range. Pixels come from the one reader,
-:mod:`.images`; the blending engine filters what :meth:`ParamTexture.source` returns.
+:mod:`.images`; the blending engine filters what a :class:`Decoded` tile returns.
 
 **Channels.** ``channel`` names one channel (``"r"``, ``"a"``, ``"Y"``, ``"diffuse.R"``, an
 index) or a run of them (``"rgb"``, ``"xyz"``, consecutive in the file). A colour takes
@@ -179,10 +179,6 @@ class ParamTexture:
             linear = colour.convert_codes(stored, self.space)  # integer codes: by table
             return self.tex.values(linear, colour.RAW, bounds)
         return self.tex.values(as_float(stored), self.space, bounds)
-
-    def source(self, tile: int | None) -> Decoded:
-        """The parameter's values on one tile, decoded a run of rows at a time."""
-        return Decoded(self, self.files[tile])
 
     def stats(self) -> tuple[np.ndarray, np.ndarray]:
         """Per-channel (min, max) of the values over every tile, before the clamp."""

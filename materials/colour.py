@@ -327,5 +327,6 @@ def texture_space(
     if path is not None and settings().config_name != DEFAULT_CONFIG:
         cfg = config()
         if not cfg.filepathOnlyMatchesDefaultRule(path):
-            return canonical(cfg.getColorSpaceFromFilepath(path))
+            found = cfg.getColorSpaceFromFilepath(path)  # (name, rule index) in PyOpenColorIO
+            return canonical(found[0] if isinstance(found, tuple) else found)
     return canonical(SRGB_TEXTURE) if bits_are_integer else working_space()

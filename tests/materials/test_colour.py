@@ -113,3 +113,23 @@ def test_integer_codes_convert_as_their_normalised_values(working, dtype, space)
     with c.use(working_space=working):
         exact = c.convert(codes.astype(np.float64) / top, space)
         np.testing.assert_allclose(c.convert_codes(codes, space), exact, rtol=0, atol=1e-6)
+
+
+def test_a_user_config_s_file_rules_name_a_colour_map_s_space(tmp_path):
+    import PyOpenColorIO as ocio
+
+    cfg = ocio.Config.CreateFromFile(colour.DEFAULT_CONFIG)
+    rules = cfg.getFileRules()
+    rules.insertRule(0, "acescg_maps", "ACEScg", "*_acescg*", "exr")
+    cfg.setFileRules(rules)
+    path = tmp_path / "studio.ocio"
+    cfg.serialize(str(path))
+    with colour.use(config=str(path)):
+        assert colour.texture_space(False, True, None, "/a/wall_acescg.1001.exr") == "ACEScg"
+        # no rule of its own matches: the bit-depth rule; data is never colour-converted
+        assert colour.texture_space(True, True, None, "/a/wall.png") == colour.canonical(
+            colour.SRGB_TEXTURE
+        )
+        assert colour.texture_space(False, False, None, "/a/r_acescg.exr") == "Raw"
+    # lookdev's own default config: its plate rules (EXR → ACES2065-1) are not consulted
+    assert colour.texture_space(False, True, None, "/a/wall.exr") == colour.working_space()
