@@ -52,8 +52,9 @@ def blend(
 ) -> BlendedMaterial:
     """Blend a library :class:`~lookdev.library.Material` at ``resolution``.
 
-    ``resolution`` is ``N`` (N × N) or ``(width, height)``. A non-layered material blends
-    to constants and no maps. Disney stacks blend parameters (:mod:`.disney`); Pixar
+    ``resolution`` is ``N`` (N × N) or ``(width, height)`` per UV square: UDIM textures
+    widen the maps to every square their tiles cover (:attr:`BlendedMaterial.uv_extent`).
+    A non-layered material blends to constants, and maps only for textured parameters. Disney stacks blend parameters (:mod:`.disney`); Pixar
     stacks composite lobe weights (:mod:`.pixar`). ``prune=False`` turns off every
     saving (all layers, all parameters as maps) and exists to measure them. ``images``
     caches decoded textures across calls (see :class:`.MaskSampler`). ``layering`` is
