@@ -54,8 +54,9 @@ def blend(
 
     ``resolution`` is ``N`` (N × N) or ``(width, height)`` per UV square: UDIM textures
     widen the maps to every square their tiles cover (:attr:`BlendedMaterial.uv_extent`).
-    A non-layered material blends to constants, and maps only for textured parameters. Disney stacks blend parameters (:mod:`.disney`); Pixar
-    stacks composite lobe weights (:mod:`.pixar`). ``prune=False`` turns off every
+    A non-layered material blends to constants, and maps only for textured parameters.
+    Disney stacks blend parameters (:mod:`.disney`); Pixar stacks composite lobe weights
+    (:mod:`.pixar`). ``prune=False`` turns off every
     saving (all layers, all parameters as maps) and exists to measure them. ``images``
     caches decoded textures across calls (see :class:`.MaskSampler`). ``layering`` is
     Smits' ``"full"`` (transmitted light meets the layers below) or ``"simple"`` layering
