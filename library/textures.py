@@ -20,12 +20,15 @@ parameter's range. Within :data:`~lookdev.materials.textures.CLAMP_TOLERANCE` of
 of the span, at most 0.01) they are clamped, with a one-line warning; further out the
 preset is refused, naming the file, the values found and the range allowed.
 
-Statistics (per-channel min and max) read every texel once per process, streamed by
-rows, and are remembered per file state (path, size, modification time).
+Statistics (per-channel min and max) read every texel once, streamed by rows, and are
+remembered per file state (path, size, modification time), in the process and under
+``$LOOKDEV_CACHE/textures/`` (safe to delete).
 """
 
 from __future__ import annotations
 
+import hashlib
+import json
 import os
 import re
 from dataclasses import dataclass
@@ -35,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from lookdev.materials import colour
+from lookdev.materials.errors import LookdevError
 from lookdev.materials.textures import (
     CLAMP_TOLERANCE,
     UDIM_TOKEN,
@@ -44,6 +48,7 @@ from lookdev.materials.textures import (
     tile_uv,
 )
 
+from . import files
 from .errors import TextureError
 from .images import TextureFile, as_float, channel_index
 from .index import warn
@@ -191,19 +196,25 @@ class ParamTexture:
             self.tex.range,
             self.tex.scale,
             self.tex.offset,
-            colour.settings(),
+            colour.settings().config_name,
+            colour.working_space(),
         )
         if key not in _STATS:
-            lo = np.full(self.count, np.inf)
-            hi = np.full(self.count, -np.inf)
-            for f in self.files.values():
-                for _, rows in f.chunks():
-                    v = self.decode(rows, clamp=False).reshape(-1, self.count)
-                    if v.size:  # per channel: numpy reduces a (N, 3) axis 0 slowly
-                        lo = np.minimum(lo, [v[:, c].min() for c in range(self.count)])
-                        hi = np.maximum(hi, [v[:, c].max() for c in range(self.count)])
-            _STATS[key] = (lo, hi)
+            _STATS[key] = _stored_stats(key) or self._read_stats(key)
         return _STATS[key]
+
+    def _read_stats(self, key: tuple) -> tuple[np.ndarray, np.ndarray]:
+        """Every texel read once (streamed), then remembered on disk (:func:`_stored_stats`)."""
+        lo = np.full(self.count, np.inf)
+        hi = np.full(self.count, -np.inf)
+        for f in self.files.values():
+            for _, rows in f.chunks():
+                v = self.decode(rows, clamp=False).reshape(-1, self.count)
+                if v.size:  # per channel: numpy reduces a (N, 3) axis 0 slowly
+                    lo = np.minimum(lo, [v[:, c].min() for c in range(self.count)])
+                    hi = np.maximum(hi, [v[:, c].max() for c in range(self.count)])
+        _store_stats(key, lo, hi)
+        return lo, hi
 
     def bounds_after_clamp(self) -> tuple[np.ndarray, np.ndarray]:
         """Per-channel (min, max) of what blending sees (after the clamp)."""
@@ -263,6 +274,33 @@ class Decoded:
 
 
 _STATS: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
+"""Statistics read in this process, by everything they depend on."""
+
+
+def _stats_file(key: tuple) -> Path:
+    """``$LOOKDEV_CACHE/textures/<sha256 of the key>.json``: the statistics of a texture
+    survive the process, so loading a preset with a 4K UDIM set reads its texels once per
+    change of its files (their sizes and modification times are in the key), not per run."""
+    digest = hashlib.sha256(repr(key).encode()).hexdigest()
+    return files.cache_root() / "textures" / f"{digest}.json"
+
+
+def _stored_stats(key: tuple) -> tuple[np.ndarray, np.ndarray] | None:
+    try:
+        doc = json.loads(_stats_file(key).read_text())
+        return np.array(doc["lo"], dtype=np.float64), np.array(doc["hi"], dtype=np.float64)
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
+def _store_stats(key: tuple, lo: np.ndarray, hi: np.ndarray) -> None:
+    """Best effort: a cache that cannot be written is not used (the next run reads again)."""
+    path = _stats_file(key)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        files.atomic_write(path, json.dumps({"lo": lo.tolist(), "hi": hi.tolist()}))
+    except (OSError, LookdevError):
+        pass
 
 
 def _state(path: Path) -> tuple[int, int]:

@@ -161,3 +161,20 @@ def test_presets_set_takes_a_texture_and_writes_it_inline(tmp_path, capsys):
         main(["presets", "set", "teal", 'roughness={texture="nope.png"}', "-L", str(tmp_path)])
     assert exit_.value.code == 2 and "nope.png does not exist" in capsys.readouterr().err
     assert (tmp_path / "teal.toml").read_text() == before  # nothing half-written
+
+
+def test_texture_statistics_are_remembered_on_disk_per_file_state(tmp_path, monkeypatch):
+    from lookdev.library import textures
+
+    monkeypatch.setenv("LOOKDEV_CACHE", str(tmp_path / "cache"))
+    write_image(tmp_path / "r.exr", np.array([[0.2, 0.6]], dtype=np.float32))
+    path = preset(tmp_path, 'roughness = { texture = "r.exr" }')
+    Library([tmp_path], use_env=False).load_file(path)
+    stored = list((tmp_path / "cache" / "textures").glob("*.json"))
+    assert len(stored) == 1
+    textures._STATS.clear()  # a new process: the numbers come from the file, not the texels
+    monkeypatch.setattr(textures.ParamTexture, "_read_stats", lambda self, key: 1 / 0)
+    Library([tmp_path], use_env=False).load_file(path)
+    write_image(tmp_path / "r.exr", np.array([[0.2, 0.7, 0.1]], dtype=np.float32))
+    with pytest.raises(ZeroDivisionError):  # the file changed: read again
+        Library([tmp_path], use_env=False).load_file(path)
