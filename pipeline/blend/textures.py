@@ -35,7 +35,8 @@ __all__ = ["extent_of", "open_textures", "sample"]
 
 def open_textures(entries: list[Entry]) -> list[Decision]:
     """Open every layer's parameter textures into ``entry.decoded``; fold uniform ones
-    into ``entry.params``. Returns a decision per folded texture."""
+    into ``entry.params`` (a varying one leaves its largest value there, never read as
+    the parameter's value). Returns a decision per folded texture."""
     decisions = []
     for entry in entries:
         entry.decoded = {}
@@ -44,6 +45,12 @@ def open_textures(entries: list[Entry]) -> list[Decision]:
             value = texture.uniform()
             if value is None:
                 entry.decoded[key] = texture
+                if key != "ior":  # ior stays unset: its layer blends in the specular spelling
+                    # The largest value stands in the constants, so rules that ask whether a
+                    # parameter is ever non-zero (sheen votes on sheen_model) see it.
+                    high = texture.bounds_after_clamp()[1]
+                    top = float(high[0]) if texture.count == 1 else tuple(map(float, high))
+                    entry.params = entry.params.model_copy(update={key: top})
                 continue
             entry.params = entry.params.model_copy(update={key: value})
             reason = f"{key}: texture {tex.texture} is uniform, folded to {value!r}"

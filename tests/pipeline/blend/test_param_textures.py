@@ -146,3 +146,19 @@ def test_a_textured_pixar_layer_composites_per_texel_as_its_constant_twin(tmp_pa
         expected = lookdev.evaluate(texel, WI, WO)
         for hub in (plain, layered_hub):
             np.testing.assert_allclose(lookdev.evaluate(hub, WI, WO, uv=uv), expected, rtol=1e-5)
+
+
+def test_a_textured_sheen_votes_on_the_sheen_model(tmp_path):
+    from lookdev.pipeline.blend import BlendError
+
+    write_image(tmp_path / "s.exr", np.linspace(0.0, 1.0, 16, dtype=np.float32).reshape(4, 4))
+    sheen = TextureInput(texture=str(tmp_path / "s.exr"))
+    cloth = Material(
+        name="cloth",
+        model="disney",
+        params=DisneyParams(sheen_model="conty_kulla"),
+        textures={"sheen": sheen},
+    )
+    velvet = disney("velvet", sheen=1.0, sheen_model="disney")
+    with pytest.raises(BlendError, match="sheen_model"):
+        blend(layered(layer(cloth), layer(velvet, NoiseMask())), 4)
