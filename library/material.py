@@ -58,6 +58,15 @@ class Material(BaseModel):
     source: Path | None = None
     citation: str | None = Field(None, description="The preset's `source` note (measurements).")
     chain: list[Path] = Field(default_factory=list, description="Files merged, child first.")
+    height: TextureInput | None = Field(
+        None, description="Height map (path absolute), in scene units after scale/offset."
+    )
+    normal_map: TextureMask | None = Field(
+        None, description="Tangent-space normal map of a texture set (path absolute)."
+    )
+    notes: list[str] = Field(
+        default_factory=list, description="What the preset's texture set left out, and why."
+    )
 
     @model_validator(mode="after")
     def _params_fit_the_model(self) -> Material:
@@ -102,8 +111,9 @@ def _resolve(name: str, lookup: Lookup, seen: tuple[str, ...]) -> Material:
         "citation": preset.source,
         "chain": paths,
     }
+    common |= _surface_maps(preset, paths[0])
     if preset.model in MODELS:
-        params, textures = _checked(preset.model, preset.params, where=where)
+        params, textures = _checked(preset.model, _with_set(preset, paths[0]), where=where)
         return _tiles_agree(Material(params=params, textures=textures, **common))
     material = Material(layers=_layers(preset, paths[0], lookup, (*seen, name)), **common)
     return _tiles_agree(material)
@@ -196,9 +206,8 @@ def _override(parent: PresetFile, child: PresetFile, *, where: str) -> PresetFil
             field="model",
         )
     given = child.model_fields_set
-    update: dict[str, Any] = {
-        k: getattr(child, k) for k in ("description", "tags", "source", "layers") if k in given
-    }
+    inherited = ("description", "tags", "source", "layers", "textures", "height")
+    update: dict[str, Any] = {k: getattr(child, k) for k in inherited if k in given}
     update["params"] = merge_params(parent.params, child.params)
     if parent.model in MODELS:
         split_params(parent.model, update["params"], where=where)
@@ -320,4 +329,39 @@ def absolute_textures(params: dict[str, Any], folder: Path) -> dict[str, Any]:
         elif isinstance(value, TextureInput):
             texture = str((folder / Path(value.texture).expanduser()).resolve())
             out[key] = value.model_copy(update={"texture": texture})
+    return out
+
+
+def _with_set(preset: PresetFile, path: Path) -> dict[str, Any]:
+    """The preset's parameters over its texture set's inputs (:mod:`.texture_sets`)."""
+    if preset.textures is None:
+        return preset.params
+    from .texture_sets import expand
+
+    found = expand(preset.textures, path.parent, where=str(path))
+    return {**found.inputs, **preset.params}
+
+
+def _surface_maps(preset: PresetFile, path: Path) -> dict[str, Any]:
+    """Height, normal map and notes of a preset: its own ``height`` (path made absolute)
+    over its texture set's."""
+    out: dict[str, Any] = {}
+    height = preset.height
+    if preset.textures is not None:
+        from .texture_sets import expand
+
+        found = expand(preset.textures, path.parent, where=str(path))
+        out["notes"] = found.notes
+        if found.normal_map is not None:
+            out["normal_map"] = TextureMask(path=Path(found.normal_map["path"]))
+            if found.normal_map["flip_y"]:
+                out["notes"].append(
+                    "normal map is DirectX (+Y down): its green channel is flipped on read"
+                )
+        if height is None and found.height is not None:
+            height = TextureInput.parse(found.height)
+    if height is not None:
+        texture = Path(height.texture).expanduser()
+        absolute = texture if texture.is_absolute() else path.parent / texture
+        out["height"] = height.model_copy(update={"texture": str(absolute)})
     return out

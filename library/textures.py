@@ -132,12 +132,12 @@ class ParamTexture:
 
     @property
     def extent(self) -> tuple[int, int, int, int]:
-        """(u0, v0, u1, v1): the whole UV squares the tiles cover ((0, 0, 1, 1) if plain)."""
+        """(0, 0, u1, v1): the UV squares from tile 1001 to the tiles' far corner ((0, 0, 1, 1)
+        if plain); UDIM grids start at tile 1001, whatever tiles a set holds."""
         if None in self.tiles:
             return (0, 0, 1, 1)
         uvs = [tile_uv(t) for t in self.tiles]
-        us, vs = [u for u, _ in uvs], [v for _, v in uvs]
-        return (min(us), min(vs), max(us) + 1, max(vs) + 1)
+        return (0, 0, max(u for u, _ in uvs) + 1, max(v for _, v in uvs) + 1)
 
     def _channels(self, probe: TextureFile) -> tuple[int, int]:
         """(first channel, how many to read) for ``tex.channel`` in ``probe``'s file."""

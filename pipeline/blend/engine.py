@@ -69,7 +69,7 @@ def blend(
         raise BlendError(f"resolution {width}x{height} must be at least 1x1", where=material.name)
     entries = stack_of(material)
     folded = open_textures(entries)
-    extent = extent_of(entries)
+    extent = extent_of(entries, _surface_sets(material))
     du, dv = extent[2] - extent[0], extent[3] - extent[1]
     sampler = MaskSampler(
         (height * dv, width * du), images, output_channels=_channels_bound(entries), extent=extent
@@ -97,6 +97,13 @@ def blend(
     result.origin = material
     result.layered = getattr(material, "model", None) == "layered"
     return result
+
+
+def _surface_sets(material: Any) -> list[str]:
+    """The texture-set height and normal maps of ``material`` (:mod:`.surface_maps` puts
+    them on the hub): their UDIM tiles widen the extent every map spans."""
+    height, normal = getattr(material, "height", None), getattr(material, "normal_map", None)
+    return [str(p) for p in (height and height.texture, normal and normal.path) if p]
 
 
 def _channels_bound(entries: list[Entry]) -> float:

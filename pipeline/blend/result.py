@@ -71,10 +71,26 @@ class BlendedMaterial:
     the original file (and its colour space) instead of baking :attr:`maps`, which still
     holds the decoded values for every other consumer."""
     uv_extent: tuple[int, int, int, int] = (0, 0, 1, 1)
-    """(u0, v0, u1, v1), whole UV squares the maps span (see module doc)."""
+    """(u0, v0, u1, v1), whole UV squares every map spans (see module doc): parameter maps,
+    :attr:`normal_map` and :attr:`height_map` alike."""
     tiles: tuple[int, ...] = ()
     """The UDIM tiles the material's textures cover (1001, 1002, …); empty when none is a
     UDIM set. A square of :attr:`uv_extent` with no tile holds the layer constants."""
+    height_map: np.ndarray | None = None
+    """Heights in scene units (float32 (H, W), UV order, over :attr:`uv_extent`) for bump
+    and displacement: the preset's ``height`` texture after its scale/offset
+    (:mod:`.surface_maps`)."""
+
+    @property
+    def map_tiles(self) -> tuple[int, int]:
+        """UV squares ``(nu, nv)`` the maps span, from tile 1001: :attr:`uv_extent`'s size
+        when it starts at (0, 0) (UDIM sets do)."""
+        u0, v0, u1, v1 = self.uv_extent
+        return (u1 - u0, v1 - v0)
+
+    @map_tiles.setter
+    def map_tiles(self, tiles: tuple[int, int]) -> None:
+        self.uv_extent = (0, 0, int(tiles[0]), int(tiles[1]))
 
     @classmethod
     def of_params(cls, params: Any, name: str | None = None) -> BlendedMaterial:
@@ -151,7 +167,7 @@ class BlendedMaterial:
     def arrays(self) -> dict[str, np.ndarray]:
         """Every array of the result by name: the maps and any normal maps."""
         out = dict(self.maps)
-        for name in ("normal_map", "specular_normal_map"):
+        for name in ("normal_map", "specular_normal_map", "height_map"):
             if getattr(self, name) is not None:
                 out[name] = getattr(self, name)
         return out

@@ -22,10 +22,10 @@ from typing import Any
 
 import numpy as np
 
-from lookdev.library.textures import Decoded, ParamTexture
+from lookdev.library.textures import Decoded, ParamTexture, udim_tiles
 from lookdev.materials import colour
 from lookdev.materials.fresnel import ior_to_specular
-from lookdev.materials.textures import udim_tile
+from lookdev.materials.textures import UDIM_TOKEN, tile_uv, udim_tile
 
 from .masks import MaskSampler
 from .stack import Decision, Entry
@@ -58,10 +58,15 @@ def open_textures(entries: list[Entry]) -> list[Decision]:
     return decisions
 
 
-def extent_of(entries: list[Entry]) -> tuple[int, int, int, int]:
-    """(u0, v0, u1, v1): the whole UV squares the UDIM textures of ``entries`` cover,
+def extent_of(entries: list[Entry], patterns: list[str] = ()) -> tuple[int, int, int, int]:
+    """(0, 0, u1, v1): the UV squares from tile 1001 to the far corner of the UDIM textures
+    of ``entries`` (and of the UDIM ``patterns``: a texture set's height and normal maps);
     (0, 0, 1, 1) when there are none."""
     extents = [t.extent for e in entries for t in e.decoded.values() if None not in t.tiles]
+    for pattern in patterns:
+        uvs = [tile_uv(t) for t in udim_tiles(pattern)] if UDIM_TOKEN in pattern else []
+        if uvs:
+            extents.append((0, 0, max(u for u, _ in uvs) + 1, max(v for _, v in uvs) + 1))
     if not extents:
         return (0, 0, 1, 1)
     u0, v0, u1, v1 = zip(*extents, strict=True)

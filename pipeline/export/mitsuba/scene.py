@@ -154,10 +154,40 @@ def bsdf_dict(
 
     def normal_texture(normals: np.ndarray, name: str) -> dict[str, Any]:
         encoded = _encode_normals(np.asarray(normals, dtype=np.float32))
-        return _bitmap(encoded, True, hub.name, name, texture_dir, hub.uv_extent)
+        return _tiled(_bitmap(encoded, True, hub.name, name, texture_dir), hub)
 
     frames = (hub.normal_map, hub.specular_normal_map)
-    return with_normals(out, model, lobes, frames, normal_texture)
+    return with_bump(hub, with_normals(out, model, lobes, frames, normal_texture), texture_dir)
+
+
+def with_bump(
+    hub: BlendedMaterial, bsdf: dict[str, Any], texture_dir: str | Path | None = None
+) -> dict[str, Any]:
+    """``bsdf`` under Mitsuba's ``bumpmap`` when the material has a height map.
+
+    The map holds heights in scene units (:attr:`BlendedMaterial.height_map`), and
+    ``bumpmap`` offsets the surface by ``scale`` × the texture along the normal when it
+    differentiates the position (Mitsuba 3 ``bumpmap``: ∂p/∂u + n·∂h/∂u), so ``scale``
+    is 1: the proof shows the bump the USD ``displacement`` describes, as shading."""
+    if hub.height_map is None:
+        return bsdf
+    height = _bitmap(hub.height_map, False, hub.name, "height", texture_dir)
+    return {"type": "bumpmap", "height": _tiled(height, hub), "scale": 1.0, "bsdf": bsdf}
+
+
+def _tiled(texture: dict[str, Any], hub: BlendedMaterial) -> dict[str, Any]:
+    """A bitmap of a map spanning the hub's UDIM extent (``hub.uv_extent``, (u0, v0, u1, v1))
+    with the ``to_uv`` that brings the mesh's UVs onto it, ``(uv − (u0, v0)) / (Δu, Δv)``,
+    so each tile's square of the map lands on that tile's UV square of the mesh."""
+    if tuple(hub.uv_extent) == (0, 0, 1, 1):
+        return texture
+    import mitsuba as mi
+
+    u0, v0, u1, v1 = hub.uv_extent
+    scale = mi.ScalarTransform4f().scale([1.0 / (u1 - u0), 1.0 / (v1 - v0), 1.0])
+    texture["to_uv"] = scale @ mi.ScalarTransform4f().translate([-u0, -v0, 0.0])
+    texture["wrap_mode"] = "clamp"  # outside the tiles: the edge texels, not another tile
+    return texture
 
 
 def _plugin_dict(hub: BlendedMaterial, texture_dir: str | Path | None) -> dict[str, Any]:
@@ -169,7 +199,7 @@ def _plugin_dict(hub: BlendedMaterial, texture_dir: str | Path | None) -> dict[s
         out[key] = _constant(value)
     for key, array in maps.items():
         colour = is_color_field(model.params_type, key)
-        out[key] = _bitmap(array, colour, hub.name, key, texture_dir, hub.uv_extent)
+        out[key] = _tiled(_bitmap(array, colour, hub.name, key, texture_dir), hub)
     return out
 
 
@@ -192,11 +222,8 @@ def _bitmap(
     name: str,
     key: str,
     texture_dir: str | Path | None,
-    extent: tuple[int, int, int, int] = (0, 0, 1, 1),
 ) -> dict[str, Any]:
-    """A ``bitmap`` of a hub map. A map spanning a UDIM extent (u0, v0, u1, v1) gets the
-    ``to_uv`` that brings the mesh's UVs onto it, ``(uv − (u0, v0)) / (Δu, Δv)``, so each
-    tile's square of the map lands on that tile's UV square of the mesh."""
+    """A ``bitmap`` of a hub map (see :func:`_tiled` for maps over UDIM tiles)."""
     import mitsuba as mi
 
     data = np.asarray(array, dtype=np.float32)
@@ -210,11 +237,6 @@ def _bitmap(
             field=key,
         )
     tex: dict[str, Any] = {"type": "bitmap", "raw": True, "wrap_mode": "repeat"}
-    if tuple(extent) != (0, 0, 1, 1):
-        u0, v0, u1, v1 = extent
-        tex["wrap_mode"] = "clamp"  # outside the tiles: the edge texels, not another tile
-        scale = mi.ScalarTransform4f().scale([1.0 / (u1 - u0), 1.0 / (v1 - v0), 1.0])
-        tex["to_uv"] = scale @ mi.ScalarTransform4f().translate([-u0, -v0, 0.0])
     if texture_dir is None:
         tex["data"] = mi.TensorXf(np.ascontiguousarray(data))
     else:
