@@ -33,7 +33,6 @@ is always kept beside the denoised one.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -165,42 +164,27 @@ def denoise(image: np.ndarray, guides: Guides | None = None) -> np.ndarray:
 
 
 # -- proofs ------------------------------------------------------------------------------
-def guide_renderer(table: Any, spp: int) -> GuideRenderer:
+def guide_renderer(table: Any, spp: int | None) -> GuideRenderer:
     """The guides of a :class:`~.turntable.Turntable` (its single-frame camera), rendered
-    with ``min(spp, GUIDE_SPP)`` samples: a 4-spp preview does not pay for 16-spp guides."""
+    with ``min(spp, GUIDE_SPP)`` samples (GUIDE_SPP under a noise target): a 4-spp
+    preview does not pay for 16-spp guides."""
+    n = GUIDE_SPP if spp is None else min(int(spp), GUIDE_SPP)
     # Not frozen: tracing the aov integrator is cheap (≈ 0.03-0.1 s a frame, measured on
     # 32×16 proofs), and a second frozen launch over the turntable's scene is one more
     # recording that can fail (see GuideRenderer); lookdev bench error times frozen guides.
-    return GuideRenderer(table.scene, table.camera_index, min(int(spp), GUIDE_SPP), freeze=False)
+    return GuideRenderer(table.scene, table.camera_index, n, freeze=False)
 
 
 def write_denoised(
-    guides: GuideRenderer,
-    image: np.ndarray,
-    stem: Path,
-    exposure: float,
-    seed: int,
-    file_entry: Callable[[Path], dict[str, Any]],
-) -> dict[str, Any]:
-    """Denoise a frame at the pose it was just rendered in and write
-    ``<stem>_denoised.exr`` and ``.png`` beside the raw ``<stem>.exr``; the frame entry's
-    additions: the two files (name, size, SHA-256, as ``exr``/``png``), ``images`` (the
-    raw and denoised file names) and ``denoise`` (seconds of guides and denoiser).
-    ``file_entry`` describes a written file (the batch's, passed in: no import cycle)."""
+    guides: GuideRenderer, image: np.ndarray, stem: Path, exposure: float, seed: int
+) -> tuple[dict[str, Path], dict[str, float]]:
+    """Denoise a frame at the pose it was just rendered in; write ``<stem>_denoised.exr``
+    and ``.png`` beside the raw ``<stem>.exr``. Returns the written files by manifest
+    role (``denoised``, ``denoised_png``) and the manifest's ``denoise`` timings."""
     from . import contact, tonemap
 
     d = guides.denoise(image, seed=seed)
     exr = contact.write_exr(d.image, stem.with_name(stem.name + "_denoised.exr"))
     display = tonemap.view(d.image, exposure)
     png = contact.write_png(display, stem.with_name(stem.name + "_denoised.png"))
-    return {
-        "denoised_exr": file_entry(exr),
-        "denoised_png": file_entry(png),
-        "images": {
-            "raw": stem.name + ".exr",
-            "png": stem.name + ".png",
-            "denoised": exr.name,
-            "denoised_png": png.name,
-        },
-        "denoise": d.timings(),
-    }
+    return {"denoised": exr, "denoised_png": png}, d.timings()
