@@ -138,7 +138,7 @@ def test_a_denoised_job_writes_both_exrs_and_records_timings(mi, tmp_path):
         den = folder / f["images"]["denoised"]
         assert raw.is_file() and den.is_file() and raw != den
         assert (folder / f["images"]["denoised_png"]).is_file()
-        assert f["denoised_exr"]["size"] == den.stat().st_size
+        assert f["files"]["denoised"]["size"] == den.stat().st_size
         assert f["denoise"]["aov_s"] > 0 and f["denoise"]["denoise_s"] > 0
     assert (folder / "contact_denoised.png").is_file()
     again = batch.run_job(job)  # the denoised files are vouched for like the raw ones
