@@ -62,6 +62,7 @@ __all__ = [
     "ColourError",
     "Settings",
     "settings",
+    "pinned",
     "use",
     "config",
     "canonical",
@@ -151,6 +152,14 @@ _current = [Settings()]
 def settings() -> Settings:
     """The colour settings in force."""
     return _current[-1]
+
+
+def pinned() -> Settings:
+    """The settings in force with every default spelled out (the config's name, the
+    working space, display, view and look as the config names them), for another
+    process, whose ``$OCIO`` may differ: ``use(**dataclasses.asdict(pinned()))``."""
+    disp, v, names = _view_names()
+    return Settings(settings().config_name, working_space(), disp, v, ", ".join(names))
 
 
 @contextlib.contextmanager

@@ -19,7 +19,15 @@ CLI prints.
 :func:`plot`           BRDF-explorer views of materials, side by side
 :func:`check`          the stability sweep of every reflectance model
 :data:`models`         the reflectance models by name
+:func:`colour_settings`  a ``with`` block: OCIO config, working space, display/view/look
 =====================  ==========================================================
+
+Colour is set one way, for everything inside a ``with lookdev.colour_settings(...)``
+block (what the CLI's global ``--config``, ``--working-space``, ``--display``, ``--view``
+and ``--look`` do): presets load into that working space, exports and EXRs name it, and
+proofs, plots and the review page show pixels through that view. Load a material inside
+the block it is used in: its colours were converted into the working space in force
+when it was loaded.
 
 Materials are accepted in any form a step can use: a preset name or ``.toml`` path
 (loaded through ``library``), a :class:`~lookdev.library.Material`, or where it makes
@@ -35,6 +43,8 @@ of folders or a :class:`~lookdev.library.Library`; the folders are searched befo
 Heavy dependencies (Mitsuba, usd-core, matplotlib) are imported by the functions that
 need them, never by ``import lookdev``.
 """
+
+from lookdev.materials.colour import use as colour_settings
 
 from .materials import (
     EVALUATE_RESOLUTION,
@@ -78,6 +88,7 @@ __all__ = [
     "bake",
     "blend",
     "check",
+    "colour_settings",
     "evaluate",
     "export_mitsuba",
     "export_usd",

@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 
 from lookdev.library import files
+from lookdev.materials import colour
 from lookdev.materials.errors import LookdevError
 
 from . import contact, tonemap
@@ -69,6 +70,9 @@ class Settings:
     spp: int = 32
     resolution: tuple[int, int] = (192, 96)
     exposure: float = 0.0  # display only: applied by the view transform, not the render
+    colour: colour.Settings = field(default_factory=colour.pinned)
+    """The OCIO config, working space and view the batch was asked in (workers are other
+    processes, perhaps on other machines: they enter these, not their own defaults)."""
 
     def frames(self) -> list[Frame]:
         return frames(self.element_frames, self.light_frames)
@@ -152,6 +156,11 @@ def run_job(job: Job) -> dict[str, Any]:
     from lookdev.pipeline.variant import use_mitsuba
 
     variant = use_mitsuba()
+    with colour.use(**asdict(job.settings.colour)):
+        return _run_job(job, variant)
+
+
+def _run_job(job: Job, variant: str) -> dict[str, Any]:
     folder = job.folder
     folder.mkdir(parents=True, exist_ok=True)
     done = read_manifest(folder, job.key)
