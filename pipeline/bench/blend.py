@@ -36,7 +36,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import OpenImageIO as oiio
 
 from lookdev.materials.layers import TextureMask
 from lookdev.materials.params import DisneyParams
@@ -282,13 +281,11 @@ def peak_bytes(fn) -> int:
 
 
 def write_mask(path: Path, values: np.ndarray) -> Path:
-    """A one-channel float EXR written with OpenImageIO."""
-    height, width = values.shape
-    buf = oiio.ImageBuf(oiio.ImageSpec(width, height, 1, oiio.FLOAT))
-    buf.set_pixels(oiio.ROI(0, width, 0, height, 0, 1, 0, 1), values.astype(np.float32))
-    if not buf.write(str(path)):
-        raise RuntimeError(f"cannot write {path}: {buf.geterror()}")
-    return path
+    """A one-channel float EXR (data: ``Raw``), through the one EXR writer."""
+    from lookdev.materials.colour import RAW
+    from lookdev.pipeline.exr import write_exr
+
+    return write_exr(path, values, RAW)
 
 
 def _random_disney(name: str, rng: np.random.Generator):

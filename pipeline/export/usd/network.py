@@ -96,6 +96,7 @@ class Image:
     pixels: np.ndarray | None = None
     write: bool = False
     origin: Path | None = None  # a file written elsewhere (a bake) to copy to ``path``
+    data: bool = False  # pixels that are not colour though RGB (a normal map): written Raw
 
 
 @dataclass

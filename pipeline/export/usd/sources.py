@@ -67,7 +67,8 @@ def baked_source(hub: BlendedMaterial, texture_dir: Path, scratch: Path) -> Sour
     files = bake(hub, scratch)
 
     def image(name: str, array: np.ndarray) -> Image:
-        return Image(texture_dir / files[name].name, np.flipud(array), True, files[name])
+        data = name.endswith("normal_map")
+        return Image(texture_dir / files[name].name, np.flipud(array), True, files[name], data)
 
     maps = {name: image(name, array) for name, array in hub.maps.items()}
     if "specular" in maps:  # the universal surface reads the same F0 as an IOR
@@ -128,7 +129,8 @@ def weights_source(hub: BlendedMaterial, texture_dir: Path) -> Source:
     normal = None
     if hub.normal_map is not None:  # encoded (n + 1)/2 like every normal map
         pixels = np.flipud(0.5 * hub.normal_map + 0.5).astype(np.float32)
-        normal = Image(texture_dir / f"{hub.name}_normal_map.exr", pixels, write=True)
+        path = texture_dir / f"{hub.name}_normal_map.exr"
+        normal = Image(path, pixels, write=True, data=True)
     return Source(
         hub.name,
         "pixar_weights",

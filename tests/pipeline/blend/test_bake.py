@@ -86,11 +86,11 @@ def test_a_failing_write_leaves_nothing_half_written(tmp_path, monkeypatch):
     real = bake_module._write_exr
     calls = []
 
-    def flaky(path, pixels, where, final):
+    def flaky(path, pixels, where, final, space):
         calls.append(path)
         if len(calls) == 3:
             raise BlendError("disk full", where=where)
-        real(path, pixels, where, final)
+        real(path, pixels, where, final, space)
 
     monkeypatch.setattr(bake_module, "_write_exr", flaky)
     with pytest.raises(BlendError, match="disk full"):
