@@ -402,8 +402,8 @@ def to_display(pixels: Any, exposure: float = 0.0) -> np.ndarray:
     if rgb.shape[-1:] != (3,):
         raise ColourError(f"a view transform needs (…, 3) RGB, not shape {rgb.shape}")
     finite = np.where(np.isfinite(rgb), rgb, np.float32(0.0))
-    out = np.ascontiguousarray(np.maximum(finite, 0.0) * np.float32(2.0**exposure))
-    out = np.nan_to_num(out, nan=0.0, posinf=np.finfo(np.float32).max)
+    scaled = np.maximum(finite, 0.0, dtype=np.float64) * 2.0**exposure  # no float32 overflow
+    out = np.ascontiguousarray(np.minimum(scaled, np.finfo(np.float32).max), dtype=np.float32)
     disp, v, names = _view_names()
     cpu = _display_cpu(settings().config_name, working_space(), disp, v, ", ".join(names))
     cpu.applyRGB(out.reshape(-1))
