@@ -209,3 +209,13 @@ def test_view_changes_the_proof_png(cli, tmp_path):
     assert np.abs(pngs[None] - pngs["Un-tone-mapped"]).max() > 0.05
     # the scene-linear EXRs do not depend on the view: only their display does
     assert exr is not None
+
+
+def test_an_acescg_stage_imports_back_into_the_presets_linear_rec709(tmp_path):
+    from lookdev.pipeline.export.usd.reader import import_usd
+
+    with lookdev.colour_settings(working_space="acescg"):
+        lookdev.export_usd(["plastic_glossy"], tmp_path / "p.usda", contexts=["universal"])
+    (imported,) = import_usd(tmp_path / "p.usda")
+    written = lookdev.load("plastic_glossy").params.base_color  # linear Rec.709
+    np.testing.assert_allclose(imported.params["base_color"], written, atol=1e-4)
