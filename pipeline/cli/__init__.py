@@ -20,7 +20,10 @@ from .common import quiet_numerics
 
 app = typer.Typer(
     name="lookdev",
-    help="Author, blend, export and proof Disney and Pixar materials.",
+    help="Author, blend, export and proof Disney and Pixar materials.\n\n"
+    "Colour is managed by OpenColorIO. Colour options go before the command and hold for "
+    "all of it: `lookdev --working-space acescg --view Un-tone-mapped proof gold`. "
+    "`lookdev colour spaces` and `lookdev colour views` list the names the config knows.",
     no_args_is_help=True,
     pretty_exceptions_enable=False,
     add_completion=False,
