@@ -21,6 +21,7 @@ from lookdev.library import files
 from lookdev.materials import colour
 from lookdev.pipeline.exr import write_exr
 
+ACES_SDR = "ACES 2.0 - SDR 100 nits (Rec.709)"
 AP1 = colour_science.RGB_COLOURSPACES["ACEScg"]
 REC709 = colour_science.RGB_COLOURSPACES["sRGB"]
 
@@ -199,16 +200,18 @@ def test_ocio_environment_names_another_builtin_config(cli, monkeypatch):
 @pytest.mark.slow
 def test_view_changes_the_proof_png(cli, tmp_path):
     common = ["gold", "--ibl", "sky", "-n", "1", "-m", "0", "-s", "4", "-r", "32", "16"]
-    pngs = {}
+    pngs, exrs = {}, {}
     for view in (None, "Un-tone-mapped"):
         out = tmp_path / (view or "default")
         r = cli(*(["--view", view] if view else []), "proof", *common, "-o", str(out))
         assert r.code == 0, r.err
         pngs[view] = oiio.ImageBuf(str(out / "gold" / "sky" / "frame_000.png")).get_pixels()
-        exr = oiio.ImageBuf(str(out / "gold" / "sky" / "frame_000.exr")).get_pixels()
+        exrs[view] = oiio.ImageBuf(str(out / "gold" / "sky" / "frame_000.exr")).get_pixels()
+        manifest = json.loads((out / "gold" / "sky" / "manifest.json").read_text())
+        assert manifest["settings"]["colour"]["view"] == (view or ACES_SDR)
     assert np.abs(pngs[None] - pngs["Un-tone-mapped"]).max() > 0.05
-    # the scene-linear EXRs do not depend on the view: only their display does
-    assert exr is not None
+    # the scene-linear frames do not depend on the view: only their display does
+    np.testing.assert_array_equal(exrs[None], exrs["Un-tone-mapped"])
 
 
 def test_an_acescg_stage_imports_back_into_the_presets_linear_rec709(tmp_path):
