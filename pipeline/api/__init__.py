@@ -6,21 +6,21 @@ every ``lookdev`` command only parses its options, calls one of these and prints
 result. Bad input raises the :class:`LookdevError` family, with the one-line message the
 CLI prints.
 
-=====================  ==========================================================
-:func:`load`           a preset (name or ``.toml`` file) resolved into a material
-:func:`blend`          a layered material blended into constants and maps
-:func:`bake`           a blend's varying maps written as EXR (and a JSON sidecar)
-:func:`evaluate`       f(wi, wo) without the cosine, numpy ``(..., 3)``
-:func:`sample`         ``(wi, weight, pdf)`` drawn for ``wo`` and uniforms ``u``
-:func:`pdf`            the density with which :func:`sample` draws ``wi``
-:func:`export_usd`     UsdShade materials, and what each render context lost
-:func:`export_mitsuba` a Mitsuba 3 scene of one material
-:func:`proof`          turntable proofs, materials × IBLs, resumable; the manifest
-:func:`plot`           BRDF-explorer views of materials, side by side
-:func:`check`          the stability sweep of every reflectance model
-:data:`models`         the reflectance models by name
+=======================  ==========================================================
+:func:`load`             a preset (name or ``.toml`` file) resolved into a material
+:func:`blend`            a layered material blended into constants and maps
+:func:`bake`             a blend's varying maps written as EXR (and a JSON sidecar)
+:func:`evaluate`         f(wi, wo) without the cosine, numpy ``(..., 3)``
+:func:`sample`           ``(wi, weight, pdf)`` drawn for ``wo`` and uniforms ``u``
+:func:`pdf`              the density with which :func:`sample` draws ``wi``
+:func:`export_usd`       UsdShade materials, and what each render context lost
+:func:`export_mitsuba`   a Mitsuba 3 scene of one material
+:func:`proof`            turntable proofs, materials × IBLs, resumable; the manifest
+:func:`plot`             BRDF-explorer views of materials, side by side
+:func:`check`            the stability sweep of every reflectance model
+:data:`models`           the reflectance models by name
 :func:`colour_settings`  a ``with`` block: OCIO config, working space, display/view/look
-=====================  ==========================================================
+=======================  ==========================================================
 
 Colour is set one way, for everything inside a ``with lookdev.colour_settings(...)``
 block (what the CLI's global ``--config``, ``--working-space``, ``--display``, ``--view``
