@@ -228,14 +228,22 @@ def canonical(space: str) -> str:
     >>> canonical("srgb_tx"), canonical("lin_ap1")
     ('sRGB Encoded Rec.709 (sRGB)', 'ACEScg')
     """
-    found = config().getColorSpace(space)
+    found = _lookup(settings().config_name, space)
     if found is None:
         known = ", ".join(sorted(config().getColorSpaceNames())[:6])
         raise ColourError(
             f"unknown colour space {space!r} in the OCIO config {settings().config_name!r} "
             f"(e.g. {known}, …; `lookdev colour spaces` lists them)"
         )
-    return found.getName()
+    return found[0]
+
+
+@functools.cache
+def _lookup(config_name: str, space: str) -> tuple[str, bool] | None:
+    # OCIO's look-up by name or alias costs ≈ 0.1 ms (it scans the config); a preset's
+    # colours ask it several times each, so the answer (name, is data) is kept
+    cs = _load(config_name).getColorSpace(space)
+    return None if cs is None else (cs.getName(), bool(cs.isData()))
 
 
 def working_space() -> str:
@@ -246,8 +254,8 @@ def working_space() -> str:
 
 def is_data(space: str) -> bool:
     """True for a data space (``Raw``): values pass through every conversion unchanged."""
-    cs = config().getColorSpace(space)
-    return bool(cs is not None and cs.isData())
+    found = _lookup(settings().config_name, space)
+    return bool(found is not None and found[1])
 
 
 @functools.cache

@@ -30,7 +30,7 @@ from pydantic import (
     model_validator,
 )
 
-from .colour import PRESET_LINEAR, canonical, convert, decode_hex, working_space
+from .colour import PRESET_LINEAR, canonical, convert, decode_hex, settings, working_space
 from .errors import ParameterError as ParameterError  # re-exported
 from .errors import one_line, register_schema
 from .fresnel import SPECULAR_F0_SCALE, ior_to_specular, specular_to_ior
@@ -59,7 +59,8 @@ def _from_preset_linear(value: Any) -> Any:
         return value
     if len(rgb) != 3 or not all(math.isfinite(v) for v in rgb):
         return value
-    if canonical(PRESET_LINEAR) == working_space():
+    ws = settings().working_space  # the default: no look-up (this runs for every colour)
+    if ws in ("lin_rec709", PRESET_LINEAR) or canonical(PRESET_LINEAR) == working_space():
         return value  # as written: no float32 round trip
     out = convert(rgb, PRESET_LINEAR).astype(np.float64)
     # a colour on a range edge stays on it: OCIO's float32 matrix may land an ulp outside
