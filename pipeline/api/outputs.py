@@ -245,6 +245,7 @@ def export_mitsuba(
     path: PathLike,
     *,
     ibl: PathLike | None = None,
+    ibl_rotation: float = 0.0,
     resolution: tuple[int, int] = (512, 512),
     spp: int = 128,
     map_resolution: int = 512,
@@ -262,6 +263,10 @@ def export_mitsuba(
     ibl
         A built-in IBL name (``studio``, ``sky``, ``overcast``, ``sunset``) or an
         ``.exr``/``.hdr`` file; None: a constant white sky (the white furnace).
+    ibl_rotation
+        Degrees the IBL turns about +y, with the proofs' orientation convention
+        (:data:`lookdev.pipeline.proof.ibl.ORIENTATION`, stated in the XML): the scene
+        lit as a proof's lighting frame at that angle.
     resolution, spp
         Film size in pixels and samples per pixel.
     map_resolution
@@ -285,6 +290,7 @@ def export_mitsuba(
     for side in resolution:
         check_range(side, 1, FILM_MAX_SIDE, field="--resolution", error=MitsubaExportError)
     check_range(spp, 1, 2**20, field="--spp", error=MitsubaExportError)
+    check_range(ibl_rotation, -360.0, 360.0, field="--ibl-rotation", error=MitsubaExportError)
     material = hub(material, map_resolution, library)
     env = _in_working_space(_environment_file(ibl), Path(path))
     scene = export_scene(
@@ -293,6 +299,7 @@ def export_mitsuba(
         resolution=tuple(resolution),
         spp=spp,
         environment=env,
+        ibl_rotation=ibl_rotation,
         force_all_lobes=force_all_lobes,
     )
     bsdf = scene["ball"]["bsdf"]
@@ -337,6 +344,7 @@ def proof(
     resolution: tuple[int, int] = (192, 96),
     exposure: float = 0.0,
     ibl_width: int = 512,
+    rig: str = "full",
     jobs: int | None = None,
     scheduler: str | None = None,
     executor: Executor | None = None,
@@ -348,9 +356,10 @@ def proof(
 
     Each proof turns the element through ``frames`` frames, then the lighting through
     ``light_frames``, and writes under ``out/MATERIAL/IBL/``: EXR frames, view-transformed
-    PNGs, a labelled ``contact.png`` and a ``manifest.json``. Calling again with the same
-    arguments renders only the frames the manifests do not vouch for (size and SHA-256),
-    so an interrupted batch resumes.
+    PNGs, a labelled ``contact.png`` and a ``manifest.json``; and
+    ``out/MATERIAL/material.json`` (resolved parameters, source, USD loss notes) for the
+    review page. Calling again with the same arguments renders only the frames the
+    manifests do not vouch for (size and SHA-256), so an interrupted batch resumes.
 
     Parameters
     ----------
@@ -365,6 +374,9 @@ def proof(
         ``(width, height)``, and stops applied by the PNG view transform.
     ibl_width
         Every IBL is resampled to this width (× ½ high) so render kernels are reused.
+    rig
+        The calibrated rig beside the material (:mod:`lookdev.pipeline.proof.rig`):
+        ``full`` (chrome ball, 18 % grey ball, ColorChecker chart), ``balls``, ``none``.
     jobs
         Local worker processes (default 1: each renders on every core). They are spawned,
         so a script calling :func:`proof` does so under ``if __name__ == "__main__":``.
@@ -373,7 +385,8 @@ def proof(
     executor
         Any ``concurrent.futures.Executor`` to run the proofs on (it is not shut down).
     report
-        Also write ``out/index.html``, a static review page.
+        Also write ``out/index.html``, a static review page: turntable players, a
+        synchronised comparison, raw/denoised, each material's parameters and losses.
     library
         See :func:`load`.
     progress
@@ -391,6 +404,10 @@ def proof(
     from lookdev.pipeline.proof import ibl as ibl_module
 
     check_proof_settings(resolution, frames, light_frames, spp, exposure, jobs)
+    from lookdev.pipeline.proof.rig import RIGS
+
+    if rig not in RIGS:
+        raise batch.ProofError(f"unknown rig {rig!r}; use {', '.join(RIGS)}", field="--rig")
     lib = library_for(library)
     if materials is None or (not isinstance(materials, str | os.PathLike) and not materials):
         materials = representative_presets(lib)
@@ -406,7 +423,7 @@ def proof(
     ibl_names = list(dict.fromkeys(ibls or ibl_module.builtin_names()))
     environments = [ibl_module.load(name, ibl_width) for name in ibl_names]
     loaded = [hub(m, batch.MAP_RESOLUTION, lib) for m in chosen]
-    settings = batch.Settings(frames, light_frames, spp, tuple(resolution), exposure)
+    settings = batch.Settings(frames, light_frames, spp, tuple(resolution), exposure, rig)
     doc = batch.proof(
         loaded,
         environments,
@@ -417,6 +434,9 @@ def proof(
         executor=executor,
         progress=progress,
     )
+    from lookdev.pipeline.proof.material_info import write_material_info
+
+    write_material_info(output, loaded)
     if report:
         from lookdev.pipeline.analysis.report import write_report
 

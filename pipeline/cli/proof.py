@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from contextlib import ExitStack
+from enum import StrEnum
 from pathlib import Path
 from typing import Annotated
 
@@ -17,6 +18,14 @@ from rich.progress import (
 )
 
 from .common import console, err_console, print_json, table
+
+
+class Rig(StrEnum):
+    """``--rig``: the values of :data:`lookdev.pipeline.proof.rig.RIGS`."""
+
+    full = "full"
+    balls = "balls"
+    none = "none"
 
 
 def proof(
@@ -72,6 +81,14 @@ def proof(
             "--ibl-width", min=8, max=8192, help="Every IBL is resampled to this width (×½ high)."
         ),
     ] = 512,
+    rig: Annotated[
+        Rig,
+        typer.Option(
+            "--rig",
+            help="The calibrated rig beside the material: full (chrome ball, 18 % grey "
+            "ball, ColorChecker chart), balls, or none.",
+        ),
+    ] = Rig.full,
     scheduler: Annotated[
         str | None,
         typer.Option(
@@ -101,8 +118,10 @@ def proof(
         bool,
         typer.Option(
             "--report",
-            help="Also write OUTPUT/index.html: contact sheets, time/noise table, each "
-            "material's BRDF plots and its frames; static, opens from disk.",
+            help="Also write OUTPUT/index.html, the review page: turntable players, a "
+            "synchronised comparison across materials or IBLs, raw/denoised, each "
+            "material's parameters, source, USD losses and BRDF plots, every frame's "
+            "spp/noise/time; static, opens from disk, offline.",
         ),
     ] = False,
 ) -> None:
@@ -156,6 +175,7 @@ def proof(
             resolution=resolution,
             exposure=exposure,
             ibl_width=ibl_width,
+            rig=rig.value,
             jobs=workers,
             scheduler=scheduler,
             report=report,

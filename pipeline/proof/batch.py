@@ -42,7 +42,8 @@ from lookdev.library import files
 from lookdev.materials import colour
 from lookdev.materials.errors import LookdevError
 
-from . import contact, tonemap
+from . import contact, ibl, rig, tonemap
+from .rig import DEFAULT_RIG
 from .turntable import Frame, frames
 
 MANIFEST = "manifest.json"
@@ -70,6 +71,7 @@ class Settings:
     spp: int = 32
     resolution: tuple[int, int] = (192, 96)
     exposure: float = 0.0  # display only: applied by the view transform, not the render
+    rig: str = DEFAULT_RIG  # the calibrated rig beside the material (.rig)
     colour: colour.Settings = field(default_factory=colour.pinned)
     """The OCIO config, working space and view the batch was asked in (workers are other
     processes, perhaps on other machines: they enter these, not their own defaults)."""
@@ -172,6 +174,8 @@ def _run_job(job: Job, variant: str) -> dict[str, Any]:
         "key": job.key,
         "variant": variant,
         "settings": job.settings.as_json(),
+        "rig": rig.manifest_entry(job.settings.rig),
+        "ibl_orientation": ibl.ORIENTATION,
         "frames": [done[i] for i in sorted(done)],
     }
     rendered = 0
@@ -191,7 +195,7 @@ def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
     from .turntable import Turntable, material_bsdf, render_frame
 
     bsdf, depth = material_bsdf(job.material)
-    table = Turntable(bsdf, job.environment, job.settings.resolution, depth)
+    table = Turntable(bsdf, job.environment, job.settings.resolution, depth, rig=job.settings.rig)
     for frame in todo:
         r = render_frame(table, frame, job.settings.spp, seed=frame.index)
         stem = job.folder / f"frame_{frame.index:03d}"
@@ -459,6 +463,7 @@ def summary(out: Path, jobs: list[Job], results: list[dict[str, Any]], seconds: 
         "version": FORMAT_VERSION,
         "wall_seconds": round(seconds, 3),
         "settings": jobs[0].settings.as_json() if jobs else {},
+        "ibl_orientation": ibl.ORIENTATION,
         "proofs": entries,
         "overview": overview(out, entries).name if entries else None,
     }

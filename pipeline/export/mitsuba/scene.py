@@ -249,11 +249,14 @@ def scene_dict(
     texture_dir: str | Path | None = None,
     force_all_lobes: bool = False,
     max_depth: int | None = None,
+    ibl_rotation: float = 0.0,
 ) -> dict[str, Any]:
     """A minimal scene: the material on a unit sphere, framed, under an environment.
 
-    ``environment`` is a lat-long image (``envmap``); without one, a constant white sky
-    (the white-furnace set-up). The integrator depth follows the material; the film
+    ``environment`` is a lat-long image (``envmap``) oriented as in the proofs (y up,
+    camera on +z, :data:`lookdev.pipeline.proof.ibl.ORIENTATION`) and turned by
+    ``ibl_rotation`` degrees about +y; without one, a constant white sky (the
+    white-furnace set-up). The integrator depth follows the material; the film
     holds RGB only (no alpha, no AOVs).
     """
     import mitsuba as mi
@@ -270,7 +273,13 @@ def scene_dict(
     if environment is None:
         emitter = {"type": "constant", "radiance": {"type": "rgb", "value": [1.0, 1.0, 1.0]}}
     else:
-        emitter = {"type": "envmap", "filename": str(environment)}
+        from lookdev.pipeline.proof.ibl import envmap_to_world
+
+        emitter = {
+            "type": "envmap",
+            "filename": str(environment),
+            "to_world": envmap_to_world(ibl_rotation),
+        }
     return {
         "type": "scene",
         "integrator": {"type": "path", "max_depth": max_depth or max_depth_for(hub)},

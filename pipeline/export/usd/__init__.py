@@ -14,7 +14,7 @@ from typing import Any
 
 from lookdev.library import files
 
-__all__ = ["export_materials"]
+__all__ = ["export_materials", "loss_notes"]
 
 
 def export_materials(
@@ -69,3 +69,24 @@ def export_materials(
             workdir=Path(scratch),
             preview_opacity=preview_opacity,
         )
+
+
+def loss_notes(
+    material: Any, contexts: Sequence[str] | None = None, preview_opacity: str = "keep"
+) -> dict[str, str]:
+    """``{context: note}``: what each render context of an export of ``material`` (a
+    blended material) could not express (``""``: nothing), as :func:`export_materials`
+    would record it, without writing a stage. Layered materials bake their maps into a
+    temporary folder that is removed afterwards.
+    """
+    import tempfile
+
+    from .network import CONTEXTS
+    from .sources import source_for
+    from .writer import losses_of, material_spec
+
+    contexts = tuple(contexts) if contexts else CONTEXTS
+    with tempfile.TemporaryDirectory(prefix="lookdev-losses-") as scratch:
+        source = source_for(material, Path(scratch, "textures"), scratch=Path(scratch))
+        spec = material_spec(source, contexts, preview_opacity)
+        return losses_of([spec])[spec.name]
