@@ -2,7 +2,8 @@
 
 Layout for a material ``NAME`` in ``out_dir``::
 
-    NAME.json              constants, map files, resolution, decisions (the sidecar)
+    NAME.json              constants, map files, resolution, decisions (the sidecar), and
+                           the colour space of each (the working space; Raw for data)
     NAME_roughness.exr     one file per varying parameter (float32, ZIP), "Y" or "R,G,B"
     NAME_normal_map.exr    unit normals encoded (n + 1)/2, the usual normal-map encoding
 
@@ -27,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from lookdev.library import files
+from lookdev.materials import colour
 from lookdev.pipeline.exr import colour_space_of, write_exr
 
 from .errors import BlendError
@@ -80,10 +82,13 @@ def sidecar_dict(blended: BlendedMaterial, files: dict[str, str]) -> dict[str, A
         "representation": blended.representation,
         "resolution": [width, height],
         "orientation": "top row of each file is v = 1; UV (0, 0) is the bottom-left texel",
+        # the OCIO name of the space colour constants and RGB colour maps are in
+        "colour_space": colour.working_space(),
         "constants": {k: _plain(v) for k, v in blended.constants.items()},
         "maps": {
             name: {
                 "file": files[name],
+                "colour_space": colour_space_of(array, data=name.endswith("normal_map")),
                 "channels": ["R", "G", "B"] if array.ndim == 3 else ["Y"],
                 "encoding": "(n + 1) / 2" if name.endswith("normal_map") else "linear",
             }

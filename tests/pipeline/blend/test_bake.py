@@ -48,9 +48,12 @@ def test_sidecar_holds_constants_and_map_files(tmp_path):
     assert doc["constants"]["clearcoat"] == 0.0 and doc["constants"]["thin"] is False
     assert doc["maps"]["roughness"] == {
         "file": "worn_roughness.exr",
+        "colour_space": "Raw",
         "channels": ["Y"],
         "encoding": "linear",
     }
+    assert doc["colour_space"] == "Linear Rec.709 (sRGB)"  # of the constants and colour maps
+    assert doc["maps"]["base_color"]["colour_space"] == "Linear Rec.709 (sRGB)"
     assert set(doc["constants"]).isdisjoint(doc["maps"])
     assert [entry["kept"] for entry in doc["layers"]] == [True, True]
 
