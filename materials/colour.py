@@ -17,8 +17,9 @@ curve or primaries matrix is written by hand anywhere in the program:
 * :func:`to_display` is the one view transform (an OCIO ``DisplayViewTransform`` from the
   working space to a display and view of the config, looks optional): proofs, contact
   sheets, plots and the review page all show pixels through it;
-* :func:`chromaticities`, :func:`interop_id` and :func:`materialx_name` name a space the
-  way EXR headers, USD (``colorSpace:name``) and MaterialX (``colorspace``) spell it.
+* :func:`chromaticities` and :func:`interop_id` name a space the way EXR headers and USD
+  (``colorSpace:name``) spell it (MaterialX's names are the exporter's:
+  :func:`lookdev.pipeline.export.usd.mtlx.mtlx_color_space`).
 
 The default view is the config's own (the studio config: ``sRGB - Display`` /
 ``ACES 2.0 - SDR 100 nits (Rec.709)``): proofs judge materials under IBLs with a sun, and
@@ -83,7 +84,6 @@ __all__ = [
     "to_display",
     "chromaticities",
     "interop_id",
-    "materialx_name",
     "PRESET_LINEAR",
 ]
 
@@ -102,24 +102,6 @@ PRESET_LINEAR = "Linear Rec.709 (sRGB)"
 """The space of a preset's linear ``[r, g, b]`` (and grey scalar) colours: lookdev's
 presets were written in linear Rec.709, so an ACEScg working space converts them rather
 than reading Rec.709 numbers as AP1 ones (which would shift every hue)."""
-
-MATERIALX_NAMES = {
-    "lin_rec709_scene": "lin_rec709",
-    "lin_ap1_scene": "acescg",
-    "lin_ap0_scene": "lin_ap0",
-    "srgb_rec709_scene": "srgb_texture",
-    "g22_rec709_scene": "g22_rec709",
-    "g18_rec709_scene": "g18_rec709",
-    "g22_ap1_scene": "g22_ap1",
-    "lin_p3d65_scene": "lin_displayp3",
-    "srgb_p3d65_scene": "srgb_displayp3",
-    "lin_adobergb_scene": "lin_adobergb",
-    "g22_adobergb_scene": "adobergb",
-    "lin_rec2020_scene": "lin_rec2020",
-    "data": "raw",
-}
-"""Interop ID (USD's canonical name, OCIO 2.5's ``interop_id``) → MaterialX's colour-space
-name (MaterialX 1.39 ``cms/`` definitions)."""
 
 
 class ColourError(LookdevError):
@@ -432,25 +414,8 @@ def interop_id(space: str | None = None) -> str:
     found = cs.getInteropID() if hasattr(cs, "getInteropID") else ""
     if found:
         return found
-    canon = [a for a in cs.getAliases() if a in MATERIALX_NAMES]
+    canon = [a for a in cs.getAliases() if a.endswith("_scene")]  # USD's canonical form
     return canon[0] if canon else cs.getName()
-
-
-def materialx_name(space: str | None = None) -> str:
-    """MaterialX's name of ``space`` (default: the working space): ``lin_rec709``,
-    ``acescg``, ``srgb_texture``, ``raw``…; a :class:`ColourError` for a space MaterialX
-    does not define.
-
-    >>> materialx_name(), materialx_name("ACEScg"), materialx_name(SRGB_TEXTURE)
-    ('lin_rec709', 'acescg', 'srgb_texture')
-    """
-    key = interop_id(space)
-    if key not in MATERIALX_NAMES:
-        raise ColourError(
-            f"MaterialX defines no colour space for {space or working_space()!r} "
-            f"(it knows {', '.join(sorted(MATERIALX_NAMES.values()))})"
-        )
-    return MATERIALX_NAMES[key]
 
 
 @functools.cache

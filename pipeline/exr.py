@@ -24,7 +24,7 @@ import numpy as np
 from lookdev.library import files
 from lookdev.materials import colour
 
-__all__ = ["write_exr", "colour_space_of"]
+__all__ = ["write_exr", "colour_space_of", "name_colour_space"]
 
 
 def colour_space_of(pixels: np.ndarray, *, data: bool = False) -> str:
@@ -32,6 +32,20 @@ def colour_space_of(pixels: np.ndarray, *, data: bool = False) -> str:
     :data:`~lookdev.materials.colour.RAW` (one channel, or ``data`` such as normals)."""
     channels = 1 if np.ndim(pixels) == 2 else np.shape(pixels)[-1]
     return colour.RAW if data or channels not in (3, 4) else colour.working_space()
+
+
+def name_colour_space(spec, space: str | None = None) -> None:
+    """Set the colour-space attributes of an OpenImageIO ``spec`` about to be written:
+    ``colorSpace`` and ``oiio:ColorSpace`` (the config's name of ``space``, default the
+    working space) and, for a colour space, its ``chromaticities``. Every EXR lookdev
+    writes gets them here (:func:`write_exr`; the USD export's tiled, mip-mapped maps)."""
+    import OpenImageIO as oiio
+
+    name = colour.canonical(space) if space else colour.working_space()
+    spec.attribute("oiio:ColorSpace", name)
+    spec.attribute("colorSpace", name)
+    if not colour.is_data(name):
+        spec.attribute("chromaticities", oiio.TypeDesc("float[8]"), colour.chromaticities(name))
 
 
 def write_exr(
@@ -56,16 +70,12 @@ def write_exr(
         px = px[..., None]  # OpenImageIO reads a 2-D array as the wrong shape
     px = np.ascontiguousarray(px)
     height, width, channels = px.shape
-    name = colour.canonical(space) if space else colour.working_space()
     spec = oiio.ImageSpec(width, height, channels, oiio.FLOAT)
     spec.channelnames = {1: ("Y",), 3: ("R", "G", "B"), 4: ("R", "G", "B", "A")}.get(
         channels, tuple(f"C{i}" for i in range(channels))
     )
     spec.attribute("compression", "zip")
-    spec.attribute("oiio:ColorSpace", name)
-    spec.attribute("colorSpace", name)
-    if not colour.is_data(name):
-        spec.attribute("chromaticities", oiio.TypeDesc("float[8]"), colour.chromaticities(name))
+    name_colour_space(spec, space)
     out = oiio.ImageOutput.create(str(path))
     ok = out is not None and out.open(str(path), spec)
     message = "" if ok else (out.geterror() if out is not None else oiio.geterror())

@@ -81,6 +81,8 @@ def export_usd(
     library: Any = None,
     progress: Callable[[int, int, str], None] | None = None,
     preview_opacity: str = "keep",
+    collect: bool = False,
+    preview_geometry: bool = False,
 ) -> UsdExport:
     """Write materials as UsdShade materials under ``/Materials`` of ``path``.
 
@@ -88,7 +90,7 @@ def export_usd(
     ----------
     materials
         One or several preset names, paths or :class:`~lookdev.library.Material` s;
-        several make a library whose ``/Look`` prim switches between them.
+        several make a library whose ``/Materials/Look`` prim switches between them.
     path
         ``.usda``, ``.usdc``, ``.usd``, or ``.usdz`` (packaged with its textures).
     contexts
@@ -116,6 +118,12 @@ def export_usd(
         transmissive materials (DCCs read ``opacity`` as alpha) and names the loss;
         ``"transmission"``: the UsdPreviewSurface spec's reading, ``opacity = 1 −
         spec_trans`` (``1 − clear`` for Pixar).
+    collect
+        Copy every texture file a preset reads into ``<name>_textures`` beside ``path``
+        (UDIM tiles included), referenced by relative paths; otherwise the files are
+        referenced where they are, relative to ``path`` where possible.
+    preview_geometry
+        Add a sphere per material, bound to it, in a grid under ``/Materials/Geometry``.
 
     Returns
     -------
@@ -158,6 +166,8 @@ def export_usd(
         split=split,
         progress=progress,
         preview_opacity=preview_opacity,
+        collect=collect,
+        preview_geometry=preview_geometry,
     )
     return UsdExport(
         result.files[0],
@@ -351,6 +361,7 @@ def proof(
     report: bool = False,
     library: Any = None,
     progress: Callable[[Any], None] | None = None,
+    geometry: PathLike | None = None,
 ) -> dict[str, Any]:
     """Render turntable proofs (Burley §6.1): every material under every IBL.
 
@@ -392,6 +403,9 @@ def proof(
     progress
         Called with a :class:`lookdev.pipeline.proof.batch.Progress` about twice a second
         and as each proof finishes (``frames_done``, ``frames_total``, ``finished``).
+    geometry
+        A mesh (PLY, OBJ, or USD geometry) rendered in the cup's place beside the ball,
+        with its own UVs (:mod:`lookdev.pipeline.proof.geometry`).
 
     Returns
     -------
@@ -415,6 +429,11 @@ def proof(
     # and every texture it names (layers a blend would prune included), every IBL.
     output = Path(out)
     batch.check_writable(output)
+    mesh = None
+    if geometry is not None:
+        from lookdev.pipeline.proof.geometry import proof_mesh
+
+        mesh = str(proof_mesh(geometry))
     chosen = _materials(materials, lib)
     for material in chosen:
         check_textures(material)
@@ -423,7 +442,7 @@ def proof(
     ibl_names = list(dict.fromkeys(ibls or ibl_module.builtin_names()))
     environments = [ibl_module.load(name, ibl_width) for name in ibl_names]
     loaded = [hub(m, batch.MAP_RESOLUTION, lib) for m in chosen]
-    settings = batch.Settings(frames, light_frames, spp, tuple(resolution), exposure, rig)
+    settings = batch.Settings(frames, light_frames, spp, tuple(resolution), exposure, mesh, rig=rig)
     doc = batch.proof(
         loaded,
         environments,

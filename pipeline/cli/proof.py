@@ -114,6 +114,15 @@ def proof(
     as_json: Annotated[
         bool, typer.Option("--json", help="Print the batch manifest as one JSON object.")
     ] = False,
+    geometry: Annotated[
+        Path | None,
+        typer.Option(
+            "--geometry",
+            "-g",
+            help="A mesh (PLY, OBJ, or USD geometry) shown in the cup's place beside the "
+            "ball, with its own UVs (UDIM tiles included).",
+        ),
+    ] = None,
     report: Annotated[
         bool,
         typer.Option(
@@ -140,6 +149,8 @@ def proof(
       lookdev proof gold velvet --ibl studio --ibl ~/hdri/loft.exr -o proofs
 
       lookdev proof copper --spp 256 --resolution 640 320 --scheduler tcp://farm:8786
+
+      lookdev proof hero.toml --geometry hero.usd --ibl studio
 
       lookdev --working-space acescg --view Un-tone-mapped proof gold   # colour: global options
 
@@ -181,6 +192,7 @@ def proof(
             report=report,
             library=library,
             progress=show,
+            geometry=geometry,
         )
     if as_json:
         print_json(doc)

@@ -71,6 +71,9 @@ class Settings:
     spp: int = 32
     resolution: tuple[int, int] = (192, 96)
     exposure: float = 0.0  # display only: applied by the view transform, not the render
+    geometry: str | None = None
+    """A mesh in the cup's place (the cached PLY of :func:`.geometry.proof_mesh`: its
+    name holds the hash of the user's file, so the proof key follows the mesh)."""
     rig: str = DEFAULT_RIG  # the calibrated rig beside the material (.rig)
     colour: colour.Settings = field(default_factory=colour.pinned)
     """The OCIO config, working space and view the batch was asked in (workers are other
@@ -195,7 +198,14 @@ def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
     from .turntable import Turntable, material_bsdf, render_frame
 
     bsdf, depth = material_bsdf(job.material)
-    table = Turntable(bsdf, job.environment, job.settings.resolution, depth, rig=job.settings.rig)
+    table = Turntable(
+        bsdf,
+        job.environment,
+        job.settings.resolution,
+        depth,
+        job.settings.geometry,
+        rig=job.settings.rig,
+    )
     for frame in todo:
         r = render_frame(table, frame, job.settings.spp, seed=frame.index)
         stem = job.folder / f"frame_{frame.index:03d}"

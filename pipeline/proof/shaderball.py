@@ -222,11 +222,15 @@ def scene_dict(
     environment: np.ndarray,
     resolution: tuple[int, int],
     max_depth: int,
+    geometry: str | Path | None = None,
     *,
     rig: str = DEFAULT_RIG,
 ) -> dict[str, Any]:
     """The shader-ball scene; the same ``bsdf`` on the ball and the cup, the ``rig``
     (:mod:`.rig`: ``full``, ``balls`` or ``none``) beside them.
+
+    ``geometry``: a PLY already placed in the cup's slot (:func:`.geometry.proof_mesh`)
+    shown instead of the cup, turning about the same centre.
 
     ``environment`` is a lat-long (H, W, 3) float32 array, used as it is (exposure is
     already in its pixels, see :mod:`.ibl`) and oriented by :data:`.ibl.ORIENTATION`.
@@ -252,7 +256,7 @@ def scene_dict(
             "type": "shapegroup",
             "shape": {
                 "type": "ply",
-                "filename": str(cup_ply()),
+                "filename": str(geometry or cup_ply()),
                 "face_normals": False,
                 "bsdf": _material,
             },

@@ -72,12 +72,13 @@ class Turntable:
         environment: np.ndarray,
         resolution: tuple[int, int],
         max_depth: int,
+        geometry: str | None = None,
         *,
         rig: str = DEFAULT_RIG,
     ):
         import mitsuba as mi
 
-        scene = shaderball.scene_dict(bsdf, environment, resolution, max_depth, rig=rig)
+        scene = shaderball.scene_dict(bsdf, environment, resolution, max_depth, geometry, rig=rig)
         scene["sensor_pair"] = _sensor_pair(scene["sensor"])
         self.scene = mi.load_dict(scene)
         self.width = int(resolution[0])
