@@ -187,7 +187,7 @@ def _candidate(xp: Any, prep: dict[str, Any], lobe: str, wo: Any, u1: Any, u2: A
     return lobes.reflect(xp, wo, h)
 
 
-def scatter_sample(xp: Any, prep: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any, Any]:
+def scatter_sample(xp: Any, prep: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any, Any, bool]:
     s = xp.select(wo[2] < 0.0, -1.0, 1.0)
     wo = xp.vec3(wo[0], wo[1], wo[2] * s)
     wi = xp.vec3(xp.zeros(u[0]), xp.zeros(u[0]), xp.zeros(u[0]) + 1.0)
@@ -204,4 +204,4 @@ def scatter_sample(xp: Any, prep: dict[str, Any], wo: Any, u: Any) -> tuple[Any,
     pdf = xp.select(ok, _mixture_pdf(xp, prep, wi, wo), 0.0)
     f = scatter_eval(xp, prep, wi, wo)
     weight = f * xp.select(pdf > 0.0, xp.abs(wi[2]) / xp.maximum(pdf, xp.tiny), 0.0)
-    return xp.vec3(wi[0], wi[1], wi[2] * s), weight, pdf
+    return xp.vec3(wi[0], wi[1], wi[2] * s), weight, pdf, False  # no delta lobe
