@@ -96,7 +96,8 @@ def test_smooth_thin_sheet_reflects_f_and_passes_the_rest_straight_through(theta
         np.testing.assert_allclose(wi[~reflected], np.broadcast_to(-wo, wi[~reflected].shape))
         energy = w.mean(axis=0)  # E[weight] = R + T·√base, exactly the lobes' values
         stderr = w.std(axis=0) / math.sqrt(N)
-        np.testing.assert_array_less(np.abs(energy - (f + (1 - f) * np.sqrt(base))), 4 * stderr + 1e-12)
+        exact = f + (1 - f) * np.sqrt(base)
+        np.testing.assert_array_less(np.abs(energy - exact), 4 * stderr + 1e-12)
 
 
 def test_smooth_glass_inside_reflects_totally_beyond_the_critical_angle():
