@@ -50,7 +50,8 @@ CASES = [
         0.25,
     ),
     # Pixar: "α" here is the reflection cone's half-angle in radians (10·r degrees).
-    ("pixar", {"roughness": 0.0}, "pixar-r0", math.radians(0.5)),
+    ("pixar", {"roughness": 0.0}, "pixar-r0", None),  # a delta reflection over the diffuse
+    ("pixar", {"clear": 1.0, "roughness": 0.0, "ior": 1.52}, "pixar-clear-glass", None),
     ("pixar", {"roughness": 0.3}, "pixar-r0.3", math.radians(3.0)),
     ("pixar", {"roughness": 1.0}, "pixar-r1", None),
     ("pixar", {"metallic": 1.0, "roughness": 0.4}, "pixar-metal", math.radians(4.0)),
