@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from contextlib import ExitStack
+from enum import StrEnum
 from pathlib import Path
 from typing import Annotated
 
@@ -17,6 +18,14 @@ from rich.progress import (
 )
 
 from .common import console, err_console, print_json, table
+
+
+class Rig(StrEnum):
+    """``--rig``: the values of :data:`lookdev.pipeline.proof.rig.RIGS`."""
+
+    full = "full"
+    balls = "balls"
+    none = "none"
 
 
 def proof(
@@ -72,6 +81,14 @@ def proof(
             "--ibl-width", min=8, max=8192, help="Every IBL is resampled to this width (×½ high)."
         ),
     ] = 512,
+    rig: Annotated[
+        Rig,
+        typer.Option(
+            "--rig",
+            help="The calibrated rig beside the material: full (chrome ball, 18 % grey "
+            "ball, ColorChecker chart), balls, or none.",
+        ),
+    ] = Rig.full,
     scheduler: Annotated[
         str | None,
         typer.Option(
@@ -97,12 +114,23 @@ def proof(
     as_json: Annotated[
         bool, typer.Option("--json", help="Print the batch manifest as one JSON object.")
     ] = False,
+    geometry: Annotated[
+        Path | None,
+        typer.Option(
+            "--geometry",
+            "-g",
+            help="A mesh (PLY, OBJ, or USD geometry) shown in the cup's place beside the "
+            "ball, with its own UVs (UDIM tiles included).",
+        ),
+    ] = None,
     report: Annotated[
         bool,
         typer.Option(
             "--report",
-            help="Also write OUTPUT/index.html: contact sheets, time/noise table, each "
-            "material's BRDF plots and its frames; static, opens from disk.",
+            help="Also write OUTPUT/index.html, the review page: turntable players, a "
+            "synchronised comparison across materials or IBLs, raw/denoised, each "
+            "material's parameters, source, USD losses and BRDF plots, every frame's "
+            "spp/noise/time; static, opens from disk, offline.",
         ),
     ] = False,
 ) -> None:
@@ -121,6 +149,8 @@ def proof(
       lookdev proof gold velvet --ibl studio --ibl ~/hdri/loft.exr -o proofs
 
       lookdev proof copper --spp 256 --resolution 640 320 --scheduler tcp://farm:8786
+
+      lookdev proof hero.toml --geometry hero.usd --ibl studio
     """
     from lookdev.pipeline import api
     from lookdev.pipeline.proof import batch
@@ -151,11 +181,13 @@ def proof(
             resolution=resolution,
             exposure=exposure,
             ibl_width=ibl_width,
+            rig=rig.value,
             jobs=workers,
             scheduler=scheduler,
             report=report,
             library=library,
             progress=show,
+            geometry=geometry,
         )
     if as_json:
         print_json(doc)

@@ -14,7 +14,7 @@ from typing import Any
 
 from lookdev.library import files
 
-__all__ = ["export_materials"]
+__all__ = ["export_materials", "loss_notes"]
 
 
 def export_materials(
@@ -29,6 +29,8 @@ def export_materials(
     split: str | Path | None = None,
     progress: Callable[[int, int, str], None] | None = None,
     preview_opacity: str = "keep",
+    collect: bool = False,
+    preview_geometry: bool = False,
 ):
     """Write blended materials (:class:`~lookdev.pipeline.blend.BlendedMaterial`) as
     UsdShade materials to ``out``.
@@ -40,7 +42,9 @@ def export_materials(
     ``progress(done, total, name)`` is called after each material's network source is
     made (varying parameters are baked then). Maps are baked into a scratch folder beside
     ``out`` and only copied into place when every file could be written.
-    ``preview_opacity``: see :data:`.names.PREVIEW_OPACITY`.
+    ``preview_opacity``: see :data:`.names.PREVIEW_OPACITY`. ``collect`` copies the
+    presets' own texture files beside ``out``; ``preview_geometry`` adds a sphere per
+    material (:func:`.writer.export_usd`).
     """
     from .network import CONTEXTS
     from .sources import source_for
@@ -68,4 +72,27 @@ def export_materials(
             split_dir=None if split is None else Path(split),
             workdir=Path(scratch),
             preview_opacity=preview_opacity,
+            collect=collect,
+            preview_geometry=preview_geometry,
         )
+
+
+def loss_notes(
+    material: Any, contexts: Sequence[str] | None = None, preview_opacity: str = "keep"
+) -> dict[str, str]:
+    """``{context: note}``: what each render context of an export of ``material`` (a
+    blended material) could not express (``""``: nothing), as :func:`export_materials`
+    would record it, without writing a stage. Layered materials bake their maps into a
+    temporary folder that is removed afterwards.
+    """
+    import tempfile
+
+    from .network import CONTEXTS
+    from .sources import source_for
+    from .writer import losses_of, material_spec
+
+    contexts = tuple(contexts) if contexts else CONTEXTS
+    with tempfile.TemporaryDirectory(prefix="lookdev-losses-") as scratch:
+        source = source_for(material, Path(scratch, "textures"), scratch=Path(scratch))
+        spec = material_spec(source, contexts, preview_opacity)
+        return losses_of([spec])[spec.name]
