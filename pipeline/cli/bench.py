@@ -257,7 +257,9 @@ def glass_(
     resolution: Annotated[
         tuple[int, int], typer.Option("--resolution", help="Width and height in pixels.")
     ] = (128, 64),
-    repeat: Annotated[int, typer.Option("--repeat", min=1, help="Seeds (interleaved rounds).")] = 4,
+    repeat: Annotated[
+        int, typer.Option("--repeat", min=1, help="Seeds (interleaved rounds).")
+    ] = 16,
     as_json: JsonOut = False,
 ) -> None:
     """Cost of our glass at equal noise against Mitsuba's dielectric / roughdielectric.

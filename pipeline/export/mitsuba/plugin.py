@@ -22,6 +22,14 @@ Conventions at the boundary, and only here (DESIGN.md, Conventions):
   : 1`` in ``sample``), and like it the refracting component is flagged ``NonSymmetric``.
   Reflection, thin sheets and η = 1 do not refract and are symmetric in both modes.
 
+Delta lobes. A model may sample some lobes as Dirac deltas (smooth glass, mirrors:
+``prepared["delta"]``, :mod:`lookdev.materials.disney_interface`). They form their own
+components, flagged ``DeltaReflection`` / ``DeltaTransmission`` (a BSDF with no other
+lobe has no ``Smooth`` flag, so the path tracer samples no light at its vertices);
+``eval`` and ``pdf`` leave them out, as the model does, and a sample of one reports that
+type and component (the model's ``delta`` mask), its pdf the probability of its choice.
+A context that asks for the smooth components only gets such samples with weight 0.
+
 Parameters arrive as Mitsuba properties, one per schema field: a constant (float, bool,
 string, ``rgb``) or a texture (``bitmap`` …). Constants are handed to ``prepare`` as Python
 values, so a lobe whose weight is a constant zero is pruned while the kernel is traced;
