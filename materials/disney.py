@@ -26,8 +26,10 @@ roughness² (BRDF Explorer; Schutte squares it). Transmission uses the radiance-
 1/η² (pbrt-v4, Mitsuba; Schutte omits it for his VCM).
 
 Thin surfaces look the same from both sides; a solid one shows only its glass from inside.
-Sampling picks a lobe with probability proportional to its estimated albedo; a lobe whose
-weight is a known zero is neither evaluated nor sampled.
+Sampling picks a lobe with probability proportional to its estimated albedo; the
+specular reflection and the glass transmission are one choice, split by the Fresnel term,
+and below the glossy minimum α they are delta lobes (:mod:`.disney_interface`). A lobe
+whose weight is a known zero is neither evaluated nor sampled.
 
 >>> import numpy as np
 >>> from .params import DisneyParams
