@@ -81,6 +81,7 @@ def export_usd(
     library: Any = None,
     progress: Callable[[int, int, str], None] | None = None,
     preview_opacity: str = "keep",
+    meters_per_unit: float = 1.0,
 ) -> UsdExport:
     """Write materials as UsdShade materials under ``/Materials`` of ``path``.
 
@@ -116,6 +117,9 @@ def export_usd(
         transmissive materials (DCCs read ``opacity`` as alpha) and names the loss;
         ``"transmission"``: the UsdPreviewSurface spec's reading, ``opacity = 1 −
         spec_trans`` (``1 − clear`` for Pixar).
+    meters_per_unit
+        The stage's ``metersPerUnit`` (0.01 for a centimetre scene). lookdev's lengths
+        (``scatter_distance``) are metres; the subsurface radius is written in these units.
 
     Returns
     -------
@@ -158,6 +162,7 @@ def export_usd(
         split=split,
         progress=progress,
         preview_opacity=preview_opacity,
+        meters_per_unit=meters_per_unit,
     )
     return UsdExport(
         result.files[0],

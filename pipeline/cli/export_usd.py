@@ -87,6 +87,16 @@ def export_usd(
             "opacity = 1 - spec_trans.",
         ),
     ] = PreviewOpacity.keep,
+    meters_per_unit: Annotated[
+        float,
+        typer.Option(
+            "--meters-per-unit",
+            min=1e-9,
+            max=1e9,
+            help="The stage's metersPerUnit (0.01 for a centimetre scene); lookdev's lengths "
+            "(scatter_distance, metres) are written in these units.",
+        ),
+    ] = 1.0,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
     """Write presets as UsdShade materials that DCCs and their renderers read.
@@ -100,6 +110,13 @@ def export_usd(
     default and lobes without weight are left out. Layered presets are blended and their
     varying parameters baked to EXR maps beside the file (UsdPreviewSurface has no mix
     node). With several presets, /Look carries a variant set that switches between them.
+
+    Clearcoat in UsdPreviewSurface: clearcoat = 0.25 x lookdev's clearcoat (Burley weights
+    his GTR1 coat 0.25, the spec's coat is unweighted: the scale keeps the coat's reflected
+    energy) and clearcoatRoughness = sqrt(mix(0.1, 0.001, clearcoat_gloss)) (Burley's coat
+    alpha, squared back by the spec); import divides and inverts the same way. The
+    subsurface radius is scatter_distance (metres) / --meters-per-unit, 1 mm where only
+    Burley 2012's distance-less subsurface is live.
 
     Examples:
 
@@ -127,6 +144,7 @@ def export_usd(
             library=library,
             progress=progress,
             preview_opacity=preview_opacity.value,
+            meters_per_unit=meters_per_unit,
         )
     if as_json:
         print_json(result.to_json())
@@ -188,14 +206,26 @@ def import_usd(
     force: Annotated[
         bool, typer.Option("--force", help="Replace preset files of the same name in -o.")
     ] = False,
+    rename: Annotated[
+        bool,
+        typer.Option(
+            "--rename",
+            help="Import a material whose name another one or a library preset has as "
+            "NAME_imported (default: refuse).",
+        ),
+    ] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
     """Read materials from a USD file back into presets.
 
-    Reads UsdPreviewSurface networks from any tool, and lookdev's own MaterialX and
-    RenderMan networks, which carry every parameter. A preset holds constants: a
-    parameter fed by a texture is named with its map's path in a comment of the TOML
-    (and under "maps" with --json), and what a surface could not say is listed too.
+    Reads UsdPreviewSurface, OpenPBR and Standard Surface networks from any tool
+    (values followed through the Material's interface inputs), and gives a lookdev
+    export back exactly (its preset travels in the Material's customData). A preset
+    holds constants: a parameter fed by a texture is written as a comment holding its
+    texture table (and under "maps" with --json); what a preset cannot hold (alpha and
+    cut-outs, normal, emission, occlusion, a specular-workflow conversion) is printed
+    and listed as "# loss:" lines. A name that another material of the file or, with
+    -o, a library preset already has is refused unless --rename.
 
     Examples:
 
@@ -208,12 +238,13 @@ def import_usd(
     (out of range, NaN, infinity) is refused, never clamped; an existing preset file is
     replaced only with --force.
     """
-    from lookdev.pipeline.export.usd.presets import write_presets
+    from lookdev.pipeline.export.usd.presets import import_names, write_presets
     from lookdev.pipeline.export.usd.reader import import_usd as read
 
     skipped: list[str] = []
     found = read(file.expanduser(), skipped)
-    written = write_presets(found, output, force=force)
+    names = import_names(found, _library_names(output), rename=rename)
+    written = write_presets(found, output, force=force, names=names)
     if as_json:
         print_json(
             {
@@ -221,13 +252,18 @@ def import_usd(
                 "materials": [
                     {
                         "name": m.name,
+                        "preset": name,
                         "model": m.model,
                         "params": m.params,
-                        "maps": {k: str(v) for k, v in m.maps.items()},
+                        "maps": {
+                            k: v.model_dump(mode="json", exclude_defaults=True)
+                            | {"texture": v.texture}
+                            for k, v in m.maps.items()
+                        },
                         "contexts": m.contexts,
                         "loss": m.loss,
                     }
-                    for m in found
+                    for m, name in zip(found, names, strict=True)
                 ],
                 "written": [str(p) for p in written],
                 "skipped": skipped,
@@ -236,11 +272,13 @@ def import_usd(
     elif output is None:
         from lookdev.pipeline.export.usd.presets import preset_toml
 
-        for m in found:
-            typer.echo(preset_toml(m))
+        for m, name in zip(found, names, strict=True):
+            typer.echo(preset_toml(m, name))
     else:
-        for path in written:
+        for path, m in zip(written, found, strict=True):
             console.print(f"wrote [bold]{path}[/]")
+            for line in m.loss:
+                console.print(f"  loss: {line}", markup=False, highlight=False)
     if skipped:
         from lookdev.pipeline.export.usd.network import ExportError
 
@@ -249,6 +287,23 @@ def import_usd(
             + ", ".join(skipped),
             where=str(file),
         )
+
+
+def _library_names(output: Path | None) -> set[str]:
+    """Names of the library's presets an import into ``output`` must not take (none when
+    only printing); a preset whose file ``output`` would replace is --force's business."""
+    if output is None:
+        return set()
+    from lookdev.library import Library
+
+    library = Library()
+    target = output.expanduser().resolve()
+    names = set()
+    for name in library.names():
+        path = library.find(name).resolve()
+        if path != target and path.parent != target:
+            names.add(name)
+    return names
 
 
 @validate_app.command("usd")

@@ -29,6 +29,7 @@ def export_materials(
     split: str | Path | None = None,
     progress: Callable[[int, int, str], None] | None = None,
     preview_opacity: str = "keep",
+    meters_per_unit: float = 1.0,
 ):
     """Write blended materials (:class:`~lookdev.pipeline.blend.BlendedMaterial`) as
     UsdShade materials to ``out``.
@@ -40,9 +41,11 @@ def export_materials(
     ``progress(done, total, name)`` is called after each material's network source is
     made (varying parameters are baked then). Maps are baked into a scratch folder beside
     ``out`` and only copied into place when every file could be written.
-    ``preview_opacity``: see :data:`.names.PREVIEW_OPACITY`.
+    ``preview_opacity``: see :data:`.names.PREVIEW_OPACITY`. ``meters_per_unit``: the
+    stage's ``metersPerUnit`` (lengths are written in its units).
     """
     from .network import CONTEXTS
+    from .record import preset_record
     from .sources import source_for
     from .writer import export_usd as write
 
@@ -56,7 +59,9 @@ def export_materials(
         texture_dir = Path(scratch, textures) if package else out.parent / textures
         sources = []
         for material in materials:
-            sources.append(source_for(material, texture_dir, scratch=Path(scratch), bake=bake))
+            source = source_for(material, texture_dir, scratch=Path(scratch), bake=bake)
+            source.record = preset_record(material)
+            sources.append(source)
             if progress is not None:
                 progress(len(sources), count or len(sources), material.name)
         return write(
@@ -68,4 +73,5 @@ def export_materials(
             split_dir=None if split is None else Path(split),
             workdir=Path(scratch),
             preview_opacity=preview_opacity,
+            meters_per_unit=meters_per_unit,
         )

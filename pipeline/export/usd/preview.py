@@ -17,7 +17,6 @@ from .network import Connection, Image, Network, Node, Source, loss_note, surfac
 from .textures import converted
 
 SURFACE = "preview_surface"
-SPECULAR_WORKFLOW = ("pixar_weights",)  # models whose highlight is a colour, not metallic
 ST_READER = "preview_st"
 SHAPE_NOTES = {
     "disney": {
@@ -31,7 +30,9 @@ SHAPE_NOTES = {
     },
     "pixar_weights": {
         "highlights": "the blend's specular and reflection lobes become one GGX lobe with "
-        "their energy-weighted roughness and Schlick's edge, not their grazing weights",
+        "their energy-weighted roughness and Schlick's edge, not their grazing weights; "
+        "their F0 colour and the diffuse are solved per texel for a base colour and a "
+        "metallic (metallic workflow: a dielectric F0 other than the ior's shifts to metallic)",
         "diffuse": "the diffuse is its weight at normal incidence",
         "diffuse_t": "no transmitted diffuse lobe",
         "transmission": "no refraction: a blend's transmitted lobes are not expressed",
@@ -71,8 +72,6 @@ def build(source: Source, preview_opacity: str = "keep") -> Network:
     nodes: list[Node] = []
     table = table_for("universal", source.model, preview_opacity)
     inputs = surface_inputs(source, table, preview_defaults(), nodes, _texture)
-    if source.model in SPECULAR_WORKFLOW:
-        inputs["useSpecularWorkflow"] = ("int", 1)
     if source.normal_map is not None:
         inputs["normal"] = _normal(nodes, source.normal_map)
     lobes = source.lobes

@@ -27,6 +27,7 @@ from .network import (
     Node,
     Source,
     loss_note,
+    subsurface_radius,
     surface_inputs,
 )
 from .textures import converted
@@ -67,11 +68,14 @@ SURFACE = "ri_surface"
 RI_DEFAULTS = {"metallic": 0.0, "anisotropic": 0.0, "specularTint": 0.0}
 
 
-def build(source: Source) -> Network:
-    """The RenderMan network of ``source``."""
+def build(source: Source, meters_per_unit: float = 1.0) -> Network:
+    """The RenderMan network of ``source``; lengths in scene units of ``meters_per_unit``."""
     nodes: list[Node] = []
     table = table_for("ri", source.model)
     inputs = surface_inputs(source, table, RI_DEFAULTS, nodes, _texture)
+    radius = ""
+    if source.model == "disney":
+        radius = subsurface_radius(source, inputs, "scatterDistances", meters_per_unit)
     if source.normal_map is not None:
         nodes.append(
             Node(
@@ -84,6 +88,8 @@ def build(source: Source) -> Network:
         inputs["bumpNormal"] = ("normal3f", Connection("ri_normal_map", "resultN"))
     node_id = SURFACE_IDS[("ri", source.model)]
     extra = [EXTRA_LOSS[source.model]] if source.model in EXTRA_LOSS else []
+    if radius:
+        extra.append(radius)
     if source.model in PXR_SURFACE_MODELS:
         inputs.update(_pixar_gains(source.lobes))
         if source.lobes["reflection_t"]:

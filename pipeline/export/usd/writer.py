@@ -8,6 +8,7 @@ succeeded, so a failure leaves no partial file (:class:`Staging`).
 
 from __future__ import annotations
 
+import math
 import os
 import shutil
 import tempfile
@@ -39,16 +40,24 @@ USD_SUFFIXES = (".usda", ".usdc", ".usd")
 
 
 def material_spec(
-    source: Source, contexts: tuple[str, ...], preview_opacity: str = "keep"
+    source: Source,
+    contexts: tuple[str, ...],
+    preview_opacity: str = "keep",
+    meters_per_unit: float = 1.0,
 ) -> MaterialSpec:
-    """The networks of ``source`` for each of ``contexts`` and the material's metadata."""
+    """The networks of ``source`` for each of ``contexts`` and the material's metadata
+    (lengths in scene units of ``meters_per_unit``, the stage's)."""
     custom = {
         "preset": source.name,
         "model": source.model,
         "spelling": source.spelling,
     }
+    if source.record:
+        custom["record"] = source.record
     networks = [
-        preview.build(source, preview_opacity) if c == "universal" else BUILDERS[c](source)
+        preview.build(source, preview_opacity)
+        if c == "universal"
+        else BUILDERS[c](source, meters_per_unit)
         for c in contexts
     ]
     return MaterialSpec(source.name, networks, custom)
@@ -107,12 +116,13 @@ def relative_asset(path: Path, base: Path) -> str:
     return rel if rel.startswith("../") else f"./{rel}"
 
 
-def new_layer(default_prim: str = "Materials"):
-    """An empty anonymous layer with the stage metadata validators expect."""
+def new_layer(default_prim: str = "Materials", meters_per_unit: float = 1.0):
+    """An empty anonymous layer with the stage metadata validators expect; lengths
+    written into it are in units of ``meters_per_unit`` metres."""
     layer = Sdf.Layer.CreateAnonymous(".usda")
     layer.defaultPrim = default_prim
     layer.pseudoRoot.SetInfo("upAxis", "Y")
-    layer.pseudoRoot.SetInfo("metersPerUnit", 1.0)
+    layer.pseudoRoot.SetInfo("metersPerUnit", float(meters_per_unit))
     return layer
 
 
@@ -276,6 +286,7 @@ def export_usd(
     split_dir: Path | None = None,
     workdir: Path | None = None,
     preview_opacity: str = "keep",
+    meters_per_unit: float = 1.0,
 ) -> ExportResult:
     """Export ``sources`` to ``out`` (``.usda``/``.usdc``/``.usd``, or ``.usdz`` to package).
 
@@ -283,6 +294,8 @@ def export_usd(
     ``mtlx_path``: also a standalone MaterialX document. ``workdir`` (packages): where the
     stage is staged before packaging; textures below it keep their path relative to it
     inside the ``.usdz``. ``preview_opacity``: see :data:`.names.PREVIEW_OPACITY`.
+    ``meters_per_unit``: the stage's ``metersPerUnit``; lengths (the subsurface radius,
+    lookdev's ``scatter_distance`` in metres) are written in those units.
     Nothing is left behind on error.
     """
     out = Path(out)
@@ -304,15 +317,21 @@ def export_usd(
             f"preview opacity {preview_opacity!r}: use {' or '.join(PREVIEW_OPACITY)}",
             where=str(out),
         )
-    specs = [material_spec(s, contexts, preview_opacity) for s in sources]
+    if not (meters_per_unit > 0.0 and math.isfinite(meters_per_unit)):
+        raise ExportError(
+            f"metersPerUnit {meters_per_unit!r}: give a positive finite number", where=str(out)
+        )
+    specs = [material_spec(s, contexts, preview_opacity, meters_per_unit) for s in sources]
     _check_names(specs, out)
     images = images_of(specs)
     check_images(images)
     with Staging() as staging:  # commits on success; removes every temporary otherwise
         if package:
-            written = _write_package(specs, images, out, Path(workdir or out.parent), staging)
+            written = _write_package(
+                specs, images, out, Path(workdir or out.parent), staging, meters_per_unit
+            )
         else:
-            written = _write_all(specs, images, out, split_dir, staging)
+            written = _write_all(specs, images, out, split_dir, staging, meters_per_unit)
         if mtlx_path is not None:
             mtlx.write_document(specs, staging.temp_for(Path(mtlx_path)), where=mtlx_path)
             written.append(Path(mtlx_path))
@@ -335,7 +354,7 @@ def _check_names(specs: list[MaterialSpec], out: Path) -> None:
         raise ExportError("no materials to export", where=str(out))
 
 
-def _write_all(specs, images, out, split_dir, staging) -> list[Path]:
+def _write_all(specs, images, out, split_dir, staging, meters_per_unit=1.0) -> list[Path]:
     for image in images:
         if image.write:
             staging.folder(image.path.parent)
@@ -343,13 +362,15 @@ def _write_all(specs, images, out, split_dir, staging) -> list[Path]:
     files = [out, *(i.path for i in images if i.write)]
     if split_dir is not None:
         staging.folder(Path(split_dir))
-        return files + _write_split(specs, out, Path(split_dir), staging)
-    layer = _one_layer(specs, out.parent)
+        return files + _write_split(specs, out, Path(split_dir), staging, meters_per_unit)
+    layer = _one_layer(specs, out.parent, meters_per_unit)
     _export_layer(layer, staging.temp_for(out), out)
     return files
 
 
-def _write_package(specs, images, out: Path, workdir: Path, staging: Staging) -> list[Path]:
+def _write_package(
+    specs, images, out: Path, workdir: Path, staging: Staging, meters_per_unit: float = 1.0
+) -> list[Path]:
     """A ``.usdz`` holding the stage and every texture it references."""
     from pxr import UsdUtils
 
@@ -363,7 +384,7 @@ def _write_package(specs, images, out: Path, workdir: Path, staging: Staging) ->
         os.close(fd)
         root = Path(name)
     try:
-        _export_layer(_one_layer(specs, workdir), root)
+        _export_layer(_one_layer(specs, workdir, meters_per_unit), root)
         if not UsdUtils.CreateNewUsdzPackage(str(root), str(staging.temp_for(out))):
             raise ExportError("USD could not write the package", where=str(out))
     finally:
@@ -371,9 +392,9 @@ def _write_package(specs, images, out: Path, workdir: Path, staging: Staging) ->
     return [out]
 
 
-def _one_layer(specs: list[MaterialSpec], base: Path):
+def _one_layer(specs: list[MaterialSpec], base: Path, meters_per_unit: float = 1.0):
     """Every material in one layer, with the ``/Look`` switch when there are several."""
-    layer = new_layer()
+    layer = new_layer(meters_per_unit=meters_per_unit)
     paths = author(layer, specs, base)
     if len(specs) > 1:
         add_switch(layer, {prim_name(s.name): ("", p) for s, p in zip(specs, paths, strict=True)})
@@ -387,15 +408,17 @@ def _write_image(image: Image, target: Path, shown: Path | None = None) -> None:
         write_image(target, image.pixels, shown)
 
 
-def _write_split(specs, out: Path, folder: Path, staging: Staging) -> list[Path]:
+def _write_split(
+    specs, out: Path, folder: Path, staging: Staging, meters_per_unit: float = 1.0
+) -> list[Path]:
     files, targets = [], {}
-    library = new_layer()
+    library = new_layer(meters_per_unit=meters_per_unit)
     scope = Sdf.CreatePrimInLayer(library, "/Materials")
     scope.specifier, scope.typeName = Sdf.SpecifierDef, "Scope"
     for spec in specs:
         name = prim_name(spec.name)
         path = folder / f"{name}.usda"
-        layer = new_layer()
+        layer = new_layer(meters_per_unit=meters_per_unit)
         (prim_path,) = author(layer, [spec], folder)
         _export_layer(layer, staging.temp_for(path), path)
         asset = relative_asset(path, out.parent)

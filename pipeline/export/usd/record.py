@@ -1,0 +1,63 @@
+"""The preset an export came from, carried in the Material's ``customData`` so that
+``lookdev import usd`` gives it back exactly (issue 15: every lookdev export round-trips).
+
+The networks say what each renderer can express; this record says what the preset *was*:
+its model, description, tags, citation and the parameters it gave (a plain preset, after
+``extends`` is resolved) or its layer document as the file wrote it (a layered preset:
+the layers name their presets and mask files as the file did). It is a JSON string under
+``customData["lookdev"]["record"]``: USD keeps a string exactly, floats included.
+"""
+
+from __future__ import annotations
+
+import json
+import tomllib
+from pathlib import Path
+from typing import Any
+
+__all__ = ["RECORD_KEY", "preset_record", "read_record"]
+
+RECORD_KEY = "record"
+
+
+def preset_record(hub: Any) -> str:
+    """The JSON record of the blended material ``hub`` (``""`` when nothing is known)."""
+    origin = getattr(hub, "origin", None)
+    doc: dict[str, Any] = {"name": hub.name}
+    if getattr(hub, "layered", False):
+        path = getattr(origin, "source", None)
+        if path is None or not Path(path).is_file():
+            return ""
+        doc = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+        doc["name"] = hub.name
+        doc.pop("extends", None)  # resolved: the layers below are the ones exported
+        if not doc.get("layers"):
+            layers = getattr(origin, "layers", None) or []
+            if not layers:
+                return ""
+        return json.dumps(doc, sort_keys=True)
+    params = getattr(origin, "params", None)
+    if params is None:
+        params = hub.params
+    doc["model"] = hub.model
+    doc["params"] = params.model_dump(mode="json", exclude_unset=True, exclude_none=True)
+    for key, value in (
+        ("description", hub.description or getattr(origin, "description", "")),
+        ("tags", list(getattr(origin, "tags", []) or [])),
+        ("source", getattr(origin, "citation", None)),
+    ):
+        if value:
+            doc[key] = value
+    return json.dumps(doc, sort_keys=True)
+
+
+def read_record(custom: dict[str, Any]) -> dict[str, Any] | None:
+    """The preset document a lookdev export carried, or None (another tool's file)."""
+    text = custom.get(RECORD_KEY)
+    if not isinstance(text, str) or not text:
+        return None
+    try:
+        doc = json.loads(text)
+    except ValueError:
+        return None
+    return doc if isinstance(doc, dict) and "name" in doc else None
