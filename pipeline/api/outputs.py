@@ -50,10 +50,14 @@ class UsdExport:
     contexts: tuple[str, ...]
     textures: list[Path]
     losses: dict[str, dict[str, str]] = field(default_factory=dict)
+    fidelity: dict[str, Any] = field(default_factory=dict)
+    """material → its universal context measured against it (``report=True``):
+    :class:`lookdev.pipeline.export.usd.fidelity.Fidelity`."""
 
     def to_json(self) -> dict[str, Any]:
         """The summary ``lookdev export usd --json`` prints."""
-        return {
+        extra = {"fidelity": [f.to_json() for f in self.fidelity.values()]} if self.fidelity else {}
+        return extra | {
             "output": str(self.output),
             "files": [str(p) for p in self.files],
             "materials": self.materials,
@@ -82,6 +86,7 @@ def export_usd(
     progress: Callable[[int, int, str], None] | None = None,
     preview_opacity: str = "keep",
     meters_per_unit: float = 1.0,
+    report: bool = False,
 ) -> UsdExport:
     """Write materials as UsdShade materials under ``/Materials`` of ``path``.
 
@@ -120,6 +125,10 @@ def export_usd(
     meters_per_unit
         The stage's ``metersPerUnit`` (0.01 for a centimetre scene). lookdev's lengths
         (``scatter_distance``) are metres; the subsurface radius is written in these units.
+    report
+        Measure each material's UsdPreviewSurface against the material (directional
+        albedo over view angles and the highlight, see
+        :mod:`lookdev.pipeline.export.usd.fidelity`): ``UsdExport.fidelity``.
 
     Returns
     -------
@@ -163,6 +172,7 @@ def export_usd(
         progress=progress,
         preview_opacity=preview_opacity,
         meters_per_unit=meters_per_unit,
+        report=report,
     )
     return UsdExport(
         result.files[0],
@@ -171,6 +181,7 @@ def export_usd(
         contexts,
         result.images,
         result.losses,
+        result.fidelity,
     )
 
 

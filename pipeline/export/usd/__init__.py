@@ -30,6 +30,7 @@ def export_materials(
     progress: Callable[[int, int, str], None] | None = None,
     preview_opacity: str = "keep",
     meters_per_unit: float = 1.0,
+    report: bool = False,
 ):
     """Write blended materials (:class:`~lookdev.pipeline.blend.BlendedMaterial`) as
     UsdShade materials to ``out``.
@@ -42,7 +43,9 @@ def export_materials(
     made (varying parameters are baked then). Maps are baked into a scratch folder beside
     ``out`` and only copied into place when every file could be written.
     ``preview_opacity``: see :data:`.names.PREVIEW_OPACITY`. ``meters_per_unit``: the
-    stage's ``metersPerUnit`` (lengths are written in its units).
+    stage's ``metersPerUnit`` (lengths are written in its units). ``report``: measure each
+    material's universal context against the material (:mod:`.fidelity`), in the
+    result's ``fidelity``.
     """
     from .network import CONTEXTS
     from .record import preset_record
@@ -58,13 +61,18 @@ def export_materials(
         textures = f"{out.stem}_textures"
         texture_dir = Path(scratch, textures) if package else out.parent / textures
         sources = []
+        measured: dict = {}
         for material in materials:
             source = source_for(material, texture_dir, scratch=Path(scratch), bake=bake)
             source.record = preset_record(material)
             sources.append(source)
+            if report:
+                from .fidelity import fidelity
+
+                measured[material.name] = fidelity(material, source, preview_opacity)
             if progress is not None:
                 progress(len(sources), count or len(sources), material.name)
-        return write(
+        result = write(
             sources,
             out,
             contexts=contexts,
@@ -75,3 +83,5 @@ def export_materials(
             preview_opacity=preview_opacity,
             meters_per_unit=meters_per_unit,
         )
+        result.fidelity = measured
+        return result

@@ -263,6 +263,8 @@ class ExportResult:
     materials: list[str]
     images: list[Path]
     losses: dict[str, dict[str, str]] = field(default_factory=dict)
+    fidelity: dict[str, Any] = field(default_factory=dict)
+    """material → :class:`.fidelity.Fidelity` when the export was asked to measure."""
 
 
 def losses_of(specs: list[MaterialSpec]) -> dict[str, dict[str, str]]:
