@@ -21,6 +21,7 @@ from typing import Any
 from .live import mixed_input
 from .names import SURFACE_IDS, Slot, mapped_params, table_for
 from .network import (
+    LOCAL,
     Connection,
     ExportError,
     Image,
@@ -28,6 +29,7 @@ from .network import (
     Network,
     Node,
     Source,
+    local_subsurface,
     loss_note,
     prim_name,
     subsurface_radius,
@@ -90,7 +92,8 @@ def build(source: Source, meters_per_unit: float = 1.0) -> Network:
     inputs = surface_inputs(source, table, node_defaults(node_id), nodes, _live_or_baked(source))
     extra = [EXTRA_LOSS[source.model]] if source.model in EXTRA_LOSS else []
     if source.model == "disney":
-        extra.append(subsurface_radius(source, inputs, "subsurfaceDistance", meters_per_unit))
+        radius = subsurface_radius(source, inputs, "subsurfaceDistance", meters_per_unit)
+        extra.append(radius)
         extra.append(_frosted(source))
         extra = [e for e in extra if e]
     if source.normal_map is not None and source.model == "disney":
@@ -104,6 +107,8 @@ def build(source: Source, meters_per_unit: float = 1.0) -> Network:
         mapped |= _sheen(source.live_values, extra)
     note = loss_note(source, node_id, mapped, "; ".join(extra))
     surface = Node(SURFACE, node_id, inputs, {"out": "token"}, {"loss": note})
+    if source.model == "disney" and local_subsurface(source):
+        surface.custom["subsurface_radius"] = LOCAL
     return Network("mtlx", Connection(SURFACE, "out"), [surface, *nodes])
 
 

@@ -178,9 +178,23 @@ does not travel, so a renderer's diffusion radius must be small against the shad
 (1 mm; skin's mean free paths are of that order). MaterialX's default, one scene unit
 (1 m at metersPerUnit 1), made skin and marble glow through."""
 
+LOCAL = "local"
+"""Shader ``customData`` ``subsurface_radius`` value marking :data:`LOCAL_SUBSURFACE_M`
+(so an import reads it back as no distance)."""
+
 UNIT = "m"
 """lookdev's length unit: ``scatter_distance`` is in metres (the proof scene's unit); an
 export divides lengths by the stage's ``metersPerUnit``."""
+
+
+def local_subsurface(source: Source) -> bool:
+    """True when only Burley 2012's distance-less subsurface is live (no distance given)."""
+    lobes = source.lobes
+    return (
+        bool(lobes.get("subsurface"))
+        and not lobes.get("scatter")
+        and ("scatter_distance" not in source.maps)
+    )
 
 
 def subsurface_radius(
@@ -204,7 +218,7 @@ def subsurface_radius(
         d = source.live_values["scatter_distance"] / meters_per_unit
         inputs[name] = ("color3f", (d, d, d))
         return ""
-    if lobes.get("subsurface"):
+    if local_subsurface(source):
         d = LOCAL_SUBSURFACE_M / meters_per_unit
         inputs[name] = ("color3f", (d, d, d))
         return (

@@ -35,6 +35,7 @@ from .names import DERIVED_FROM, SURFACE_IDS, table_for
 from .network import (
     CONTEXT_OUTPUT,
     F0_KEYS,
+    LOCAL,
     Connection,
     ExportError,
     Image,
@@ -227,7 +228,8 @@ def _imported(spec: MaterialSpec) -> Imported | None:
         surface = _surface(net, context, model)
         if surface is None:
             continue
-        _read_surface(net, surface, context, model, values, result)
+        units = spec.custom.get("meters_per_unit", 1.0)
+        _read_surface(net, surface, context, model, values, result, units)
         if context == "universal":
             nodes = {n.name: n for n in net.nodes}
             result.loss.extend(preview_extras(surface, nodes, _texture_file))
@@ -292,12 +294,14 @@ def _surface(net: Network | None, context: str, model: str) -> Node | None:
     return node
 
 
-def _read_surface(net, surface, context, model, values, result) -> None:
+def _read_surface(net, surface, context, model, values, result, units: float = 1.0) -> None:
     """Values of one surface into ``values`` (our names), maps into ``result.maps``.
 
     Unwritten inputs of a lobe take the target's default only once the written ones
     show the lobe live: lookdev prunes a dead lobe's inputs, and their target defaults
-    (MaterialX's ``subsurfaceDistance`` = 1) must not bring it back to life.
+    (MaterialX's ``subsurfaceDistance`` = 1) must not bring it back to life. Lengths
+    come back in metres (× the stage's ``units``, metersPerUnit); a radius lookdev wrote
+    for Burley 2012's distance-less subsurface (marked on the shader) is no distance.
     """
     defaults = _defaults(context, surface.id)
     nodes = {n.name: n for n in net.nodes}
@@ -306,9 +310,12 @@ def _read_surface(net, surface, context, model, values, result) -> None:
     pending = []
     if model == "pixar" and context != "universal":
         table = tuple(s for s in table if s.param not in DERIVED_FROM)
+    local = surface.custom.get("subsurface_radius") == LOCAL
     for slot in table:
         if slot.param == "ior" and has_specular:
             continue  # there `ior` only refracts and equals the specular's IOR by construction
+        if slot.param == "scatter_distance" and local:
+            continue
         given = surface.inputs.get(slot.input)
         if given is not None and isinstance(given[1], Connection):
             texture = _texture_input(nodes, given[1], slot)  # None for a live mix chain
@@ -316,6 +323,8 @@ def _read_surface(net, surface, context, model, values, result) -> None:
                 result.maps.setdefault(slot.param, texture)
         elif given is not None:
             values[slot.param] = slot.from_target(given[1])
+            if slot.param == "scatter_distance":
+                values[slot.param] *= units
         elif defaults is not None and slot.input in defaults:
             pending.append(slot)
     lobes = active_lobes(values, model)

@@ -20,12 +20,14 @@ from typing import Any
 
 from .names import SURFACE_IDS, Slot, mapped_params, table_for
 from .network import (
+    LOCAL,
     Connection,
     ExportError,
     Image,
     Network,
     Node,
     Source,
+    local_subsurface,
     loss_note,
     subsurface_radius,
     surface_inputs,
@@ -96,6 +98,8 @@ def build(source: Source, meters_per_unit: float = 1.0) -> Network:
             extra.append(GLASS_REFLECTION)
     note = loss_note(source, node_id, mapped_params("ri", source.model), "; ".join(extra))
     surface = Node(SURFACE, node_id, inputs, {"bxdf_out": "token"}, {"loss": note})
+    if source.model == "disney" and local_subsurface(source):
+        surface.custom["subsurface_radius"] = LOCAL
     net = Network("ri", Connection(SURFACE, "bxdf_out"), [surface, *nodes])
     check_network(net, source.name)
     return net

@@ -145,8 +145,11 @@ def test_baked_maps_come_back_as_paths(tmp_path):
     export_usd([source], tmp_path / "r.usda", contexts=("universal",))
     (found,) = import_usd(tmp_path / "r.usda")
     assert set(found.maps) == set(source.maps) - {"specular"}  # universal reads F0 as ior
-    for name, path in found.maps.items():
-        assert Path(path).resolve() == (tmp_path / "tex" / source.maps[name].path.name).resolve()
+    for name, texture in found.maps.items():
+        assert (
+            Path(texture.texture).resolve()
+            == (tmp_path / "tex" / source.maps[name].path.name).resolve()
+        )
 
 
 def test_foreign_preview_surface_imports(tmp_path):
@@ -169,7 +172,7 @@ def test_foreign_preview_surface_imports(tmp_path):
     assert found.name == "Ceramic"
     assert found.params["base_color"] == (0.9, 0.85, 0.8)
     assert found.params["ior"] == pytest.approx(1.6)  # a foreign file spells the F0 as IOR
-    assert found.maps["roughness"].name == "rough.png"
+    assert Path(found.maps["roughness"].texture).name == "rough.png"
 
 
 scale = st.sampled_from([0.0, 1.0]) | st.floats(0.0, 2.0)
