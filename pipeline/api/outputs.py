@@ -335,6 +335,7 @@ def proof(
     report: bool = False,
     library: Any = None,
     progress: Callable[[Any], None] | None = None,
+    context: str | None = None,
 ) -> dict[str, Any]:
     """Render turntable proofs (Burley §6.1): every material under every IBL.
 
@@ -371,6 +372,10 @@ def proof(
     progress
         Called with a :class:`lookdev.pipeline.proof.batch.Progress` about twice a second
         and as each proof finishes (``frames_done``, ``frames_total``, ``finished``).
+    context
+        ``"universal"``: also proof, beside each material, what its USD universal context
+        (UsdPreviewSurface) keeps of it, as ``NAME-universal``
+        (:func:`lookdev.pipeline.export.usd.fidelity.preview_hub`): what a DCC preview shows.
 
     Returns
     -------
@@ -398,6 +403,14 @@ def proof(
     ibl_names = list(dict.fromkeys(ibls or ibl_module.builtin_names()))
     environments = [ibl_module.load(name, ibl_width) for name in ibl_names]
     loaded = [hub(m, batch.MAP_RESOLUTION, lib) for m in chosen]
+    if context not in (None, "source", "universal"):
+        raise batch.ProofError(
+            f"unknown context {context!r}; allowed: universal", field="--context"
+        )
+    if context == "universal":
+        from lookdev.pipeline.export.usd.fidelity import preview_hub
+
+        loaded = [h for m in loaded for h in (m, preview_hub(m))]
     settings = batch.Settings(frames, light_frames, spp, tuple(resolution), exposure)
     doc = batch.proof(
         loaded,

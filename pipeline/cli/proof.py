@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from contextlib import ExitStack
+from enum import StrEnum
 from pathlib import Path
 from typing import Annotated
 
@@ -17,6 +18,10 @@ from rich.progress import (
 )
 
 from .common import console, err_console, print_json, table
+
+
+class ProofContext(StrEnum):
+    universal = "universal"
 
 
 def proof(
@@ -105,6 +110,15 @@ def proof(
             "material's BRDF plots and its frames; static, opens from disk.",
         ),
     ] = False,
+    context: Annotated[
+        ProofContext | None,
+        typer.Option(
+            "--context",
+            help="'universal': also proof, beside each preset, what its USD universal "
+            "context (UsdPreviewSurface) keeps of it, as PRESET-universal: what a DCC "
+            "preview shows (export usd --report measures the difference).",
+        ),
+    ] = None,
 ) -> None:
     """Render turntable proofs: every PRESET under every --ibl.
 
@@ -156,6 +170,7 @@ def proof(
             report=report,
             library=library,
             progress=show,
+            context=None if context is None else context.value,
         )
     if as_json:
         print_json(doc)

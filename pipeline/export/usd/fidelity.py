@@ -32,7 +32,7 @@ from .names import table_for
 from .network import Connection, Source
 from .preview import build, preview_defaults
 
-__all__ = ["ANGLES", "Fidelity", "fidelity", "preview_params"]
+__all__ = ["ANGLES", "PREVIEW_SUFFIX", "Fidelity", "fidelity", "preview_hub", "preview_params"]
 
 ANGLES = (0.0, 30.0, 45.0, 60.0, 75.0, 85.0)
 """View angles (degrees from the normal) at which albedo is compared."""
@@ -177,3 +177,73 @@ def _source_params(hub: Any) -> tuple[Any, dict[str, Any]]:
     # Lobe weights: the constants as parameters, the centre texel's weights as maps.
     maps = {k: np.asarray(v, np.float64) for k, v in values.items() if k in hub.maps}
     return hub.params, maps
+
+
+PREVIEW_SUFFIX = "-universal"
+"""Name suffix of a material's universal-context proof (``lookdev proof --context``)."""
+KEPT_DISNEY = (
+    "base_color",
+    "metallic",
+    "roughness",
+    "specular",
+    "ior",
+    "clearcoat",
+    "clearcoat_gloss",
+)
+"""Disney parameters the universal context keeps (:data:`.names.PREVIEW_DISNEY`; the
+coat's 0.25 scale and gloss↔roughness are exact inverses); the rest take their defaults."""
+
+
+def preview_hub(hub: Any) -> Any:
+    """What a DCC's UsdPreviewSurface keeps of ``hub``, as a Disney material to proof
+    beside it (named ``NAME-universal``): the parameters the universal context writes,
+    maps included, every other one at its default. Its BRDF is Burley's, not the
+    preview's own; their difference is what ``export usd --report`` measures.
+    """
+    from lookdev.materials.params import DisneyParams
+    from lookdev.pipeline.blend.result import LOBE_WEIGHTS, BlendedMaterial
+
+    from .pixar import DEFAULT_ETA, from_weights
+
+    name = f"{hub.name}{PREVIEW_SUFFIX}"
+    if hub.representation == LOBE_WEIGHTS:  # a layered Pixar blend: its preview maps
+        arrays = {k: np.asarray(v) for k, v in {**hub.constants, **hub.maps}.items()}
+        ior = arrays.pop("ior", None)
+        eta = DEFAULT_ETA if ior is None else float(np.mean(ior))
+        w = from_weights(arrays, eta)
+        fields = {
+            "base_color": w["preview_base"],
+            "metallic": w["preview_metallic"],
+            "roughness": w["highlight_roughness"],
+        }
+        constants: dict[str, Any] = {"ior": min(max(eta, 1.0), 10.0)}
+        maps = {}
+        for key, value in fields.items():
+            value = np.asarray(value)
+            if value.ndim >= 2:
+                maps[key] = value.astype(np.float32)
+            else:
+                constants[key] = tuple(float(x) for x in value) if value.ndim else float(value)
+    elif hub.model == "pixar":
+        p = hub.params
+        constants = {
+            "base_color": tuple(p.surface_color),
+            "metallic": p.metallic,
+            "roughness": p.roughness,
+            "ior": min(max(p.eta, 1.0), 10.0),
+        }
+        maps = {}
+    else:
+        constants = {k: v for k, v in hub.constants.items() if k in KEPT_DISNEY}
+        maps = {k: v for k, v in hub.maps.items() if k in KEPT_DISNEY}
+        if "ior" in constants and "specular" in constants:
+            del constants["specular"]
+    out = BlendedMaterial(name, "disney", hub.resolution, constants, maps)
+    out.normal_map = hub.normal_map
+    out.description = f"{hub.name} as UsdPreviewSurface keeps it"
+    if not maps:
+        fields = DisneyParams.model_fields
+        out.__dict__["params"] = DisneyParams.parse(
+            {k: v for k, v in constants.items() if k in fields}
+        )
+    return out

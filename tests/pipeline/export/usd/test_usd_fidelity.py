@@ -153,3 +153,33 @@ def test_layered_pixar_normal_map_is_not_applied_twice():
     assert math.isclose(nodes[1].inputs["in2"][1], 2.0) and math.isclose(
         nodes[2].inputs["in2"][1], 1.0
     )
+
+
+def test_the_universal_proof_material_keeps_what_the_preview_surface_keeps():
+    from lookdev.library import Library, load_material
+    from lookdev.pipeline.blend import blend
+    from lookdev.pipeline.export.usd.fidelity import preview_hub
+
+    lib = Library(use_env=False)
+    velvet = preview_hub(blend(load_material("velvet", lib), 8))
+    assert velvet.name == "velvet-universal" and velvet.params.sheen == 0.0  # lost
+    rust = blend(load_material("rusty_iron", lib), 8)
+    kept = preview_hub(rust)
+    assert set(kept.maps) == set(rust.maps) & {"base_color", "metallic", "roughness", "specular"}
+    layered_pixar = preview_hub(blend(load_material("pixar_painted_metal", lib), 8))
+    assert layered_pixar.model == "disney"
+    assert {"base_color", "metallic", "roughness"} <= set(layered_pixar.maps) | set(
+        layered_pixar.constants
+    )
+    gold = preview_hub(blend(load_material("pixar_gold", lib), 8))
+    assert gold.params.metallic == 1.0 and gold.params.roughness == 0.15
+
+
+@pytest.mark.slow
+def test_proof_context_universal_renders_both(cli, tmp_path):
+    args = ("proof", "gold", "--context", "universal", "--ibl", "studio", "--frames", "1")
+    result = cli(*args, "--light-frames", "0", "--spp", "2", "--resolution", "16", "8",
+                 "-o", str(tmp_path), "--json")  # fmt: skip
+    assert result.code == 0, result.err
+    names = {p["material"] for p in json.loads(result.out)["proofs"]}
+    assert names == {"gold", "gold-universal"}
