@@ -168,11 +168,15 @@ def metallic_workflow(front: Any, f0: Any, eta: float) -> tuple[Any, Any]:
 
     UsdPreviewSurface spec 2.5, ``metallic``: at 0, F0 comes from ``ior``
     (a = ((1 − ior)/(1 + ior))²) and the diffuse is ``diffuseColor``; at 1, F0 is
-    ``diffuseColor`` and there is no diffuse; "in between, we interpolate". With base
-    colour B, luminances Yd (diffuse) and Ys (F0): Yd = B(1 − a)(1 − m) and
-    Ys = a(1 − m) + B·m, which eliminate B to a m² + (Yd/(1 − a) + Ys − 2a) m + a − Ys = 0;
-    m is its non-negative root (0 where Ys ≤ a: a dielectric). The colour is the diffuse's
-    where m is small and the F0's where m is large (blended by m²), clamped to 0..1.
+    ``diffuseColor`` and there is no diffuse; "in between, we interpolate" — as USD's
+    reference implementation does it (:mod:`lookdev.materials.preview_surface`): with
+    base B and metallic m, F0 = ((1 − m) + m·B)·((1 − m)·a + m), and the diffuse seen at
+    normal incidence is B·(1 − m)·(1 − F0). m is the root, by bisection per texel, of
+    Y(F0(m, B(m))) = Y(f0) with B(m) from the diffuse (0 where Y(f0) ≤ a: a dielectric);
+    the colour is then the diffuse's where m is small and the F0's where m is large
+    (blended by m²), clamped to 0..1. Only luminances are matched: F0's tint at a
+    fractional m is the interpolation's, a loss the export names.
+
     The specular workflow would carry ``f0`` as it is, but DCC importers read
     ``specularColor`` as a tint on their own dielectric F0 (≈ 0.04), so a metal's F0 of
     ~1 would arrive ~25 times too dark.
@@ -191,19 +195,29 @@ def metallic_workflow(front: Any, f0: Any, eta: float) -> tuple[Any, Any]:
     d = np.asarray(front, np.float64)
     s = np.asarray(f0, np.float64)
     a = float(ior_to_f0(eta))
-    yd, ys = luminance(d), luminance(s)
-    b = yd / (1.0 - a) + ys - 2.0 * a
-    c = a - ys
-    if a > 0.0:
-        disc = np.sqrt(np.maximum(b * b - 4.0 * a * c, 0.0))
-        root = (-b + disc) / (2.0 * a)
-    else:  # a = 0 (ior 1): the equation is linear
-        root = np.where(b > 0.0, -c / np.where(b > 0.0, b, 1.0), 1.0)
-    m = np.clip(np.where(ys <= a, 0.0, root), 0.0, 1.0)
+    ys = luminance(s)
+    dim = 1.0 - np.clip(s, 0.0, 1.0)
+
+    def base_from_diffuse(m: Any) -> Any:
+        return np.clip(d / np.maximum((1.0 - m[..., None]) * dim, 1e-6), 0.0, 1.0)
+
+    def excess(m: Any) -> Any:  # Y(F0) of the preview minus the target's, rising in m
+        mm = m[..., None]
+        spec = (1.0 - mm) + mm * base_from_diffuse(m)
+        return luminance(spec * ((1.0 - mm) * a + mm)) - ys
+
+    lo = np.zeros(np.shape(ys))
+    hi = np.ones(np.shape(ys))
+    for _ in range(40):  # 2^-40: far below float32
+        mid = 0.5 * (lo + hi)
+        high = excess(mid) > 0.0
+        hi = np.where(high, mid, hi)
+        lo = np.where(high, lo, mid)
+    m = np.where(ys <= a, 0.0, 0.5 * (lo + hi))
     mm = m[..., None]
-    from_diffuse = d / np.maximum((1.0 - a) * (1.0 - mm), 1e-6)
-    from_f0 = (s - a * (1.0 - mm)) / np.maximum(mm, 1e-6)
-    base = np.clip(from_diffuse + (from_f0 - from_diffuse) * mm * mm, 0.0, 1.0)
+    from_f0 = (s / np.maximum((1.0 - mm) * a + mm, 1e-6) - (1.0 - mm)) / np.maximum(mm, 1e-6)
+    base = base_from_diffuse(m)
+    base = np.clip(base + (np.clip(from_f0, 0.0, 1.0) - base) * mm * mm, 0.0, 1.0)
     return base, m
 
 

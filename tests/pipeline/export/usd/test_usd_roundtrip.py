@@ -91,7 +91,12 @@ def _assert_same(got: dict, want: DisneyParams, keys: set[str]) -> None:
 def test_universal_round_trip_recovers_what_it_expresses(tmp_path, data):
     params = DisneyParams(**data)
     got = _round_trip(tmp_path, params, ("universal",))
-    _assert_same(got, params, PREVIEW_PARAMS)
+    keys = PREVIEW_PARAMS
+    if 0.0 < np.float32(params.metallic) < 1.0:
+        # A fractional metallic is refitted for the surface's own interpolation (F0
+        # towards white): base colour and metallic change, named in the loss note.
+        keys = keys - {"metallic", "base_color"}
+    _assert_same(got, params, keys)
     unexpressed = set(got) - PREVIEW_PARAMS
     assert not unexpressed, f"read parameters the surface cannot hold: {unexpressed}"
 
