@@ -64,12 +64,16 @@ class PreviewParams(Params):
     ior: float = Field(1.5, ge=0.0, le=1e7)
 
 
-def _alpha(r: float) -> float:
-    return max(r * r, ALPHA_MIN)
+def _alpha(xp: Any, r: Any) -> Any:
+    if isinstance(r, float):
+        return max(r * r, ALPHA_MIN)
+    return xp.maximum(r * r, ALPHA_MIN)
 
 
 def prepare(xp: Any, params: PreviewParams, **maps: Any) -> dict[str, Any]:
-    """F0, F90, the diffuse colour and the lobe weights of the metallic or specular workflow."""
+    """F0, F90, the diffuse colour and the lobe weights of the metallic or specular workflow.
+
+    ``maps`` may vary ``diffuse_color``, ``metallic`` and ``roughness`` per element."""
     base = xp.color(maps.get("diffuse_color", params.diffuse_color))
     r = (1.0 - params.ior) / (1.0 + params.ior)
     r2 = r * r
@@ -78,24 +82,25 @@ def prepare(xp: Any, params: PreviewParams, **maps: Any) -> dict[str, Any]:
         f90 = xp.color((1.0, 1.0, 1.0))
         diffuse = base
     else:
-        m = params.metallic
+        m = maps.get("metallic", params.metallic)
         spec = 1.0 + (base - 1.0) * m  # mix(1, diffuseColor, metallic)
         f0 = r2 * spec + (spec - r2 * spec) * m
         f90 = spec
         diffuse = base * (1.0 - m)
-    lobes = ["diffuse", "specular"]
+    metal = "metallic" not in maps and params.metallic >= 1.0 and not params.use_specular_workflow
+    lobes = ["specular"] if metal else ["diffuse", "specular"]  # a pure metal has no diffuse
     if params.clearcoat > 0.0:
         lobes.append("clearcoat")
     return {
         "diffuse": diffuse,
         "f0": f0,
         "f90": f90,
-        "alpha": _alpha(params.roughness),
+        "alpha": _alpha(xp, maps.get("roughness", params.roughness)),
         "cc": params.clearcoat,
-        "cc_alpha": _alpha(params.clearcoat_roughness),
+        "cc_alpha": _alpha(xp, params.clearcoat_roughness),
         "cc_f0": r2,
         "lobes": tuple(lobes),
-        "p_diffuse": 0.5,
+        "p_diffuse": 0.0 if metal else 0.5,
         "p_coat": 0.2 if params.clearcoat > 0.0 else 0.0,
     }
 
@@ -148,8 +153,8 @@ def sample(xp: Any, p: dict[str, Any], wo: Any, u: Any) -> Any:
     r = xp.sqrt(u1)
     phi = 2.0 * math.pi * u2
     cos_dir = xp.vec3(r * xp.cos(phi), r * xp.sin(phi), xp.safe_sqrt(1.0 - u1))
-    a = p["alpha"]
-    ca = p["cc_alpha"] if pc > 0.0 else a
+    a = p["alpha"] + 0.0 * u1  # arrays, so select works on either backend
+    ca = (p["cc_alpha"] if pc > 0.0 else p["alpha"]) + 0.0 * u1
     use_coat = u[0] >= 1.0 - pc
     alpha = xp.select(use_coat, ca, a)
     h = sample_ggx(xp, alpha, alpha, u1, u2)

@@ -373,9 +373,10 @@ def proof(
         Called with a :class:`lookdev.pipeline.proof.batch.Progress` about twice a second
         and as each proof finishes (``frames_done``, ``frames_total``, ``finished``).
     context
-        ``"universal"``: also proof, beside each material, what its USD universal context
-        (UsdPreviewSurface) keeps of it, as ``NAME-universal``
-        (:func:`lookdev.pipeline.export.usd.fidelity.preview_hub`): what a DCC preview shows.
+        ``"universal"``: also proof, beside each material, its USD universal context as
+        ``NAME-universal``: the UsdPreviewSurface values rendered by that surface's own
+        BRDF (:func:`lookdev.pipeline.export.usd.fidelity.preview_hub`), what a DCC
+        preview shows.
 
     Returns
     -------

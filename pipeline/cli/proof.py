@@ -114,9 +114,9 @@ def proof(
         ProofContext | None,
         typer.Option(
             "--context",
-            help="'universal': also proof, beside each preset, what its USD universal "
-            "context (UsdPreviewSurface) keeps of it, as PRESET-universal: what a DCC "
-            "preview shows (export usd --report measures the difference).",
+            help="'universal': also proof, beside each preset, its USD universal context "
+            "as PRESET-universal: the UsdPreviewSurface values rendered by that surface's "
+            "own BRDF, what a DCC preview shows (export usd --report measures the difference).",
         ),
     ] = None,
 ) -> None:

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -27,12 +28,21 @@ import numpy as np
 from lookdev.materials.colour import luminance
 from lookdev.materials.preview_surface import MODEL as PREVIEW
 from lookdev.materials.preview_surface import PreviewParams
+from lookdev.pipeline.blend.result import BlendedMaterial
 
 from .names import table_for
 from .network import Connection, Source
 from .preview import build, preview_defaults
 
-__all__ = ["ANGLES", "PREVIEW_SUFFIX", "Fidelity", "fidelity", "preview_hub", "preview_params"]
+__all__ = [
+    "ANGLES",
+    "PREVIEW_SUFFIX",
+    "Fidelity",
+    "PreviewHub",
+    "fidelity",
+    "preview_hub",
+    "preview_params",
+]
 
 ANGLES = (0.0, 30.0, 45.0, 60.0, 75.0, 85.0)
 """View angles (degrees from the normal) at which albedo is compared."""
@@ -181,69 +191,75 @@ def _source_params(hub: Any) -> tuple[Any, dict[str, Any]]:
 
 PREVIEW_SUFFIX = "-universal"
 """Name suffix of a material's universal-context proof (``lookdev proof --context``)."""
-KEPT_DISNEY = (
-    "base_color",
-    "metallic",
-    "roughness",
-    "specular",
-    "ior",
-    "clearcoat",
-    "clearcoat_gloss",
-)
-"""Disney parameters the universal context keeps (:data:`.names.PREVIEW_DISNEY`; the
-coat's 0.25 scale and gloss↔roughness are exact inverses); the rest take their defaults."""
+
+_PREVIEW_FIELDS = {
+    "diffuseColor": "diffuse_color",
+    "metallic": "metallic",
+    "roughness": "roughness",
+    "clearcoat": "clearcoat",
+    "clearcoatRoughness": "clearcoat_roughness",
+    "ior": "ior",
+    "specularColor": "specular_color",
+    "useSpecularWorkflow": "use_specular_workflow",
+}
+"""UsdPreviewSurface input → :class:`PreviewParams` field."""
+PREVIEW_MAPPED = ("diffuse_color", "metallic", "roughness")
+"""Fields the preview model takes per texel (the rest as their map's centre value)."""
 
 
-def preview_hub(hub: Any) -> Any:
-    """What a DCC's UsdPreviewSurface keeps of ``hub``, as a Disney material to proof
-    beside it (named ``NAME-universal``): the parameters the universal context writes,
-    maps included, every other one at its default. Its BRDF is Burley's, not the
-    preview's own; their difference is what ``export usd --report`` measures.
+class PreviewHub(BlendedMaterial):
+    """A blended material rendered by UsdPreviewSurface's own BRDF (spec 2.5)."""
+
+    @property
+    def bsdf_model(self):
+        return PREVIEW
+
+
+def preview_hub(hub: Any, source: Source | None = None) -> Any:
+    """What a DCC's preview shows of ``hub``: its universal context's values rendered by
+    UsdPreviewSurface's BRDF (:mod:`lookdev.materials.preview_surface`), named
+    ``NAME-universal``, maps of the base colour, metallic and roughness kept per texel.
+
+    ``source`` is the exporter's view of ``hub`` (built here when not given: maps baked to
+    a scratch folder that is removed).
     """
-    from lookdev.materials.params import DisneyParams
-    from lookdev.pipeline.blend.result import LOBE_WEIGHTS, BlendedMaterial
+    import tempfile
 
-    from .pixar import DEFAULT_ETA, from_weights
+    from .sources import source_for
 
-    name = f"{hub.name}{PREVIEW_SUFFIX}"
-    if hub.representation == LOBE_WEIGHTS:  # a layered Pixar blend: its preview maps
-        arrays = {k: np.asarray(v) for k, v in {**hub.constants, **hub.maps}.items()}
-        ior = arrays.pop("ior", None)
-        eta = DEFAULT_ETA if ior is None else float(np.mean(ior))
-        w = from_weights(arrays, eta)
-        fields = {
-            "base_color": w["preview_base"],
-            "metallic": w["preview_metallic"],
-            "roughness": w["highlight_roughness"],
-        }
-        constants: dict[str, Any] = {"ior": min(max(eta, 1.0), 10.0)}
-        maps = {}
-        for key, value in fields.items():
-            value = np.asarray(value)
-            if value.ndim >= 2:
-                maps[key] = value.astype(np.float32)
-            else:
-                constants[key] = tuple(float(x) for x in value) if value.ndim else float(value)
-    elif hub.model == "pixar":
-        p = hub.params
-        constants = {
-            "base_color": tuple(p.surface_color),
-            "metallic": p.metallic,
-            "roughness": p.roughness,
-            "ior": min(max(p.eta, 1.0), 10.0),
-        }
-        maps = {}
-    else:
-        constants = {k: v for k, v in hub.constants.items() if k in KEPT_DISNEY}
-        maps = {k: v for k, v in hub.maps.items() if k in KEPT_DISNEY}
-        if "ior" in constants and "specular" in constants:
-            del constants["specular"]
-    out = BlendedMaterial(name, "disney", hub.resolution, constants, maps)
-    out.normal_map = hub.normal_map
-    out.description = f"{hub.name} as UsdPreviewSurface keeps it"
+    if source is None:
+        with tempfile.TemporaryDirectory(prefix="lookdev-preview-") as tmp:
+            source = source_for(hub, Path(tmp) / "tex", scratch=Path(tmp), bake=True)
+            return _preview_hub(hub, source)
+    return _preview_hub(hub, source)
+
+
+def _preview_hub(hub: Any, source: Source) -> Any:
+    net = build(source)
+    surface = net.nodes[0]
+    slots = {s.input: s for s in table_for("universal", source.model)}
+    constants = preview_params(source).model_dump()
+    maps: dict[str, np.ndarray] = {}
+    for name, (_, value) in surface.inputs.items():
+        field = _PREVIEW_FIELDS.get(name)
+        slot = slots.get(name)
+        if not isinstance(value, Connection) or field not in PREVIEW_MAPPED or slot is None:
+            continue
+        image = source.maps.get(slot.param)
+        if image is None or image.pixels is None:
+            continue
+        px = np.flipud(np.asarray(image.pixels, np.float64))  # back to UV order
+        converted = np.vectorize(slot.to_target, otypes=[np.float64])(px)
+        if field == "diffuse_color":
+            converted = np.clip(converted, 0.0, 1.0)
+        maps[field] = converted.astype(np.float32)
+        constants.pop(field, None)
+    width, height = hub.resolution
+    out = PreviewHub(f"{hub.name}{PREVIEW_SUFFIX}", "disney", hub.resolution, constants)
+    out.maps = maps
+    if hub.normal_map is not None:
+        out.normal_map = hub.normal_map
+    out.description = f"{hub.name} as UsdPreviewSurface shows it"
     if not maps:
-        fields = DisneyParams.model_fields
-        out.__dict__["params"] = DisneyParams.parse(
-            {k: v for k, v in constants.items() if k in fields}
-        )
+        out.__dict__["params"] = PreviewParams.parse(constants)
     return out

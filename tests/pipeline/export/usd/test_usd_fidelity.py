@@ -155,24 +155,21 @@ def test_layered_pixar_normal_map_is_not_applied_twice():
     )
 
 
-def test_the_universal_proof_material_keeps_what_the_preview_surface_keeps():
+def test_the_universal_proof_renders_the_preview_surface_s_own_brdf():
     from lookdev.library import Library, load_material
     from lookdev.pipeline.blend import blend
     from lookdev.pipeline.export.usd.fidelity import preview_hub
 
     lib = Library(use_env=False)
     velvet = preview_hub(blend(load_material("velvet", lib), 8))
-    assert velvet.name == "velvet-universal" and velvet.params.sheen == 0.0  # lost
-    rust = blend(load_material("rusty_iron", lib), 8)
-    kept = preview_hub(rust)
-    assert set(kept.maps) == set(rust.maps) & {"base_color", "metallic", "roughness", "specular"}
-    layered_pixar = preview_hub(blend(load_material("pixar_painted_metal", lib), 8))
-    assert layered_pixar.model == "disney"
-    assert {"base_color", "metallic", "roughness"} <= set(layered_pixar.maps) | set(
-        layered_pixar.constants
-    )
+    assert velvet.name == "velvet-universal"
+    assert velvet.bsdf_model.name == "usd_preview_surface"  # not Burley's with sheen off
+    rust = preview_hub(blend(load_material("rusty_iron", lib), 16))
+    assert set(rust.maps) == {"diffuse_color", "metallic", "roughness"}
+    assert rust.maps["diffuse_color"].shape == (16, 16, 3)
     gold = preview_hub(blend(load_material("pixar_gold", lib), 8))
-    assert gold.params.metallic == 1.0 and gold.params.roughness == 0.15
+    assert (gold.params.metallic, gold.params.roughness) == (1.0, 0.15)
+    assert gold.live_lobes == ("specular",)  # a pure metal: no diffuse traced
 
 
 @pytest.mark.slow
