@@ -29,12 +29,10 @@ def preset_record(hub: Any) -> str:
         if path is None or not Path(path).is_file():
             return ""
         doc = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+        if not doc.get("layers"):  # inherited through `extends`: the file alone is not it
+            return ""
         doc["name"] = hub.name
-        doc.pop("extends", None)  # resolved: the layers below are the ones exported
-        if not doc.get("layers"):
-            layers = getattr(origin, "layers", None) or []
-            if not layers:
-                return ""
+        doc.pop("extends", None)  # its own layers replace the parent's whole (library rules)
         return json.dumps(doc, sort_keys=True)
     params = getattr(origin, "params", None)
     if params is None:
