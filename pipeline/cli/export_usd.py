@@ -227,8 +227,9 @@ def import_usd(
         bool,
         typer.Option(
             "--rename",
-            help="Import a material whose name another one or a library preset has as "
-            "NAME_imported (default: refuse).",
+            help="Import a material whose name another material of the file, a preset in "
+            "-o, or (when -o is a library folder) a library preset has as NAME_imported "
+            "(default: refuse; --force replaces a preset in -o instead).",
         ),
     ] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
@@ -241,8 +242,9 @@ def import_usd(
     holds constants: a parameter fed by a texture is written as a comment holding its
     texture table (and under "maps" with --json); what a preset cannot hold (alpha and
     cut-outs, normal, emission, occlusion, a specular-workflow conversion) is printed
-    and listed as "# loss:" lines. A name that another material of the file or, with
-    -o, a library preset already has is refused unless --rename.
+    and listed as "# loss:" lines. A name another material of the file has, or (when
+    -o is a folder of the library) a library preset elsewhere has, is refused unless
+    --rename.
 
     Examples:
 
@@ -260,7 +262,7 @@ def import_usd(
 
     skipped: list[str] = []
     found = read(file.expanduser(), skipped)
-    names = import_names(found, _library_names(output), rename=rename)
+    names = import_names(found, _taken_names(output, rename), rename=rename)
     written = write_presets(found, output, force=force, names=names)
     if as_json:
         print_json(
@@ -306,21 +308,29 @@ def import_usd(
         )
 
 
-def _library_names(output: Path | None) -> set[str]:
-    """Names of the library's presets an import into ``output`` must not take (none when
-    only printing); a preset whose file ``output`` would replace is --force's business."""
+def _taken_names(output: Path | None, rename: bool) -> set[str]:
+    """Preset names an import into ``output`` must not take.
+
+    When ``output`` is a folder of the library's search path, a preset of the same name
+    elsewhere in the library would shadow it or be shadowed: refused (or renamed). With
+    ``rename``, the presets already in ``output`` are avoided too (without it, replacing
+    one is ``--force``'s business).
+    """
     if output is None:
         return set()
     from lookdev.library import Library
 
+    target = output.expanduser()
+    folder = (target.parent if target.suffix == ".toml" else target).resolve()
+    taken: set[str] = set()
+    if rename and folder.is_dir():
+        taken |= {p.stem for p in folder.glob("*.toml")}
     library = Library()
-    target = output.expanduser().resolve()
-    names = set()
-    for name in library.names():
-        path = library.find(name).resolve()
-        if path != target and path.parent != target:
-            names.add(name)
-    return names
+    if any(folder == f.resolve() for f in library.folders if f.is_dir()):
+        for name in library.names():
+            if library.find(name).resolve().parent != folder:
+                taken.add(name)
+    return taken
 
 
 @validate_app.command("usd")

@@ -46,7 +46,7 @@ from .network import (
 )
 from .pixar import ior_to_normal_fresnel
 from .preview import preview_defaults
-from .record import read_record
+from .record import network_digest, read_record
 
 TEXTURE_FILE_INPUT = {"UsdUVTexture": "file", "PxrTexture": "filename"}
 READ_ORDER = ("universal", "ri", "mtlx")
@@ -208,7 +208,8 @@ def import_usd(path: Path, skipped: list[str] | None = None) -> list[Imported]:
 
 def _imported(spec: MaterialSpec) -> Imported | None:
     document = read_record(spec.custom)
-    if document is not None:  # lookdev's own export: the preset as it was
+    edited = document is not None and spec.custom.get("networks") != network_digest(spec.networks)
+    if document is not None and not edited:  # lookdev's own export, as exported
         result = Imported(spec.name, document.get("model", "layered"), {}, document=document)
         result.params = dict(document.get("params", {}))
         result.contexts.append("record")
@@ -216,6 +217,11 @@ def _imported(spec: MaterialSpec) -> Imported | None:
     model = spec.custom.get("model", "disney")
     values = dict(DEFAULTS[model])
     result = Imported(spec.name, model, {})
+    if edited:
+        result.loss.append(
+            "the networks were edited after lookdev exported them: read from the networks, "
+            "not from the preset record the file carries"
+        )
     by_context = {net.context: net for net in spec.networks}
     spelling = spec.custom.get("spelling") or "ior"
     for context in READABLE[model]:

@@ -6,16 +6,22 @@ its model, description, tags, citation and the parameters it gave (a plain prese
 ``extends`` is resolved) or its layer document as the file wrote it (a layered preset:
 the layers name their presets and mask files as the file did). It is a JSON string under
 ``customData["lookdev"]["record"]``: USD keeps a string exactly, floats included.
+
+A record is only trusted while the networks are the ones exported with it: beside it the
+Material carries :func:`network_digest` of its networks, and an import whose networks
+hash differently (someone edited the file in a DCC) reads the networks instead.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
+import struct
 import tomllib
 from pathlib import Path
 from typing import Any
 
-__all__ = ["RECORD_KEY", "preset_record", "read_record"]
+__all__ = ["RECORD_KEY", "network_digest", "preset_record", "read_record"]
 
 RECORD_KEY = "record"
 
@@ -59,3 +65,33 @@ def read_record(custom: dict[str, Any]) -> dict[str, Any] | None:
     except ValueError:
         return None
     return doc if isinstance(doc, dict) and "name" in doc else None
+
+
+def network_digest(networks: list[Any]) -> str:
+    """SHA-256 of what renderers read of ``networks`` (:class:`~.network.Network`): each
+    node's id and inputs, values as USD stores them (float32), asset paths left out (they
+    move with the file), connections by node and output. The same for the networks an
+    export authors and for those read back from its file."""
+    from .network import Connection, Image
+
+    def plain(value: Any) -> Any:
+        if isinstance(value, Connection):
+            return f"->{value.node}.{value.output}"
+        if isinstance(value, Image) or hasattr(value, "resolvedPath"):
+            return "asset"
+        if isinstance(value, bool):
+            return int(value)
+        if isinstance(value, float):
+            return repr(struct.unpack("f", struct.pack("f", value))[0])
+        if isinstance(value, tuple | list):
+            return [plain(v) for v in value]
+        return value if isinstance(value, int | str) else str(value)
+
+    rows = []
+    for net in networks:
+        terminal = f"{net.terminal.node}.{net.terminal.output}"
+        for node in net.nodes:
+            inputs = sorted((k, plain(v)) for k, (_, v) in node.inputs.items())
+            rows.append([net.context, terminal, node.name, node.id, inputs])
+    text = json.dumps(sorted(rows, key=lambda r: (r[0], r[2])), sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()

@@ -52,14 +52,17 @@ def material_spec(
         "model": source.model,
         "spelling": source.spelling,
     }
-    if source.record:
-        custom["record"] = source.record
     networks = [
         preview.build(source, preview_opacity)
         if c == "universal"
         else BUILDERS[c](source, meters_per_unit)
         for c in contexts
     ]
+    if source.record:  # the preset, trusted while the networks are these (.record)
+        from .record import network_digest
+
+        custom["record"] = source.record
+        custom["networks"] = network_digest(networks)
     return MaterialSpec(source.name, networks, custom)
 
 

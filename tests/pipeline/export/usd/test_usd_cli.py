@@ -43,11 +43,9 @@ def test_export_validate_import_round_trip(cli, tmp_path):
     assert check["ok"] and check["errors"] == [] and check["mtlx_networks"] == 2
 
     result = cli("import", "usd", str(out), "-o", str(tmp_path), "--json")
-    assert result.code == 2 and "--rename" in result.err  # gold is a library preset
-    result = cli("import", "usd", str(out), "-o", str(tmp_path), "--json", "--rename")
     assert result.code == 0, result.err
-    path = tmp_path / "gold_imported.toml"
-    gold = parse_preset(path.read_bytes(), where=str(path), stem="gold_imported")
+    path = tmp_path / "gold.toml"
+    gold = parse_preset(path.read_bytes(), where=str(path), stem="gold")
     assert gold.params == {"base_color": [1.0, 0.782, 0.344], "metallic": 1.0, "roughness": 0.2}
 
 

@@ -212,18 +212,40 @@ def test_a_texture_feeding_an_input_is_kept_as_a_texture_input(tmp_path):
     assert 'roughness = { texture = "' in preset_toml(found)
 
 
-def test_name_clashes_are_refused_unless_renamed(cli, tmp_path):
+def test_name_clashes_are_refused_unless_renamed(cli, tmp_path, monkeypatch):
     out = tmp_path / "g.usda"
     assert cli("export", "usd", "gold", "-o", str(out), "-c", "universal").code == 0
-    folder = tmp_path / "imported"
-    folder.mkdir()
-    result = cli("import", "usd", str(out), "-o", str(folder))
+    library = tmp_path / "lib"
+    library.mkdir()
+    monkeypatch.setenv("LOOKDEV_LIBRARY_PATH", str(library))
+    # Into a library folder: the built-in gold would be shadowed.
+    result = cli("import", "usd", str(out), "-o", str(library))
     assert result.code == 2 and "--rename" in result.err and len(result.err.splitlines()) == 1
-    result = cli("import", "usd", str(out), "-o", str(folder), "--rename", "--json")
+    result = cli("import", "usd", str(out), "-o", str(library), "--rename", "--json")
     assert result.code == 0, result.err
     assert json.loads(result.out)["materials"][0]["preset"] == "gold_imported"
-    assert (folder / "gold_imported.toml").is_file()
+    assert (library / "gold_imported.toml").is_file()
+    # A plain folder: no clash; a second import there is renamed, not replaced.
+    plain = tmp_path / "plain"
+    plain.mkdir()
+    assert cli("import", "usd", str(out), "-o", str(plain)).code == 0
+    assert cli("import", "usd", str(out), "-o", str(plain), "--rename").code == 0
+    assert sorted(p.name for p in plain.iterdir()) == ["gold.toml", "gold_imported.toml"]
     (found,) = import_usd(out)
     with pytest.raises(ExportError, match="another material in the file"):
         import_names([found, found])
     assert import_names([found, found], rename=True) == ["gold", "gold_imported"]
+
+
+def test_a_file_edited_after_export_is_read_from_its_networks(tmp_path):
+    out = tmp_path / "g.usda"
+    api.export_usd(["gold"], out, ("universal",))
+    (found,) = import_usd(out)
+    assert found.contexts == ["record"] and found.params["roughness"] == 0.2
+    layer = Sdf.Layer.FindOrOpen(str(out))
+    layer.GetAttributeAtPath("/Materials/gold/preview_surface.inputs:roughness").default = 0.35
+    layer.Save()
+    (found,) = import_usd(out)
+    assert found.contexts == ["universal"]
+    assert found.params["roughness"] == pytest.approx(0.35)  # the edit, not the stale record
+    assert any("edited after lookdev exported" in line for line in found.loss)
