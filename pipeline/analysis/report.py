@@ -1,24 +1,26 @@
 """The review page of a proof batch: ``index.html``, static, opens from disk, no network.
 
 :func:`write_report` reads every ``manifest.json`` under a batch folder (one per material
-× IBL, written by :mod:`lookdev.pipeline.proof`) and writes ``index.html`` beside them
-with, in this order: the contact sheets; the time/noise table built from the manifests;
-then per material its BRDF-explorer plots (slice, albedo, polar, lit sphere) and, per IBL,
-its turntable frames.
+× IBL, written by :mod:`lookdev.pipeline.proof`) and writes ``index.html`` beside them:
+a raw/denoised toggle, a comparison (all materials under one IBL, or one material under
+every IBL, side by side and synchronised), then per material its resolved parameters,
+source and USD loss notes, its BRDF-explorer plots (slice, albedo, polar, lit sphere) and
+a turntable player per IBL (play, pause, scrub through the element and the light turn,
+each frame's spp, noise, time); then the time/noise table and the contact sheets. The
+players are ``review.js`` (package data, copied into ``report/``) reading the page's JSON
+(:mod:`.review`).
 
 Everything the page shows lives under the batch folder and is linked relatively, so the
 folder can be moved, zipped or served as it is. Browsers cannot show EXR, so EXR frames
 get sRGB PNG thumbnails in ``report/``; plots go there too. Images are only linked once
 they exist on disk: the page has no broken images by construction, and the test opens it
-in headless Chromium to make sure.
+in headless Chromium, plays, scrubs, toggles and compares to make sure.
 """
 
 from __future__ import annotations
 
 import html
 import json
-import os
-import urllib.parse
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,11 +31,15 @@ import numpy as np
 from lookdev.library import files
 from lookdev.materials.errors import LookdevError
 
+from . import review
+
 REPORT_DIR = "report"
 WEB_IMAGES = (".png", ".jpg", ".jpeg", ".gif", ".webp", ".svg")
 PLOT_VIEWS = ("slice", "albedo", "polar", "sphere")
 # Manifest fields that identify files rather than describe the proof.
-NOT_IN_TABLE = frozenset({"key", "sha256", "size", "file", "version", "contact_sheet"})
+NOT_IN_TABLE = frozenset(
+    {"key", "sha256", "size", "file", "version", "contact_sheet", "rig", "ibl_orientation"}
+)
 
 
 class ReportError(LookdevError):
@@ -273,48 +279,39 @@ def _environment(ibl: str | None, load: Any) -> np.ndarray | None:
 
 
 # -- the page -------------------------------------------------------------------------
-CSS = """
-body{font:14px/1.4 system-ui,sans-serif;margin:24px;background:#1e1e1e;color:#ddd}
-h1,h2,h3{font-weight:600}h2{border-bottom:1px solid #444;padding-bottom:4px;margin-top:32px}
-table{border-collapse:collapse;font-variant-numeric:tabular-nums}
-th,td{padding:3px 10px;border-bottom:1px solid #333;text-align:right}
-th:first-child,td:first-child,th:nth-child(2),td:nth-child(2){text-align:left}
-.strip{display:flex;flex-wrap:wrap;gap:6px}.strip img{height:128px;background:#000}
-.plots img{height:260px;background:#fff;margin:4px}
-figure{margin:0}figcaption{font-size:12px;color:#999}a{color:#8cf}
-img.sheet{width:100%;max-width:960px}
-"""
-
-
 def _img(src: Path, base: Path, alt: str, cls: str = "") -> str:
-    # URL-quoted: a '#' or '?' in a file name would otherwise end the path
-    rel = urllib.parse.quote(Path(os.path.relpath(src, base)).as_posix())
     c = f' class="{cls}"' if cls else ""
-    return f'<img{c} src="{html.escape(rel)}" alt="{html.escape(alt)}">'
+    return f'<img{c} src="{html.escape(review.url(src, base))}" alt="{html.escape(alt)}">'
 
 
-def render_page(batch_dir: Path, entries: list[Entry], sheets: list[Path], plots: dict) -> str:
-    """The HTML text of the review page."""
+def render_page(
+    batch_dir: Path,
+    entries: list[Entry],
+    sheets: list[Path],
+    plots: dict,
+    hubs: Mapping[str, Any] | None = None,
+) -> str:
+    """The HTML text of the review page: a sticky raw/denoised toggle, the comparison
+    and a turntable player per proof (built by ``report/review.js`` from the page's JSON,
+    :mod:`.review`), then the time/noise table and the contact sheets."""
     out = batch_dir / REPORT_DIR
     esc = html.escape
+    materials = list(dict.fromkeys(e.material for e in entries))
+    data = review.page_data(
+        batch_dir, entries, lambda p: web_image(p, out), plots, dict(hubs or {})
+    )
     parts = [
         "<!doctype html><html lang=en><head><meta charset=utf-8>",
-        f"<title>lookdev proof: {esc(batch_dir.name)}</title><style>{CSS}</style></head><body>",
+        '<meta name="viewport" content="width=device-width, initial-scale=1">',
+        f"<title>lookdev proof: {esc(batch_dir.name)}</title>",
+        f'<link rel="stylesheet" href="{REPORT_DIR}/review.css"></head><body>',
         f"<h1>lookdev proof — {esc(batch_dir.name)}</h1>",
-        f"<p>{len({e.material for e in entries})} material(s), {len(entries)} proof(s): "
-        + ", ".join(
-            f'<a href="#{esc(_slug(m))}">{esc(m)}</a>'
-            for m in dict.fromkeys(e.material for e in entries)
-        )
-        + ".</p>",
+        f"<p>{len(materials)} material(s), {len(entries)} proof(s) under "
+        f"{len(data['ibls'])} IBL(s): " + ", ".join(esc(m) for m in materials) + ".</p>",
+        "<noscript><p>The players and the comparison need JavaScript; the table and the "
+        "contact sheets below do not.</p></noscript>",
+        '<main id="review"></main>',
     ]
-    if sheets:
-        parts.append("<h2>Contact sheets</h2>")
-        for s in sheets:
-            parts.append(
-                f"<figure>{_img(web_image(s, out), batch_dir, s.stem, 'sheet')}"
-                f"<figcaption>{esc(s.relative_to(batch_dir).as_posix())}</figcaption></figure>"
-            )
     columns, rows = table_rows(entries)
     parts.append("<h2>Time and noise</h2><table><thead><tr>")
     parts += [f"<th>{esc(c)}</th>" for c in columns]
@@ -322,20 +319,15 @@ def render_page(batch_dir: Path, entries: list[Entry], sheets: list[Path], plots
     for row in rows:
         parts.append("<tr>" + "".join(f"<td>{esc(v)}</td>" for v in row) + "</tr>")
     parts.append("</tbody></table>")
-    for material in dict.fromkeys(e.material for e in entries):
-        parts.append(f'<h2 id="{esc(_slug(material))}">{esc(material)}</h2>')
-        if material in plots:
-            parts.append('<div class="plots">')
-            parts += [_img(p, batch_dir, f"{material} {v}") for v, p in plots[material].items()]
-            parts.append("</div>")
-        for e in (e for e in entries if e.material == material):
-            parts.append(f"<h3>{esc(e.ibl)}</h3><div class=strip>")
-            parts += [
-                f"<figure>{_img(web_image(f, out), batch_dir, f'{material} {e.ibl} {cap}')}"
-                f"<figcaption>{esc(cap)}</figcaption></figure>"
-                for f, cap in e.frames
-            ]
-            parts.append("</div>")
+    if sheets:
+        parts.append("<h2>Contact sheets</h2>")
+        for s in sheets:
+            parts.append(
+                f"<figure>{_img(web_image(s, out), batch_dir, s.stem, 'sheet')}"
+                f"<figcaption>{esc(s.relative_to(batch_dir).as_posix())}</figcaption></figure>"
+            )
+    parts.append(review.data_script(data))
+    parts.append(f'<script src="{REPORT_DIR}/review.js"></script>')
     parts.append("</body></html>")
     return "\n".join(parts)
 
@@ -357,6 +349,7 @@ def write_report(
     out.mkdir(exist_ok=True)
     names = dict.fromkeys(e.material for e in entries)
     made = material_plots(names, materials or {}, out, entries[0].ibl) if plots else {}
-    page = render_page(batch_dir, entries, contact_sheets(batch_dir), made)
+    review.copy_assets(out)
+    page = render_page(batch_dir, entries, contact_sheets(batch_dir), made, materials)
     index = batch_dir / "index.html"
     return files.atomic_write(index, page)

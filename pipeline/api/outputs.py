@@ -87,6 +87,8 @@ def export_usd(
     preview_opacity: str = "keep",
     meters_per_unit: float = 1.0,
     report: bool = False,
+    collect: bool = False,
+    preview_geometry: bool = False,
 ) -> UsdExport:
     """Write materials as UsdShade materials under ``/Materials`` of ``path``.
 
@@ -94,7 +96,7 @@ def export_usd(
     ----------
     materials
         One or several preset names, paths or :class:`~lookdev.library.Material` s;
-        several make a library whose ``/Look`` prim switches between them.
+        several make a library whose ``/Materials/Look`` prim switches between them.
     path
         ``.usda``, ``.usdc``, ``.usd``, or ``.usdz`` (packaged with its textures).
     contexts
@@ -129,6 +131,12 @@ def export_usd(
         Measure each material's UsdPreviewSurface against the material (directional
         albedo over view angles and the highlight, see
         :mod:`lookdev.pipeline.export.usd.fidelity`): ``UsdExport.fidelity``.
+    collect
+        Copy every texture file a preset reads into ``<name>_textures`` beside ``path``
+        (UDIM tiles included), referenced by relative paths; otherwise the files are
+        referenced where they are, relative to ``path`` where possible.
+    preview_geometry
+        Add a sphere per material, bound to it, in a grid under ``/Materials/Geometry``.
 
     Returns
     -------
@@ -173,6 +181,8 @@ def export_usd(
         preview_opacity=preview_opacity,
         meters_per_unit=meters_per_unit,
         report=report,
+        collect=collect,
+        preview_geometry=preview_geometry,
     )
     return UsdExport(
         result.files[0],
@@ -237,6 +247,7 @@ def export_mitsuba(
     path: PathLike,
     *,
     ibl: PathLike | None = None,
+    ibl_rotation: float = 0.0,
     resolution: tuple[int, int] = (512, 512),
     spp: int = 128,
     map_resolution: int = 512,
@@ -254,6 +265,10 @@ def export_mitsuba(
     ibl
         A built-in IBL name (``studio``, ``sky``, ``overcast``, ``sunset``) or an
         ``.exr``/``.hdr`` file; None: a constant white sky (the white furnace).
+    ibl_rotation
+        Degrees the IBL turns about +y, with the proofs' orientation convention
+        (:data:`lookdev.pipeline.proof.ibl.ORIENTATION`, stated in the XML): the scene
+        lit as a proof's lighting frame at that angle.
     resolution, spp
         Film size in pixels and samples per pixel.
     map_resolution
@@ -277,6 +292,7 @@ def export_mitsuba(
     for side in resolution:
         check_range(side, 1, FILM_MAX_SIDE, field="--resolution", error=MitsubaExportError)
     check_range(spp, 1, 2**20, field="--spp", error=MitsubaExportError)
+    check_range(ibl_rotation, -360.0, 360.0, field="--ibl-rotation", error=MitsubaExportError)
     material = hub(material, map_resolution, library)
     env = _environment_file(ibl)
     scene = export_scene(
@@ -285,6 +301,7 @@ def export_mitsuba(
         resolution=tuple(resolution),
         spp=spp,
         environment=env,
+        ibl_rotation=ibl_rotation,
         force_all_lobes=force_all_lobes,
     )
     bsdf = scene["ball"]["bsdf"]
@@ -329,6 +346,7 @@ def proof(
     resolution: tuple[int, int] = (192, 96),
     exposure: float = 0.0,
     ibl_width: int = 512,
+    rig: str = "full",
     jobs: int | None = None,
     scheduler: str | None = None,
     executor: Executor | None = None,
@@ -336,14 +354,16 @@ def proof(
     library: Any = None,
     progress: Callable[[Any], None] | None = None,
     context: str | None = None,
+    geometry: PathLike | None = None,
 ) -> dict[str, Any]:
     """Render turntable proofs (Burley §6.1): every material under every IBL.
 
     Each proof turns the element through ``frames`` frames, then the lighting through
     ``light_frames``, and writes under ``out/MATERIAL/IBL/``: EXR frames, view-transformed
-    PNGs, a labelled ``contact.png`` and a ``manifest.json``. Calling again with the same
-    arguments renders only the frames the manifests do not vouch for (size and SHA-256),
-    so an interrupted batch resumes.
+    PNGs, a labelled ``contact.png`` and a ``manifest.json``; and
+    ``out/MATERIAL/material.json`` (resolved parameters, source, USD loss notes) for the
+    review page. Calling again with the same arguments renders only the frames the
+    manifests do not vouch for (size and SHA-256), so an interrupted batch resumes.
 
     Parameters
     ----------
@@ -358,6 +378,9 @@ def proof(
         ``(width, height)``, and stops applied by the PNG view transform.
     ibl_width
         Every IBL is resampled to this width (× ½ high) so render kernels are reused.
+    rig
+        The calibrated rig beside the material (:mod:`lookdev.pipeline.proof.rig`):
+        ``full`` (chrome ball, 18 % grey ball, ColorChecker chart), ``balls``, ``none``.
     jobs
         Local worker processes (default 1: each renders on every core). They are spawned,
         so a script calling :func:`proof` does so under ``if __name__ == "__main__":``.
@@ -366,7 +389,8 @@ def proof(
     executor
         Any ``concurrent.futures.Executor`` to run the proofs on (it is not shut down).
     report
-        Also write ``out/index.html``, a static review page.
+        Also write ``out/index.html``, a static review page: turntable players, a
+        synchronised comparison, raw/denoised, each material's parameters and losses.
     library
         See :func:`load`.
     progress
@@ -377,6 +401,9 @@ def proof(
         ``NAME-universal``: the UsdPreviewSurface values rendered by that surface's own
         BRDF (:func:`lookdev.pipeline.export.usd.fidelity.preview_hub`), what a DCC
         preview shows.
+    geometry
+        A mesh (PLY, OBJ, or USD geometry) rendered in the cup's place beside the ball,
+        with its own UVs (:mod:`lookdev.pipeline.proof.geometry`).
 
     Returns
     -------
@@ -389,6 +416,10 @@ def proof(
     from lookdev.pipeline.proof import ibl as ibl_module
 
     check_proof_settings(resolution, frames, light_frames, spp, exposure, jobs)
+    from lookdev.pipeline.proof.rig import RIGS
+
+    if rig not in RIGS:
+        raise batch.ProofError(f"unknown rig {rig!r}; use {', '.join(RIGS)}", field="--rig")
     lib = library_for(library)
     if materials is None or (not isinstance(materials, str | os.PathLike) and not materials):
         materials = representative_presets(lib)
@@ -396,6 +427,11 @@ def proof(
     # and every texture it names (layers a blend would prune included), every IBL.
     output = Path(out)
     batch.check_writable(output)
+    mesh = None
+    if geometry is not None:
+        from lookdev.pipeline.proof.geometry import proof_mesh
+
+        mesh = str(proof_mesh(geometry))
     chosen = _materials(materials, lib)
     for material in chosen:
         check_textures(material)
@@ -412,7 +448,7 @@ def proof(
         from lookdev.pipeline.export.usd.fidelity import preview_hub
 
         loaded = [h for m in loaded for h in (m, preview_hub(m))]
-    settings = batch.Settings(frames, light_frames, spp, tuple(resolution), exposure)
+    settings = batch.Settings(frames, light_frames, spp, tuple(resolution), exposure, mesh, rig=rig)
     doc = batch.proof(
         loaded,
         environments,
@@ -423,6 +459,9 @@ def proof(
         executor=executor,
         progress=progress,
     )
+    from lookdev.pipeline.proof.material_info import write_material_info
+
+    write_material_info(output, loaded)
     if report:
         from lookdev.pipeline.analysis.report import write_report
 

@@ -18,6 +18,8 @@ In one process, on the variant :func:`~lookdev.pipeline.variant.use_mitsuba` pic
 * **by frame size**: the three runs again at smaller frames (previews), where a frame's
   fixed costs (a rebuild, tracing) weigh more against its samples; it shows up to which
   frame size the 3× target holds.
+* **rig**: the same turntable with the calibrated rig (``full``, the default; ``balls``)
+  against none: what the chrome ball, the grey ball and the chart cost.
 * **pruning**: time and noise of frames of the material as exported (lobes with zero
   weight dropped) against the same material with every lobe forced on, at equal spp.
 
@@ -94,12 +96,13 @@ class Clock:
         self.timing = Timing(time.perf_counter() - wall, time.process_time() - cpu)
 
 
-def time_pipeline(bsdf: dict, depth: int, env: Any, s: Settings) -> Timing:
-    """A whole turntable (scene load included), with the frames' mean noise."""
+def time_pipeline(bsdf: dict, depth: int, env: Any, s: Settings, rig: str = "full") -> Timing:
+    """A whole turntable (scene load included), with the frames' mean noise; ``rig``
+    beside the material (:mod:`lookdev.pipeline.proof.rig`)."""
     from lookdev.pipeline.proof.turntable import Turntable, render_frame
 
     with Clock() as clock:
-        table = Turntable(bsdf, env.pixels, s.resolution, depth)
+        table = Turntable(bsdf, env.pixels, s.resolution, depth, rig=rig)
         noise = [render_frame(table, f, s.spp, seed=f.index) for f in _frames(s.frames)]
     mean_noise = float(np.mean([r.noise_relative or 0.0 for r in noise]))
     return Timing(clock.timing.wall, clock.timing.cpu, mean_noise)
@@ -256,6 +259,8 @@ def run(s: Settings) -> dict[str, Any]:
     forced, _ = material_bsdf(material, force_all_lobes=True)
     cases = turntable_cases(bsdf, depth, env, s)
     cases["all_lobes"] = lambda: time_pipeline(forced, depth, env, s)
+    for rig in ("balls", "none"):  # the pipeline's own run has the default, full rig
+        cases[f"rig_{rig}"] = lambda rig=rig: time_pipeline(bsdf, depth, env, s, rig)
     got = interleaved(cases, s.repeat)
     turntable = compare(got)
     sizes = by_frame_size(bsdf, depth, env, s)
@@ -273,6 +278,14 @@ def run(s: Settings) -> dict[str, Any]:
         | {"targets": {"speedup_vs_naive": ">= 3", "overhead_vs_bare": "< 0.10"}},
         "by_frame_size": [*sizes, main],
         "speedup_target_met_up_to_samples_per_frame": target_met_up_to([*sizes, main]),
+        "rig": {
+            "full": pipeline.to_json(),
+            "balls": got["rig_balls"].to_json(),
+            "none": got["rig_none"].to_json(),
+            "cost_full_vs_none": pipeline.wall / got["rig_none"].wall,
+            "cpu_cost_full_vs_none": pipeline.cpu / got["rig_none"].cpu,
+            "cost_balls_vs_none": got["rig_balls"].wall / got["rig_none"].wall,
+        },
         "pruning": {
             "pruned": pipeline.to_json() | {"noise_relative": pipeline.noise},
             "all_lobes": all_on.to_json() | {"noise_relative": all_on.noise},

@@ -371,6 +371,10 @@ def _print_proof(report: dict[str, Any], s: proof.Settings) -> None:
     ]
     columns = ["material", "wall s", "CPU s", "noise (rel)"]
     console.print(table(f"lobe pruning at {s.spp} spp", columns, rows))
+    r = report["rig"]
+    rows = [[name, r[name]["wall_s"], r[name]["wall_s"] / r["none"]["wall_s"], r[name]["cpu_s"]]
+            for name in ("full", "balls", "none")]  # fmt: skip
+    console.print(table("the calibrated rig (--rig)", ["rig", "wall s", "× none", "CPU s"], rows))
 
 
 def usd_(

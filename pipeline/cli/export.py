@@ -35,6 +35,16 @@ def mitsuba(
             "(default: a constant white sky, the white-furnace set-up).",
         ),
     ] = None,
+    ibl_rotation: Annotated[
+        float,
+        typer.Option(
+            "--ibl-rotation",
+            min=-360.0,
+            max=360.0,
+            help="Turn the IBL by this many degrees about +y, as a proof's lighting frame "
+            "does (positive: a front light moves to the camera's right).",
+        ),
+    ] = 0.0,
     map_resolution: Annotated[
         int,
         typer.Option(
@@ -74,6 +84,7 @@ def mitsuba(
             preset,
             output,
             ibl=environment,
+            ibl_rotation=ibl_rotation,
             resolution=resolution,
             spp=spp,
             map_resolution=map_resolution,

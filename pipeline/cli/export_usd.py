@@ -68,7 +68,7 @@ def export_usd(
         typer.Option(
             "--split",
             help="One file per material in this folder; -o becomes a library that references "
-            "them, with a variant set 'preset' on /Look to switch between them.",
+            "them, with a variant set 'preset' on /Materials/Look to switch between them.",
         ),
     ] = None,
     all_presets: Annotated[
@@ -105,6 +105,21 @@ def export_usd(
             "directional albedo over view angles (RMS, worst) and the highlight ratio.",
         ),
     ] = False,
+    collect: Annotated[
+        bool,
+        typer.Option(
+            "--collect",
+            help="Copy the presets' texture files (UDIM tiles included) into NAME_textures "
+            "beside the output and reference them by relative paths.",
+        ),
+    ] = False,
+    preview_geometry: Annotated[
+        bool,
+        typer.Option(
+            "--preview-geometry",
+            help="Add a sphere per material, bound to it, so a DCC's default import shows it.",
+        ),
+    ] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
     """Write presets as UsdShade materials that DCCs and their renderers read.
@@ -117,7 +132,10 @@ def export_usd(
     --preview-opacity transmission. Only what a material needs is written: inputs at the target's
     default and lobes without weight are left out. Layered presets are blended and their
     varying parameters baked to EXR maps beside the file (UsdPreviewSurface has no mix
-    node). With several presets, /Look carries a variant set that switches between them.
+    node). With several presets, /Materials/Look carries a variant set that switches between
+    them. A parameter read from one texture file references that file (its colour space
+    named: sourceColorSpace, colorSpace, colorspace, linearize), or a copy with --collect;
+    a preset's height map becomes displacement in scene units (metersPerUnit = 1).
 
     Clearcoat in UsdPreviewSurface: clearcoat = 0.25 x lookdev's clearcoat (Burley weights
     his GTR1 coat 0.25, the spec's coat is unweighted: the scale keeps the coat's reflected
@@ -154,6 +172,8 @@ def export_usd(
             preview_opacity=preview_opacity.value,
             meters_per_unit=meters_per_unit,
             report=report,
+            collect=collect,
+            preview_geometry=preview_geometry,
         )
     if as_json:
         print_json(result.to_json())

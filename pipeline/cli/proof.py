@@ -24,6 +24,14 @@ class ProofContext(StrEnum):
     universal = "universal"
 
 
+class Rig(StrEnum):
+    """``--rig``: the values of :data:`lookdev.pipeline.proof.rig.RIGS`."""
+
+    full = "full"
+    balls = "balls"
+    none = "none"
+
+
 def proof(
     presets: Annotated[
         list[str] | None,
@@ -77,6 +85,14 @@ def proof(
             "--ibl-width", min=8, max=8192, help="Every IBL is resampled to this width (×½ high)."
         ),
     ] = 512,
+    rig: Annotated[
+        Rig,
+        typer.Option(
+            "--rig",
+            help="The calibrated rig beside the material: full (chrome ball, 18 % grey "
+            "ball, ColorChecker chart), balls, or none.",
+        ),
+    ] = Rig.full,
     scheduler: Annotated[
         str | None,
         typer.Option(
@@ -102,12 +118,23 @@ def proof(
     as_json: Annotated[
         bool, typer.Option("--json", help="Print the batch manifest as one JSON object.")
     ] = False,
+    geometry: Annotated[
+        Path | None,
+        typer.Option(
+            "--geometry",
+            "-g",
+            help="A mesh (PLY, OBJ, or USD geometry) shown in the cup's place beside the "
+            "ball, with its own UVs (UDIM tiles included).",
+        ),
+    ] = None,
     report: Annotated[
         bool,
         typer.Option(
             "--report",
-            help="Also write OUTPUT/index.html: contact sheets, time/noise table, each "
-            "material's BRDF plots and its frames; static, opens from disk.",
+            help="Also write OUTPUT/index.html, the review page: turntable players, a "
+            "synchronised comparison across materials or IBLs, raw/denoised, each "
+            "material's parameters, source, USD losses and BRDF plots, every frame's "
+            "spp/noise/time; static, opens from disk, offline.",
         ),
     ] = False,
     context: Annotated[
@@ -135,6 +162,8 @@ def proof(
       lookdev proof gold velvet --ibl studio --ibl ~/hdri/loft.exr -o proofs
 
       lookdev proof copper --spp 256 --resolution 640 320 --scheduler tcp://farm:8786
+
+      lookdev proof hero.toml --geometry hero.usd --ibl studio
     """
     from lookdev.pipeline import api
     from lookdev.pipeline.proof import batch
@@ -165,12 +194,14 @@ def proof(
             resolution=resolution,
             exposure=exposure,
             ibl_width=ibl_width,
+            rig=rig.value,
             jobs=workers,
             scheduler=scheduler,
             report=report,
             library=library,
             progress=show,
             context=None if context is None else context.value,
+            geometry=geometry,
         )
     if as_json:
         print_json(doc)

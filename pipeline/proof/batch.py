@@ -41,7 +41,8 @@ import numpy as np
 from lookdev.library import files
 from lookdev.materials.errors import LookdevError
 
-from . import contact, tonemap
+from . import contact, ibl, rig, tonemap
+from .rig import DEFAULT_RIG
 from .turntable import Frame, frames
 
 MANIFEST = "manifest.json"
@@ -69,6 +70,10 @@ class Settings:
     spp: int = 32
     resolution: tuple[int, int] = (192, 96)
     exposure: float = 0.0  # display only: applied by the view transform, not the render
+    geometry: str | None = None
+    """A mesh in the cup's place (the cached PLY of :func:`.geometry.proof_mesh`: its
+    name holds the hash of the user's file, so the proof key follows the mesh)."""
+    rig: str = DEFAULT_RIG  # the calibrated rig beside the material (.rig)
 
     def frames(self) -> list[Frame]:
         return frames(self.element_frames, self.light_frames)
@@ -163,6 +168,8 @@ def run_job(job: Job) -> dict[str, Any]:
         "key": job.key,
         "variant": variant,
         "settings": job.settings.as_json(),
+        "rig": rig.manifest_entry(job.settings.rig),
+        "ibl_orientation": ibl.ORIENTATION,
         "frames": [done[i] for i in sorted(done)],
     }
     rendered = 0
@@ -182,7 +189,14 @@ def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
     from .turntable import Turntable, material_bsdf, render_frame
 
     bsdf, depth = material_bsdf(job.material)
-    table = Turntable(bsdf, job.environment, job.settings.resolution, depth)
+    table = Turntable(
+        bsdf,
+        job.environment,
+        job.settings.resolution,
+        depth,
+        job.settings.geometry,
+        rig=job.settings.rig,
+    )
     for frame in todo:
         r = render_frame(table, frame, job.settings.spp, seed=frame.index)
         stem = job.folder / f"frame_{frame.index:03d}"
@@ -450,6 +464,7 @@ def summary(out: Path, jobs: list[Job], results: list[dict[str, Any]], seconds: 
         "version": FORMAT_VERSION,
         "wall_seconds": round(seconds, 3),
         "settings": jobs[0].settings.as_json() if jobs else {},
+        "ibl_orientation": ibl.ORIENTATION,
         "proofs": entries,
         "overview": overview(out, entries).name if entries else None,
     }

@@ -16,6 +16,13 @@ Lat-long convention (Mitsuba's ``envmap``): (u, v) looks along
 Light directions in the definitions are (azimuth, elevation) in degrees with azimuth 0
 towards the camera (+z: a front light), 90 from the camera's right (+x), 180 behind the
 subject (a rim light).
+
+Orientation convention (:data:`ORIENTATION`; written to every proof manifest and as a
+comment into exported Mitsuba scenes, which use the same :func:`envmap_to_world`):
+**up is +y**; at **rotation 0** the lat-long's centre column (u = ½) lies towards the
+camera (+z) and u = ¼ towards the camera's right (+x), row 0 is the zenith; a **positive
+rotation** turns the environment about +y right-handedly, counter-clockwise seen from
+above: a light in front of the subject moves to the camera's right at +90°.
 """
 
 from __future__ import annotations
@@ -28,6 +35,7 @@ import os
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
@@ -36,6 +44,16 @@ from lookdev.materials.errors import LookdevError, one_line
 
 from .contact import ProofImageError, write_exr
 
+ORIENTATION = {
+    "up": "+y",
+    "camera": "on +z looking towards -z, +x to its right",
+    "zero_rotation": "lat-long centre column (u = 0.5) towards the camera (+z), "
+    "u = 0.25 towards the camera's right (+x), row 0 the zenith (+y)",
+    "positive_rotation": "right-handed about +y (counter-clockwise seen from above): "
+    "a light in front (+z) moves to the camera's right (+x) at +90 degrees",
+    "convention": "Mitsuba 3 envmap, to_world = rotate(+y, degrees)",
+}
+"""The IBL orientation every proof and exported scene uses (module docstring)."""
 GENERATOR_VERSION = 1  # bump when the generator's maths changes: invalidates the cache
 DEFAULT_WIDTH = 512
 SUFFIXES = (".exr", ".hdr")
@@ -176,6 +194,13 @@ def direction(azimuth: float, elevation: float) -> np.ndarray:
     """Unit vector towards (azimuth, elevation) in degrees (module docstring convention)."""
     az, el = math.radians(azimuth), math.radians(elevation)
     return np.array([math.sin(az) * math.cos(el), math.sin(el), math.cos(az) * math.cos(el)])
+
+
+def envmap_to_world(degrees: float = 0.0) -> Any:
+    """The envmap's ``to_world`` at lighting rotation ``degrees`` (:data:`ORIENTATION`)."""
+    import mitsuba as mi
+
+    return mi.ScalarTransform4f().rotate([0.0, 1.0, 0.0], float(degrees))
 
 
 def _smooth_step(x: np.ndarray) -> np.ndarray:

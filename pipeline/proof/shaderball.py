@@ -8,7 +8,8 @@ tilted about its own centre it rests on the ground at any tilt and any turntable
 
 The cup is a triangle mesh generated with numpy and written once as a binary PLY into
 the cache (:func:`cup_ply`), so a scene dict, the naive benchmark script and an exported
-XML scene all load the same file. World: y up, camera on +z looking at the pair.
+XML scene all load the same file. World: y up, camera on +z looking at the pair; the
+calibrated rig (:mod:`.rig`) stands right of the cup and the camera frames it too.
 """
 
 from __future__ import annotations
@@ -23,7 +24,9 @@ import numpy as np
 
 from lookdev.library import files
 
-from .ibl import cache_dir
+from . import rig as rig_module
+from .ibl import cache_dir, envmap_to_world
+from .rig import DEFAULT_RIG
 
 GROUND_ALBEDO = 0.18  # a photographer's mid-grey card
 BALL_CENTER = (-1.2, 1.0, 0.0)
@@ -135,16 +138,40 @@ def cup_ply() -> Path:
     return path if path.is_file() else write_ply(cup_mesh(), path)
 
 
-def camera(width: int, height: int) -> dict[str, Any]:
-    """A perspective camera framing both shapes, slightly above them."""
+PAIR_HALF_WIDTH = 2.3
+"""Half the width the ball and the cup take together (x from −2.3 to 2.3)."""
+MARGIN = 0.6
+"""Space left and right of what is framed, in world units."""
+ELEVATION_DEG, DISTANCE = 14.0, 9.0
+
+
+def framed(rig: str = DEFAULT_RIG) -> tuple[float, float]:
+    """(left, right) world x the camera frames: the pair and the ``rig`` beside it."""
+    left, right = -PAIR_HALF_WIDTH, PAIR_HALF_WIDTH
+    if rig != "none":
+        lo, hi = rig_module.extent(rig)
+        left, right = min(left, lo), max(right, hi)
+    return left, right
+
+
+def eye(rig: str = DEFAULT_RIG) -> tuple[np.ndarray, np.ndarray]:
+    """(camera origin, target) framing the pair and the ``rig`` beside it."""
+    left, right = framed(rig)
+    elevation = math.radians(ELEVATION_DEG)
+    target = np.array([(left + right) / 2, 0.85, 0.0])
+    origin = target + DISTANCE * np.array([0.0, math.sin(elevation), math.cos(elevation)])
+    return origin, target
+
+
+def camera(width: int, height: int, rig: str = DEFAULT_RIG) -> dict[str, Any]:
+    """A perspective camera framing both shapes and the rig, slightly above them."""
     import mitsuba as mi
 
-    elevation, distance = math.radians(14.0), 9.0
-    target = np.array([0.0, 0.85, 0.0])
-    origin = target + distance * np.array([0.0, math.sin(elevation), math.cos(elevation)])
-    # Horizontal field of view that fits the pair (≈ 4.6 units wide) with a margin; a
-    # tall film keeps the same width and shows more ground and sky.
-    fov = 2.0 * math.degrees(math.atan(2.9 / distance))
+    origin, target = eye(rig)
+    left, right = framed(rig)
+    # Horizontal field of view that fits what is framed with a margin; a tall film keeps
+    # the same width and shows more ground and sky.
+    fov = 2.0 * math.degrees(math.atan(((right - left) / 2 + MARGIN) / DISTANCE))
     return {
         "type": "perspective",
         "fov": fov,
@@ -195,11 +222,18 @@ def scene_dict(
     environment: np.ndarray,
     resolution: tuple[int, int],
     max_depth: int,
+    geometry: str | Path | None = None,
+    *,
+    rig: str = DEFAULT_RIG,
 ) -> dict[str, Any]:
-    """The shader-ball scene; the same ``bsdf`` on the ball and the cup.
+    """The shader-ball scene; the same ``bsdf`` on the ball and the cup, the ``rig``
+    (:mod:`.rig`: ``full``, ``balls`` or ``none``) beside them.
+
+    ``geometry``: a PLY already placed in the cup's slot (:func:`.geometry.proof_mesh`)
+    shown instead of the cup, turning about the same centre.
 
     ``environment`` is a lat-long (H, W, 3) float32 array, used as it is (exposure is
-    already in its pixels, see :mod:`.ibl`).
+    already in its pixels, see :mod:`.ibl`) and oriented by :data:`.ibl.ORIENTATION`.
     """
     import mitsuba as mi
 
@@ -207,10 +241,11 @@ def scene_dict(
     return {
         "type": "scene",
         "integrator": {"type": "path", "max_depth": int(max_depth)},
-        "sensor": camera(width, height),
+        "sensor": camera(width, height, rig),
         "environment": {
             "type": "envmap",
             "bitmap": mi.Bitmap(np.ascontiguousarray(environment, dtype=np.float32)),
+            "to_world": envmap_to_world(0.0),
         },
         "material": bsdf | {"id": "material"},
         # Each shape sits in a shapegroup placed by an instance: turning an instance
@@ -221,7 +256,7 @@ def scene_dict(
             "type": "shapegroup",
             "shape": {
                 "type": "ply",
-                "filename": str(cup_ply()),
+                "filename": str(geometry or cup_ply()),
                 "face_normals": False,
                 "bsdf": _material,
             },
@@ -233,4 +268,5 @@ def scene_dict(
             "to_world": mi.ScalarTransform4f().rotate([1, 0, 0], -90).scale([30, 30, 1]),
             "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": GROUND_ALBEDO}},
         },
+        **rig_module.shapes(rig, tuple(eye(rig)[0])),
     }

@@ -25,6 +25,8 @@ import numpy as np
 from lookdev.materials.colour import luminance
 
 from . import shaderball
+from .ibl import envmap_to_world
+from .rig import DEFAULT_RIG
 
 
 @dataclass(frozen=True)
@@ -58,7 +60,11 @@ def material_bsdf(hub: Any, *, force_all_lobes: bool = False) -> tuple[dict, int
 
 
 class Turntable:
-    """A loaded shader-ball scene whose rotations are set per frame, never reloaded."""
+    """A loaded shader-ball scene whose rotations are set per frame, never reloaded.
+
+    ``rig`` places the calibrated rig beside the material (:mod:`.rig`); it stays put
+    while the element turns and turns with the lighting.
+    """
 
     def __init__(
         self,
@@ -66,10 +72,13 @@ class Turntable:
         environment: np.ndarray,
         resolution: tuple[int, int],
         max_depth: int,
+        geometry: str | None = None,
+        *,
+        rig: str = DEFAULT_RIG,
     ):
         import mitsuba as mi
 
-        scene = shaderball.scene_dict(bsdf, environment, resolution, max_depth)
+        scene = shaderball.scene_dict(bsdf, environment, resolution, max_depth, geometry, rig=rig)
         scene["sensor_pair"] = _sensor_pair(scene["sensor"])
         self.scene = mi.load_dict(scene)
         self.width = int(resolution[0])
@@ -88,15 +97,13 @@ class Turntable:
         Turning the element re-commits the scene's top-level acceleration structure, so a
         lighting frame after the first touches the envmap's ``to_world`` alone.
         """
-        import mitsuba as mi
-
         element = frame.angle if frame.kind == "element" else 0.0
         light = frame.angle if frame.kind == "light" else 0.0
         if element != self._pose[0]:
             self.params["ball.to_world"] = shaderball.ball_to_world(element)
             self.params["cup.to_world"] = shaderball.cup_to_world(element)
         if light != self._pose[1]:
-            self.params["environment.to_world"] = mi.ScalarTransform4f().rotate([0, 1, 0], light)
+            self.params["environment.to_world"] = envmap_to_world(light)
         self._pose = (element, light)
         self.params.update()
 

@@ -154,10 +154,37 @@ def bsdf_dict(
 
     def normal_texture(normals: np.ndarray, name: str) -> dict[str, Any]:
         encoded = _encode_normals(np.asarray(normals, dtype=np.float32))
-        return _bitmap(encoded, True, hub.name, name, texture_dir)
+        return _tiled(_bitmap(encoded, True, hub.name, name, texture_dir), hub)
 
     frames = (hub.normal_map, hub.specular_normal_map)
-    return with_normals(out, model, lobes, frames, normal_texture)
+    return with_bump(hub, with_normals(out, model, lobes, frames, normal_texture), texture_dir)
+
+
+def with_bump(
+    hub: BlendedMaterial, bsdf: dict[str, Any], texture_dir: str | Path | None = None
+) -> dict[str, Any]:
+    """``bsdf`` under Mitsuba's ``bumpmap`` when the material has a height map.
+
+    The map holds heights in scene units (:attr:`BlendedMaterial.height_map`), and
+    ``bumpmap`` offsets the surface by ``scale`` × the texture along the normal when it
+    differentiates the position (Mitsuba 3 ``bumpmap``: ∂p/∂u + n·∂h/∂u), so ``scale``
+    is 1: the proof shows the bump the USD ``displacement`` describes, as shading."""
+    if hub.height_map is None:
+        return bsdf
+    height = _bitmap(hub.height_map, False, hub.name, "height", texture_dir)
+    return {"type": "bumpmap", "height": _tiled(height, hub), "scale": 1.0, "bsdf": bsdf}
+
+
+def _tiled(texture: dict[str, Any], hub: BlendedMaterial) -> dict[str, Any]:
+    """A map spanning UDIM tiles (``hub.map_tiles``) read at UV (u, v) ∈ [0, nu)×[0, nv)."""
+    nu, nv = hub.map_tiles
+    if (nu, nv) == (1, 1):
+        return texture
+    import mitsuba as mi
+
+    texture["to_uv"] = mi.ScalarTransform4f().scale([1.0 / nu, 1.0 / nv, 1.0])
+    texture["wrap_mode"] = "clamp"
+    return texture
 
 
 def _plugin_dict(hub: BlendedMaterial, texture_dir: str | Path | None) -> dict[str, Any]:
@@ -245,11 +272,14 @@ def scene_dict(
     texture_dir: str | Path | None = None,
     force_all_lobes: bool = False,
     max_depth: int | None = None,
+    ibl_rotation: float = 0.0,
 ) -> dict[str, Any]:
     """A minimal scene: the material on a unit sphere, framed, under an environment.
 
-    ``environment`` is a lat-long image (``envmap``); without one, a constant white sky
-    (the white-furnace set-up). The integrator depth follows the material; the film
+    ``environment`` is a lat-long image (``envmap``) oriented as in the proofs (y up,
+    camera on +z, :data:`lookdev.pipeline.proof.ibl.ORIENTATION`) and turned by
+    ``ibl_rotation`` degrees about +y; without one, a constant white sky (the
+    white-furnace set-up). The integrator depth follows the material; the film
     holds RGB only (no alpha, no AOVs).
     """
     import mitsuba as mi
@@ -266,7 +296,13 @@ def scene_dict(
     if environment is None:
         emitter = {"type": "constant", "radiance": {"type": "rgb", "value": [1.0, 1.0, 1.0]}}
     else:
-        emitter = {"type": "envmap", "filename": str(environment)}
+        from lookdev.pipeline.proof.ibl import envmap_to_world
+
+        emitter = {
+            "type": "envmap",
+            "filename": str(environment),
+            "to_world": envmap_to_world(ibl_rotation),
+        }
     return {
         "type": "scene",
         "integrator": {"type": "path", "max_depth": max_depth or max_depth_for(hub)},

@@ -112,9 +112,26 @@ def to_xml(tree: Mapping[str, Any], *, relative_to: Path | None = None) -> str:
     root = to_element(tree)
     ET.indent(root)
     body = ET.tostring(root, encoding="unicode")
+    if _has_envmap(tree):
+        body = f"<!--{orientation_note()}-->\n{body}"
     if uses_our_plugins(tree):
         body = f"<!--{LOAD_HINT}-->\n{body}"
     return body + "\n"
+
+
+def orientation_note() -> str:
+    """The IBL orientation convention, as the comment an exported scene carries."""
+    from lookdev.pipeline.proof.ibl import ORIENTATION
+
+    return (
+        " lookdev IBL orientation: " + "; ".join(f"{k}: {v}" for k, v in ORIENTATION.items()) + " "
+    )
+
+
+def _has_envmap(tree: Mapping[str, Any]) -> bool:
+    if tree.get("type") == "envmap":
+        return True
+    return any(isinstance(v, Mapping) and _has_envmap(v) for v in tree.values())
 
 
 def _relative_filenames(tree: Mapping[str, Any], base: Path) -> dict[str, Any]:

@@ -14,7 +14,7 @@ from typing import Any
 
 from lookdev.library import files
 
-__all__ = ["export_materials"]
+__all__ = ["export_materials", "loss_notes"]
 
 
 def export_materials(
@@ -31,6 +31,8 @@ def export_materials(
     preview_opacity: str = "keep",
     meters_per_unit: float = 1.0,
     report: bool = False,
+    collect: bool = False,
+    preview_geometry: bool = False,
 ):
     """Write blended materials (:class:`~lookdev.pipeline.blend.BlendedMaterial`) as
     UsdShade materials to ``out``.
@@ -46,6 +48,9 @@ def export_materials(
     stage's ``metersPerUnit`` (lengths are written in its units). ``report``: measure each
     material's universal context against the material (:mod:`.fidelity`), in the
     result's ``fidelity``.
+    ``preview_opacity``: see :data:`.names.PREVIEW_OPACITY`. ``collect`` copies the
+    presets' own texture files beside ``out``; ``preview_geometry`` adds a sphere per
+    material (:func:`.writer.export_usd`).
     """
     from .network import CONTEXTS
     from .record import preset_record
@@ -82,6 +87,29 @@ def export_materials(
             workdir=Path(scratch),
             preview_opacity=preview_opacity,
             meters_per_unit=meters_per_unit,
+            collect=collect,
+            preview_geometry=preview_geometry,
         )
         result.fidelity = measured
         return result
+
+
+def loss_notes(
+    material: Any, contexts: Sequence[str] | None = None, preview_opacity: str = "keep"
+) -> dict[str, str]:
+    """``{context: note}``: what each render context of an export of ``material`` (a
+    blended material) could not express (``""``: nothing), as :func:`export_materials`
+    would record it, without writing a stage. Layered materials bake their maps into a
+    temporary folder that is removed afterwards.
+    """
+    import tempfile
+
+    from .network import CONTEXTS
+    from .sources import source_for
+    from .writer import losses_of, material_spec
+
+    contexts = tuple(contexts) if contexts else CONTEXTS
+    with tempfile.TemporaryDirectory(prefix="lookdev-losses-") as scratch:
+        source = source_for(material, Path(scratch, "textures"), scratch=Path(scratch))
+        spec = material_spec(source, contexts, preview_opacity)
+        return losses_of([spec])[spec.name]

@@ -31,7 +31,7 @@ from lookdev.materials.preview_surface import PreviewParams
 from lookdev.pipeline.blend.result import BlendedMaterial
 
 from .names import table_for
-from .network import Connection, Source
+from .network import Connection, Source, plain_value
 from .preview import build, preview_defaults
 
 __all__ = [
@@ -92,6 +92,7 @@ def preview_params(source: Source, preview_opacity: str = "keep") -> PreviewPara
     values = dict(preview_defaults())
     slots = {s.input: s for s in table_for("universal", source.model, preview_opacity)}
     for name, (_, value) in surface.inputs.items():
+        value = plain_value(value)  # an interface input: the value it holds
         if isinstance(value, Connection):
             slot = slots.get(name)
             if slot is None:
@@ -241,6 +242,7 @@ def _preview_hub(hub: Any, source: Source) -> Any:
     constants = preview_params(source).model_dump()
     maps: dict[str, np.ndarray] = {}
     for name, (_, value) in surface.inputs.items():
+        value = plain_value(value)
         field = _PREVIEW_FIELDS.get(name)
         slot = slots.get(name)
         if not isinstance(value, Connection) or field not in PREVIEW_MAPPED or slot is None:

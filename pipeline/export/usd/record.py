@@ -72,9 +72,10 @@ def network_digest(networks: list[Any]) -> str:
     node's id and inputs, values as USD stores them (float32), asset paths left out (they
     move with the file), connections by node and output. The same for the networks an
     export authors and for those read back from its file."""
-    from .network import Connection, Image
+    from .network import Connection, Image, plain_value
 
     def plain(value: Any) -> Any:
+        value = plain_value(value)  # an interface input: the value it holds
         if isinstance(value, Connection):
             return f"->{value.node}.{value.output}"
         if isinstance(value, Image) or hasattr(value, "resolvedPath"):
@@ -90,8 +91,16 @@ def network_digest(networks: list[Any]) -> str:
     rows = []
     for net in networks:
         terminal = f"{net.terminal.node}.{net.terminal.output}"
-        for node in net.nodes:
+        by_name = {n.name: n for n in net.nodes}
+        todo, seen = [net.terminal.node], set()
+        while todo:  # the nodes the surface reads (what an import collects), once each
+            name = todo.pop()
+            node = by_name.get(name)
+            if node is None or name in seen:
+                continue
+            seen.add(name)
             inputs = sorted((k, plain(v)) for k, (_, v) in node.inputs.items())
             rows.append([net.context, terminal, node.name, node.id, inputs])
+            todo += [v.node for _, v in node.inputs.values() if isinstance(v, Connection)]
     text = json.dumps(sorted(rows, key=lambda r: (r[0], r[2])), sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()

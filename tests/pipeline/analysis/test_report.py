@@ -1,31 +1,18 @@
-"""The review page: built from a proof batch, opened in headless Chromium.
-
-Chromium is driven over the DevTools protocol on a pipe (``--remote-debugging-pipe``:
-fd 3 into the browser, fd 4 out of it, NUL-separated JSON), so the test sees console
-messages, exceptions, failed loads, every request and every image's decoded size, and
-saves a screenshot. No port is opened and nothing leaves the machine.
-"""
+"""The review page: built from a proof batch, opened in headless Chromium
+(tests/_chromium.py; the interactive checks are in test_review.py)."""
 
 from __future__ import annotations
 
-import base64
-import fcntl
 import json
-import os
-import select
-import shutil
-import subprocess
-import time
 from pathlib import Path
 from urllib.parse import unquote
 
 import numpy as np
 import OpenImageIO as oiio
 import pytest
+from _chromium import needs_chromium, open_in_chromium
 
 from lookdev.pipeline.analysis import report as R
-
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 
 
 def _write_image(path: Path, pixels: np.ndarray) -> Path:
@@ -131,180 +118,28 @@ def test_bad_batches_are_one_line_errors(tmp_path):
     assert not (tmp_path / "index.html").exists()
 
 
+def _page_data(index) -> dict:
+    text = index.read_text()
+    raw = text.split('id="lookdev-data">', 1)[1].split("</script>", 1)[0]
+    return json.loads(raw)
+
+
 def test_page_links_only_files_that_exist_and_nothing_remote(batch):
     index = R.write_report(batch, plots=False)
     text = index.read_text()
     assert "http://" not in text and "https://" not in text
     import re
 
-    srcs = re.findall(r'src="([^"]+)"', text)
-    assert len(srcs) == 1 + 4 * 3  # contact sheet + frames
-    for src in srcs:
+    srcs = re.findall(r'(?:src|href)="([^"#]+)"', text)
+    assert len(srcs) == 1 + 2  # contact sheet + the page's script and style sheet
+    data = _page_data(index)
+    frames = [f["raw"] for p in data["proofs"] for f in p["frames"]]
+    assert len(frames) == 4 * 3
+    for src in [*srcs, *frames]:
         assert (batch / unquote(src.replace("&amp;", "&"))).is_file(), src
 
 
-# -- headless Chromium -----------------------------------------------------------------
-class DevTools:
-    """A minimal DevTools-protocol client over Chromium's debugging pipe."""
-
-    def __init__(self, user_dir: Path):
-        to_browser_r, self._w = os.pipe()
-        self._r, from_browser_w = os.pipe()
-
-        def wire():  # in the child: fd 3 reads our commands, fd 4 writes replies
-            # Copy both above 10 first: either may already sit on 3 or 4, and dup2 onto
-            # itself would keep the close-on-exec flag.
-            a = fcntl.fcntl(to_browser_r, fcntl.F_DUPFD, 10)
-            b = fcntl.fcntl(from_browser_w, fcntl.F_DUPFD, 10)
-            os.dup2(a, 3)
-            os.dup2(b, 4)
-
-        self.proc = subprocess.Popen(
-            [
-                CHROMIUM,
-                "--headless",
-                "--no-sandbox",
-                "--disable-gpu",
-                "--disable-quic",
-                "--no-first-run",
-                "--disable-background-networking",
-                "--disable-component-update",
-                "--disable-sync",
-                "--disable-dev-shm-usage",
-                f"--user-data-dir={user_dir}",
-                "--remote-debugging-pipe",
-                "about:blank",
-            ],
-            close_fds=False,  # the pipe ends must survive until wire() has run
-            preexec_fn=wire,
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.PIPE,
-        )
-        os.close(to_browser_r)
-        os.close(from_browser_w)
-        self._buf = b""
-        self._id = 0
-        self.events: list[dict] = []
-
-    def send(
-        self,
-        method: str,
-        params: dict | None = None,
-        session: str | None = None,
-        timeout: float = 30.0,
-    ) -> dict:
-        self._id += 1
-        msg = {"id": self._id, "method": method, "params": params or {}}
-        if session:
-            msg["sessionId"] = session
-        os.write(self._w, json.dumps(msg).encode() + b"\0")
-        while True:
-            reply = self._next(timeout)
-            if reply.get("id") == self._id:
-                if "error" in reply:
-                    raise RuntimeError(f"{method}: {reply['error']}")
-                return reply["result"]
-            self.events.append(reply)
-
-    def wait_for(self, method: str, timeout: float = 30.0) -> dict:
-        for e in self.events:
-            if e.get("method") == method:
-                return e
-        while True:
-            e = self._next(timeout)
-            self.events.append(e)
-            if e.get("method") == method:
-                return e
-
-    def _next(self, timeout: float) -> dict:
-        deadline = time.monotonic() + timeout
-        while b"\0" not in self._buf:
-            left = deadline - time.monotonic()
-            if left <= 0 or not select.select([self._r], [], [], left)[0]:
-                raise TimeoutError("Chromium did not answer")
-            chunk = os.read(self._r, 1 << 16)
-            if not chunk:
-                raise RuntimeError(
-                    "Chromium closed the pipe: " + self.proc.stderr.read().decode()[-500:]
-                )
-            self._buf += chunk
-        raw, self._buf = self._buf.split(b"\0", 1)
-        return json.loads(raw)
-
-    def close(self) -> None:
-        try:
-            self.send("Browser.close", timeout=5)
-        except (RuntimeError, TimeoutError, OSError):
-            pass
-        try:
-            self.proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-        os.close(self._w)
-        os.close(self._r)
-
-
-def open_in_chromium(page: Path, profile: Path) -> dict:
-    """Load ``page`` and collect what a reviewer would trip over, plus a screenshot."""
-    browser = DevTools(profile)
-    try:
-        target = browser.send("Target.createTarget", {"url": "about:blank"})["targetId"]
-        session = browser.send("Target.attachToTarget", {"targetId": target, "flatten": True})
-        session = session["sessionId"]
-        for domain in ("Runtime", "Log", "Page", "Network"):
-            browser.send(f"{domain}.enable", session=session)
-        browser.send("Page.navigate", {"url": page.as_uri()}, session=session)
-        browser.wait_for("Page.loadEventFired")
-        images = browser.send(
-            "Runtime.evaluate",
-            {
-                "expression": "JSON.stringify([...document.images].map(i => "
-                "[i.getAttribute('src'), i.complete, i.naturalWidth]))",
-                "returnByValue": True,
-            },
-            session=session,
-        )["result"]["value"]
-        shot = browser.send(
-            "Page.captureScreenshot",
-            {"format": "png", "captureBeyondViewport": True},
-            session=session,
-        )["data"]
-    finally:
-        browser.close()
-
-    def params(method: str) -> list[dict]:
-        return [e["params"] for e in browser.events if e.get("method") == method]
-
-    images = json.loads(images)
-    return {
-        "console": [
-            p
-            for p in params("Runtime.consoleAPICalled")
-            if p["type"] in ("error", "assert", "warning")
-        ],
-        "exceptions": params("Runtime.exceptionThrown"),
-        "log": [
-            p["entry"]
-            for p in params("Log.entryAdded")
-            if p["entry"]["level"] in ("error", "warning")
-        ],
-        "failed": params("Network.loadingFailed"),
-        "remote": [
-            p["request"]["url"]
-            for p in params("Network.requestWillBeSent")
-            if not p["request"]["url"].startswith(("file:", "data:"))
-        ],
-        "images": images,
-        "broken": [src for src, done, width in images if not done or width == 0],
-        "screenshot": base64.b64decode(shot),
-    }
-
-
-needs_chromium = pytest.mark.skipif(
-    CHROMIUM is None, reason="chromium not installed (scripts/setup.sh installs it)"
-)
-
-
+# -- headless Chromium ---------------------------------------------------------------
 @pytest.mark.slow
 @needs_chromium
 def test_the_chromium_check_itself_sees_broken_images_and_console_errors(tmp_path):
@@ -332,8 +167,8 @@ def test_page_opens_in_chromium_without_errors_or_broken_images(batch, tmp_path)
     shot.write_bytes(seen["screenshot"])
     for problem in ("console", "exceptions", "log", "failed", "remote", "broken"):
         assert not seen[problem], (problem, seen[problem])
-    # a contact sheet, 12 frames and gold's plots
-    assert len(seen["images"]) == 13 + len(R.PLOT_VIEWS)
+    # a contact sheet, 4 players, the comparison's 2 materials under one IBL, gold's plots
+    assert len(seen["images"]) == 1 + 4 + 2 + len(R.PLOT_VIEWS)
     assert sorted(p.name for p in (batch / "report" / "plots").iterdir()) == sorted(
         f"gold_{view}.png" for view in R.PLOT_VIEWS
     )
@@ -377,5 +212,10 @@ def test_lookdev_proof_report_writes_a_page_that_opens_cleanly(cli, tmp_path):
     (out / "report" / "screenshot.png").write_bytes(seen["screenshot"])
     for problem in ("console", "exceptions", "log", "failed", "remote", "broken"):
         assert not seen[problem], (problem, seen[problem])
-    # 2 contact sheets, 2 × 3 frames, 2 × 4 plots
-    assert len(seen["images"]) == 2 + 6 + 8
+    # 2 contact sheets, 2 players, the comparison's 2 materials under studio, 2 × 4 plots
+    assert len(seen["images"]) == 2 + 2 + 2 + 8
+    # the batch recorded each material's parameters, source and USD loss notes
+    data = json.loads(text.split('id="lookdev-data">', 1)[1].split("</script>", 1)[0])
+    assert data["materials"]["gold"]["parameters"]["metallic"] == 1.0
+    assert data["materials"]["plaster"]["source"]["file"].endswith("plaster.toml")
+    assert set(data["materials"]["gold"]["usd_losses"]) == {"universal", "mtlx", "ri"}

@@ -26,6 +26,9 @@ def test_bench_proof_quick_json_reports_every_measurement(cli, tmp_path, monkeyp
         assert t[f"{prefix}overhead_vs_bare"] == pytest.approx(overhead)
     assert p["all_lobes"]["cpu_s"] > 0 and p["pruned"]["noise_relative"] > 0
     assert doc["settings"]["frames"] == 4
+    rig = doc["rig"]  # the calibrated rig's cost, measured against none in the same run
+    assert rig["full"] == t["pipeline"] and rig["none"]["wall_s"] > 0
+    assert rig["cost_full_vs_none"] == pytest.approx(rig["full"]["wall_s"] / rig["none"]["wall_s"])
     # the floor: kernel run time from Dr.Jit's history bounds every speed-up
     assert 0 < t["kernels_s"] and t["bound_vs_naive"] == pytest.approx(
         t["naive_rebuild"]["wall_s"] / t["kernels_s"]
@@ -45,6 +48,7 @@ def test_bench_proof_table_names_the_floor_and_the_frame_sizes(cli, tmp_path, mo
     assert r.code == 0, r.err
     assert "render kernels alone" in r.out and "by frame size" in r.out
     assert "no pipeline can be much more" in r.out and "3× target is met" in r.out
+    assert "the calibrated rig" in r.out
 
 
 def test_interleaved_keeps_each_cases_fastest_round():

@@ -193,6 +193,8 @@ def test_a_job_writes_frames_sheet_and_manifest(mitsuba, gold, tmp_path):
     assert doc["rendered"] == 3 and doc["skipped"] == 0
     manifest = json.loads((folder / "manifest.json").read_text())
     assert [f["kind"] for f in manifest["frames"]] == ["element", "element", "light"]
+    assert manifest["ibl_orientation"] == ibl.ORIENTATION  # the convention, stated
+    assert manifest["rig"]["rig"] == "full" and manifest["rig"]["grey_albedo"] == 0.18
     for f in manifest["frames"]:
         assert f["seconds"] > 0 and f["noise_rmse"] > 0
         assert (folder / f["exr"]["file"]).stat().st_size == f["exr"]["size"]

@@ -243,7 +243,8 @@ def test_a_file_edited_after_export_is_read_from_its_networks(tmp_path):
     (found,) = import_usd(out)
     assert found.contexts == ["record"] and found.params["roughness"] == 0.2
     layer = Sdf.Layer.FindOrOpen(str(out))
-    layer.GetAttributeAtPath("/Materials/gold/preview_surface.inputs:roughness").default = 0.35
+    # The override a DCC user makes: the Material's interface input every context reads.
+    layer.GetAttributeAtPath("/Materials/gold.inputs:roughness").default = 0.35
     layer.Save()
     (found,) = import_usd(out)
     assert found.contexts == ["universal"]
