@@ -109,6 +109,10 @@ def loss_notes(
     from .writer import losses_of, material_spec
 
     contexts = tuple(contexts) if contexts else CONTEXTS
+    from lookdev.materials.preview_surface import MODEL as PREVIEW
+
+    if getattr(material, "model", None) == PREVIEW.name:  # proof --context universal's:
+        return dict.fromkeys(contexts, "")  # it is an export's universal context already
     with tempfile.TemporaryDirectory(prefix="lookdev-losses-") as scratch:
         source = source_for(material, Path(scratch, "textures"), scratch=Path(scratch))
         spec = material_spec(source, contexts, preview_opacity)

@@ -257,7 +257,7 @@ def _preview_hub(hub: Any, source: Source) -> Any:
         maps[field] = converted.astype(np.float32)
         constants.pop(field, None)
     width, height = hub.resolution
-    out = PreviewHub(f"{hub.name}{PREVIEW_SUFFIX}", "disney", hub.resolution, constants)
+    out = PreviewHub(f"{hub.name}{PREVIEW_SUFFIX}", PREVIEW.name, hub.resolution, constants)
     out.maps = maps
     if hub.normal_map is not None:
         out.normal_map = hub.normal_map
