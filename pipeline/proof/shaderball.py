@@ -163,8 +163,19 @@ def eye(rig: str = DEFAULT_RIG) -> tuple[np.ndarray, np.ndarray]:
     return origin, target
 
 
-def camera(width: int, height: int, rig: str = DEFAULT_RIG) -> dict[str, Any]:
-    """A perspective camera framing both shapes and the rig, slightly above them."""
+PIXEL_FILTERS = ("box", "gaussian")
+"""Reconstruction filters a proof camera takes; ``box`` is the default (see :func:`camera`)."""
+
+
+def camera(
+    width: int, height: int, rig: str = DEFAULT_RIG, pixel_filter: str = "box"
+) -> dict[str, Any]:
+    """A perspective camera framing both shapes and the rig, slightly above them.
+
+    The pixel filter is a box by default: each sample lands in one pixel, so pixel noise
+    stays independent, which a denoiser relies on (a Gaussian spreads each sample over
+    its neighbours, and OIDN then gains almost nothing: issue 16), and it costs less.
+    """
     import mitsuba as mi
 
     origin, target = eye(rig)
@@ -184,7 +195,7 @@ def camera(width: int, height: int, rig: str = DEFAULT_RIG) -> dict[str, Any]:
             "width": int(width),
             "height": int(height),
             "pixel_format": "rgb",
-            "rfilter": {"type": "gaussian"},
+            "rfilter": {"type": pixel_filter},
         },
         "sampler": {"type": "independent"},
     }
@@ -225,6 +236,8 @@ def scene_dict(
     geometry: str | Path | None = None,
     *,
     rig: str = DEFAULT_RIG,
+    pixel_filter: str = "box",
+    clamp: float | None = None,
 ) -> dict[str, Any]:
     """The shader-ball scene; the same ``bsdf`` on the ball and the cup, the ``rig``
     (:mod:`.rig`: ``full``, ``balls`` or ``none``) beside them.
@@ -234,14 +247,18 @@ def scene_dict(
 
     ``environment`` is a lat-long (H, W, 3) float32 array, used as it is (exposure is
     already in its pixels, see :mod:`.ibl`) and oriented by :data:`.ibl.ORIENTATION`.
+    ``clamp``: each camera sample's radiance is limited to that value (:mod:`.clamp`;
+    biased, for previews); None renders unclamped.
     """
     import mitsuba as mi
+
+    from .clamp import integrator
 
     width, height = resolution
     return {
         "type": "scene",
-        "integrator": {"type": "path", "max_depth": int(max_depth)},
-        "sensor": camera(width, height, rig),
+        "integrator": integrator(max_depth, clamp),
+        "sensor": camera(width, height, rig, pixel_filter),
         "environment": {
             "type": "envmap",
             "bitmap": mi.Bitmap(np.ascontiguousarray(environment, dtype=np.float32)),
