@@ -157,7 +157,7 @@ def _scalars(data: dict[str, Any], prefix: str = "") -> dict[str, Any]:
     """Numbers, strings and booleans of a manifest, nested keys joined with dots.
 
     Per-frame numbers are summarised: times (keys with ``seconds`` or ``time``) summed,
-    everything else (noise …) averaged, e.g. ``frames.seconds (sum)``.
+    everything else (noise …) averaged, e.g. ``frames.time_s (sum)``.
     """
     out: dict[str, Any] = {}
     for k, v in data.items():

@@ -66,6 +66,12 @@ def plot(
         list[Path] | None,
         typer.Option("--library", "-L", help="Extra preset folders searched before the built-ins."),
     ] = None,
+    uv: Annotated[
+        tuple[float, float] | None,
+        typer.Option(
+            "--uv", help="Plot a texture-driven material as it is at this UV (default: centre)."
+        ),
+    ] = None,
     as_json: Annotated[
         bool, typer.Option("--json", help="Print one JSON object for scripts.")
     ] = False,
@@ -89,6 +95,7 @@ def plot(
             ibl=ibl,
             resolution=resolution,
             library=library,
+            uv=uv,
         )
     if as_json:
         print_json(result.to_json())
