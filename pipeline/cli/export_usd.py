@@ -258,9 +258,9 @@ def import_usd(
 
     Reads UsdPreviewSurface, OpenPBR and Standard Surface networks from any tool
     (values followed through the Material's interface inputs), and gives a lookdev
-    export back exactly (its preset travels in the Material's customData). A preset
-    holds constants: a parameter fed by a texture is written as a comment holding its
-    texture table (and under "maps" with --json); what a preset cannot hold (alpha and
+    export back exactly (its preset travels in the Material's customData). A parameter
+    fed by a texture becomes the preset's texture table for it (file, channel, colour
+    space, scale/offset, wrap; under "maps" with --json); what a preset cannot hold (alpha and
     cut-outs, normal, emission, occlusion, a specular-workflow conversion) is printed
     and listed as "# loss:" lines. A name another material of the file has, or (when
     -o is a folder of the library) a library preset elsewhere has, is refused unless

@@ -1,8 +1,8 @@
 """Imported materials as preset files (TOML), written safely.
 
-A preset holds constants; a parameter a texture fed in the USD file is kept as a
-comment holding its :class:`~lookdev.materials.textures.TextureInput` (the table a preset
-writes for a texture-driven parameter), so nothing read is silently dropped. A lookdev
+A parameter a texture fed in the USD file becomes its
+:class:`~lookdev.materials.textures.TextureInput` (the table a preset writes for a
+texture-driven parameter: file, channel, colour space, scale/offset, wrap). A lookdev
 export carries its preset whole (:mod:`.record`): that document is written back as it was.
 Names must not clash, with each other or with a preset of the library: such a material
 is refused in one line, or renamed with ``rename``.
@@ -36,29 +36,21 @@ def preset_toml(material: Imported, name: str | None = None) -> str:
     name = name or preset_name(material.name)
     if material.document is not None:
         return dump_preset(PresetFile(**{**material.document, "name": name}))
+    params = dict(material.params)
+    for key, texture in material.maps.items():  # a texture-driven parameter (TextureInput)
+        params[key] = {"texture": texture.texture} | texture.model_dump(
+            mode="json", exclude_defaults=True, exclude={"texture"}
+        )
     preset = PresetFile(
         name=name,
         model=material.model,
         description=f"Imported from USD ({', '.join(material.contexts)}).",
-        params=dict(material.params),
+        params=params,
     )
     text = dump_preset(preset)
-    notes = [
-        f"# map: {k} = {_inline(v)} (constant here until presets take textures)"
-        for k, v in sorted(material.maps.items())
-    ]
+    notes = []
     notes += [f"# loss: {line}" for line in material.loss]
     return text + ("\n" + "\n".join(notes) + "\n" if notes else "")
-
-
-def _inline(texture) -> str:
-    """A TextureInput as the inline TOML table a preset writes for it."""
-    import json
-
-    data = {"texture": texture.texture}
-    data.update(texture.model_dump(mode="json", exclude_defaults=True, exclude={"texture"}))
-    parts = [f"{k} = {json.dumps(v)}" for k, v in data.items()]  # JSON scalars are TOML
-    return "{ " + ", ".join(parts) + " }"
 
 
 def import_names(

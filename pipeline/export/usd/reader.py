@@ -325,7 +325,12 @@ def _read_surface(net, surface, context, model, values, result, units: float = 1
         given = surface.inputs.get(slot.input)
         if given is not None and isinstance(given[1], Connection):
             texture = _texture_input(nodes, given[1], slot)  # None for a live mix chain
-            if texture is not None:
+            if texture is not None and slot.texture_linear is None:
+                result.loss.append(
+                    f"{context}: {slot.input} reads the map {texture.texture} through a "
+                    f"conversion {slot.param} has no texture form for (not imported)"
+                )
+            elif texture is not None:
                 result.maps.setdefault(slot.param, texture)
         elif given is not None:
             values[slot.param] = slot.from_target(given[1])
@@ -375,10 +380,15 @@ def _texture_input(nodes: dict[str, Node], conn: Connection, slot) -> TextureInp
     channel = {"r": 0, "g": 1, "b": 2, "a": 3}.get(conn.output, 0)
     scale = node.inputs.get("scale", (None, None))[1]
     bias = node.inputs.get("bias", (None, None))[1]
-    if isinstance(scale, tuple) and scale[channel] != 1.0:
-        fields["scale"] = scale[channel]
-    if isinstance(bias, tuple) and bias[channel] != 0.0:
-        fields["offset"] = bias[channel]
+    s = float(scale[channel]) if isinstance(scale, tuple) else 1.0
+    o = float(bias[channel]) if isinstance(bias, tuple) else 0.0
+    # The input is a·param + b (the slot's affine map): param = (texel·s + o − b)/a.
+    a, b = slot.texture_linear or (1.0, 0.0)
+    s, o = s / a, (o - b) / a
+    if s != 1.0:
+        fields["scale"] = s
+    if o != 0.0:
+        fields["offset"] = o
     wrap = node.inputs.get("wrapS", (None, None))[1]
     if wrap in WRAP:
         fields["wrap"] = WRAP[wrap]
