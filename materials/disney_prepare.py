@@ -20,7 +20,8 @@ TINT_WEIGHTS = (0.3, 0.6, 0.1)
 """Burley's tint luminance, from the Disney BRDF Explorer's ``disney.brdf``:
 ``float Cdlum = .3*Cdlin[0] + .6*Cdlin[1] + .1*Cdlin[2]; // luminance approx.``
 (Schutte's seed prints (0.3, 0.6, 1.0): a typo). Part of the model, a rough hue normaliser;
-not Rec.709 Y (:data:`lookdev.materials.colour.REC709_LUMINANCE`), which measures pixels."""
+not luminance Y (:func:`lookdev.materials.colour.luminance`, the working space's XYZ row), which
+measures pixels."""
 CLEARCOAT_F0 = 0.04  # IOR 1.5 polyurethane (Burley §5.4)
 SCHLICK_MEAN = 1.0 / 21.0  # ∫ (1 − μ)⁵ 2μ dμ: hemispherical mean of the Schlick weight
 SHEEN_ALBEDO_GUESS = 0.1  # rough albedo of sheen 1, only used to weight sampling

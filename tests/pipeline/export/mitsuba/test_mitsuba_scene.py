@@ -184,7 +184,9 @@ def test_xml_without_our_plugins_has_no_hint(mi):
     from lookdev.pipeline.export.mitsuba import xml
 
     text = xml.to_xml({"type": "scene", "s": {"type": "sphere", "bsdf": {"type": "diffuse"}}})
-    assert text.startswith("<scene")
+    assert xml.LOAD_HINT not in text
+    comment, scene = text.split("\n", 1)  # only the colour note: the space its RGB is in
+    assert comment == f"<!--{xml.colour_note()}-->" and scene.startswith("<scene")
     assert '<bsdf type="diffuse" name="bsdf"' in text
 
 
