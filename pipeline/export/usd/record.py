@@ -44,7 +44,9 @@ def preset_record(hub: Any) -> str:
     if params is None:
         params = hub.params
     doc["model"] = hub.model
-    doc["params"] = params.model_dump(mode="json", exclude_unset=True, exclude_none=True)
+    doc["params"] = _preset_space(
+        type(params), params.model_dump(mode="json", exclude_unset=True, exclude_none=True)
+    )
     for key, value in (
         ("description", hub.description or getattr(origin, "description", "")),
         ("tags", list(getattr(origin, "tags", []) or [])),
@@ -53,6 +55,23 @@ def preset_record(hub: Any) -> str:
         if value:
             doc[key] = value
     return json.dumps(doc, sort_keys=True)
+
+
+def _preset_space(params_type: type, values: dict[str, Any]) -> dict[str, Any]:
+    """Colours from the working space (where loaded presets hold them) back to the space a
+    preset's ``[r, g, b]`` is written in, so the record reads as the preset file does."""
+    from lookdev.materials import colour
+    from lookdev.materials.registry import is_color_field
+
+    source = colour.working_space()
+    if colour.canonical(source) == colour.canonical(colour.PRESET_LINEAR):
+        return values
+    out = dict(values)
+    for key, value in values.items():
+        if key in params_type.model_fields and is_color_field(params_type, key):
+            converted = colour.convert(tuple(value), source, colour.PRESET_LINEAR)
+            out[key] = [float(c) for c in converted]
+    return out
 
 
 def read_record(custom: dict[str, Any]) -> dict[str, Any] | None:
