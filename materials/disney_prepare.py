@@ -147,6 +147,8 @@ def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
         "flatness": p["flatness"] if thin else 0.0,
     }
     pr["ax2"], pr["ay2"] = ax * ax, ay * ay
+    pr["spec_lum_a"] = luminance(a)
+    r_t = p["roughness"]
     if thin:
         # Burley 2015 Fig. 15 via Schutte: a thin sheet's transmission looks rougher.
         r_t = (0.65 * eta - 0.35) * p["roughness"]
@@ -154,6 +156,12 @@ def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
         pr["tax"], pr["tay"] = mf.anisotropic_alphas(xp, r_t, p["anisotropic"])
     else:
         pr["tax"], pr["tay"] = ax, ay
+    # Lobes whose α is below ALPHA_MIN are deltas (microfacet.is_delta, disney_interface).
+    pr["delta"] = tuple(
+        k
+        for k, r in (("specular", p["roughness"]), ("spec_trans", r_t))
+        if mf.is_delta(r, p["anisotropic"])
+    )
     pr["tax2"], pr["tay2"] = pr["tax"] * pr["tax"], pr["tay"] * pr["tay"]
     weights = {
         "diffuse": pr["diffuse"],

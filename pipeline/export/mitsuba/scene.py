@@ -23,6 +23,7 @@ import numpy as np
 
 from lookdev.library import files
 from lookdev.materials import registry
+from lookdev.materials.microfacet import is_delta
 from lookdev.materials.pixar import GRAZING
 from lookdev.materials.registry import is_color_field
 from lookdev.pipeline import exr
@@ -110,14 +111,18 @@ def principled_equivalent(hub: BlendedMaterial) -> dict[str, Any] | None:
     specular is Schlick's Fresnel on the base colour with the anisotropic GGX and Smith G
     of the 2014 addendum, which ``principled`` implements the same way (DESIGN.md, Traps);
     tests/test_mitsuba_scene.py measures the two equal to float32 precision over roughness
-    0..1 and anisotropic 0..1. Tinted and dielectric speculars, clearcoat (Mitsuba leaves
-    out its 1/(4 cos θl cos θv)) and transmission differ on purpose and keep our plugin.
+    0.04..1 and anisotropic 0..1. Tinted and dielectric speculars, clearcoat (Mitsuba leaves
+    out its 1/(4 cos θl cos θv)) and transmission differ on purpose and keep our plugin,
+    and so does a smooth metal (roughness below √10⁻³): a delta mirror in our model
+    (:func:`lookdev.materials.microfacet.is_delta`), a glossy α = 10⁻³ lobe in principled.
     """
     c = hub.constants
     if hub.bsdf_model.name != "disney" or hub.maps or c.get("metallic") != 1.0:
         return None
     if c.get("clearcoat", 0.0) != 0.0:
         return None
+    if is_delta(float(hub.params.roughness), float(hub.params.anisotropic)):
+        return None  # a smooth metal is a delta in our model, principled is glossy (α 10⁻³)
     out: dict[str, Any] = {"type": "principled", "metallic": 1.0}
     out["base_color"] = {"type": "rgb", "value": list(hub.params.base_color)}
     for key in ("roughness", "anisotropic"):
