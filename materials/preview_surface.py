@@ -164,7 +164,7 @@ def sample(xp: Any, p: dict[str, Any], wo: Any, u: Any) -> Any:
     f = eval(xp, p, wi, wo)
     ok = (density > 0.0) & (wi[2] > 0.0)
     weight = xp.select(ok, f * wi[2] / xp.maximum(density, 1e-30), 0.0 * f)
-    return wi, weight, xp.select(ok, density, 0.0 * density)
+    return wi, weight, xp.select(ok, density, 0.0 * density), False  # no delta lobes
 
 
 MODEL = Model(
