@@ -51,10 +51,14 @@ class UsdExport:
     contexts: tuple[str, ...]
     textures: list[Path]
     losses: dict[str, dict[str, str]] = field(default_factory=dict)
+    fidelity: dict[str, Any] = field(default_factory=dict)
+    """material → its universal context measured against it (``report=True``):
+    :class:`lookdev.pipeline.export.usd.fidelity.Fidelity`."""
 
     def to_json(self) -> dict[str, Any]:
         """The summary ``lookdev export usd --json`` prints."""
-        return {
+        extra = {"fidelity": [f.to_json() for f in self.fidelity.values()]} if self.fidelity else {}
+        return extra | {
             "output": str(self.output),
             "files": [str(p) for p in self.files],
             "materials": self.materials,
@@ -82,6 +86,8 @@ def export_usd(
     library: Any = None,
     progress: Callable[[int, int, str], None] | None = None,
     preview_opacity: str = "keep",
+    meters_per_unit: float = 1.0,
+    report: bool = False,
     collect: bool = False,
     preview_geometry: bool = False,
 ) -> UsdExport:
@@ -119,6 +125,13 @@ def export_usd(
         transmissive materials (DCCs read ``opacity`` as alpha) and names the loss;
         ``"transmission"``: the UsdPreviewSurface spec's reading, ``opacity = 1 −
         spec_trans`` (``1 − clear`` for Pixar).
+    meters_per_unit
+        The stage's ``metersPerUnit`` (0.01 for a centimetre scene). lookdev's lengths
+        (``scatter_distance``) are metres; the subsurface radius is written in these units.
+    report
+        Measure each material's UsdPreviewSurface against the material (directional
+        albedo over view angles and the highlight, see
+        :mod:`lookdev.pipeline.export.usd.fidelity`): ``UsdExport.fidelity``.
     collect
         Copy every texture file a preset reads into ``<name>_textures`` beside ``path``
         (UDIM tiles included), referenced by relative paths; otherwise the files are
@@ -167,6 +180,8 @@ def export_usd(
         split=split,
         progress=progress,
         preview_opacity=preview_opacity,
+        meters_per_unit=meters_per_unit,
+        report=report,
         collect=collect,
         preview_geometry=preview_geometry,
     )
@@ -177,6 +192,7 @@ def export_usd(
         contexts,
         result.images,
         result.losses,
+        result.fidelity,
     )
 
 
@@ -367,6 +383,7 @@ def proof(
     report: bool = False,
     library: Any = None,
     progress: Callable[[Any], None] | None = None,
+    context: str | None = None,
     geometry: PathLike | None = None,
     denoise: bool = False,
 ) -> dict[str, Any]:
@@ -431,6 +448,11 @@ def proof(
     progress
         Called with a :class:`lookdev.pipeline.proof.batch.Progress` about twice a second
         and as each proof finishes (``frames_done``, ``frames_total``, ``finished``).
+    context
+        ``"universal"``: also proof, beside each material, its USD universal context as
+        ``NAME-universal``: the UsdPreviewSurface values rendered by that surface's own
+        BRDF (:func:`lookdev.pipeline.export.usd.fidelity.preview_hub`), what a DCC
+        preview shows.
     geometry
         A mesh (PLY, OBJ, or USD geometry) rendered in the cup's place beside the ball,
         with its own UVs (:mod:`lookdev.pipeline.proof.geometry`).
@@ -486,6 +508,14 @@ def proof(
     ibl_names = list(dict.fromkeys(ibls or ibl_module.builtin_names()))
     environments = [ibl_module.load(name, ibl_width) for name in ibl_names]
     loaded = [hub(m, batch.MAP_RESOLUTION, lib) for m in chosen]
+    if context not in (None, "source", "universal"):
+        raise batch.ProofError(
+            f"unknown context {context!r}; allowed: universal", field="--context"
+        )
+    if context == "universal":
+        from lookdev.pipeline.export.usd.fidelity import preview_hub
+
+        loaded = [h for m in loaded for h in (m, preview_hub(m))]
     doc = batch.proof(
         loaded,
         environments,

@@ -87,6 +87,24 @@ def export_usd(
             "opacity = 1 - spec_trans.",
         ),
     ] = PreviewOpacity.keep,
+    meters_per_unit: Annotated[
+        float,
+        typer.Option(
+            "--meters-per-unit",
+            min=1e-9,
+            max=1e9,
+            help="The stage's metersPerUnit (0.01 for a centimetre scene); lookdev's lengths "
+            "(scatter_distance, metres) are written in these units.",
+        ),
+    ] = 1.0,
+    report: Annotated[
+        bool,
+        typer.Option(
+            "--report",
+            help="Measure each material's UsdPreviewSurface against the material: "
+            "directional albedo over view angles (RMS, worst) and the highlight ratio.",
+        ),
+    ] = False,
     collect: Annotated[
         bool,
         typer.Option(
@@ -119,6 +137,13 @@ def export_usd(
     named: sourceColorSpace, colorSpace, colorspace, linearize), or a copy with --collect;
     a preset's height map becomes displacement in scene units (metersPerUnit = 1).
 
+    Clearcoat in UsdPreviewSurface: clearcoat = 0.25 x lookdev's clearcoat (Burley weights
+    his GTR1 coat 0.25, the spec's coat is unweighted: the scale keeps the coat's reflected
+    energy) and clearcoatRoughness = sqrt(mix(0.1, 0.001, clearcoat_gloss)) (Burley's coat
+    alpha, squared back by the spec); import divides and inverts the same way. The
+    subsurface radius is scatter_distance (metres) / --meters-per-unit, 1 mm where only
+    Burley 2012's distance-less subsurface is live.
+
     Examples:
 
       lookdev export usd gold -o gold.usda
@@ -150,6 +175,8 @@ def export_usd(
             library=library,
             progress=progress,
             preview_opacity=preview_opacity.value,
+            meters_per_unit=meters_per_unit,
+            report=report,
             collect=collect,
             preview_geometry=preview_geometry,
         )
@@ -174,6 +201,14 @@ def export_usd(
         console.print(losses)
     else:
         console.print("every render context expresses every material fully")
+    if result.fidelity:
+        rows = sorted(result.fidelity.values(), key=lambda f: -f.rms)
+        fid = table(
+            "UsdPreviewSurface vs the material (albedo over 0-85°, highlight at 30°)",
+            ["material", "albedo RMS", "worst", "highlight preview/source"],
+            [f.row() for f in rows],
+        )
+        console.print(fid)
 
 
 @contextmanager
@@ -213,14 +248,28 @@ def import_usd(
     force: Annotated[
         bool, typer.Option("--force", help="Replace preset files of the same name in -o.")
     ] = False,
+    rename: Annotated[
+        bool,
+        typer.Option(
+            "--rename",
+            help="Import a material whose name another material of the file, a preset in "
+            "-o, or (when -o is a library folder) a library preset has as NAME_imported "
+            "(default: refuse; --force replaces a preset in -o instead).",
+        ),
+    ] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
     """Read materials from a USD file back into presets.
 
-    Reads UsdPreviewSurface networks from any tool, and lookdev's own MaterialX and
-    RenderMan networks, which carry every parameter. A preset holds constants: a
-    parameter fed by a texture is named with its map's path in a comment of the TOML
-    (and under "maps" with --json), and what a surface could not say is listed too.
+    Reads UsdPreviewSurface, OpenPBR and Standard Surface networks from any tool
+    (values followed through the Material's interface inputs), and gives a lookdev
+    export back exactly (its preset travels in the Material's customData). A parameter
+    fed by a texture becomes the preset's texture table for it (file, channel, colour
+    space, scale/offset, wrap; under "maps" with --json); what a preset cannot hold (alpha and
+    cut-outs, normal, emission, occlusion, a specular-workflow conversion) is printed
+    and listed as "# loss:" lines. A name another material of the file has, or (when
+    -o is a folder of the library) a library preset elsewhere has, is refused unless
+    --rename.
 
     Examples:
 
@@ -233,12 +282,13 @@ def import_usd(
     (out of range, NaN, infinity) is refused, never clamped; an existing preset file is
     replaced only with --force.
     """
-    from lookdev.pipeline.export.usd.presets import write_presets
+    from lookdev.pipeline.export.usd.presets import import_names, write_presets
     from lookdev.pipeline.export.usd.reader import import_usd as read
 
     skipped: list[str] = []
     found = read(file.expanduser(), skipped)
-    written = write_presets(found, output, force=force)
+    names = import_names(found, _taken_names(output, rename), rename=rename)
+    written = write_presets(found, output, force=force, names=names)
     if as_json:
         print_json(
             {
@@ -246,13 +296,18 @@ def import_usd(
                 "materials": [
                     {
                         "name": m.name,
+                        "preset": name,
                         "model": m.model,
                         "params": m.params,
-                        "maps": {k: str(v) for k, v in m.maps.items()},
+                        "maps": {
+                            k: v.model_dump(mode="json", exclude_defaults=True)
+                            | {"texture": v.texture}
+                            for k, v in m.maps.items()
+                        },
                         "contexts": m.contexts,
                         "loss": m.loss,
                     }
-                    for m in found
+                    for m, name in zip(found, names, strict=True)
                 ],
                 "written": [str(p) for p in written],
                 "skipped": skipped,
@@ -261,11 +316,13 @@ def import_usd(
     elif output is None:
         from lookdev.pipeline.export.usd.presets import preset_toml
 
-        for m in found:
-            typer.echo(preset_toml(m))
+        for m, name in zip(found, names, strict=True):
+            typer.echo(preset_toml(m, name))
     else:
-        for path in written:
+        for path, m in zip(written, found, strict=True):
             console.print(f"wrote [bold]{path}[/]")
+            for line in m.loss:
+                console.print(f"  loss: {line}", markup=False, highlight=False)
     if skipped:
         from lookdev.pipeline.export.usd.network import ExportError
 
@@ -274,6 +331,31 @@ def import_usd(
             + ", ".join(skipped),
             where=str(file),
         )
+
+
+def _taken_names(output: Path | None, rename: bool) -> set[str]:
+    """Preset names an import into ``output`` must not take.
+
+    When ``output`` is a folder of the library's search path, a preset of the same name
+    elsewhere in the library would shadow it or be shadowed: refused (or renamed). With
+    ``rename``, the presets already in ``output`` are avoided too (without it, replacing
+    one is ``--force``'s business).
+    """
+    if output is None:
+        return set()
+    from lookdev.library import Library
+
+    target = output.expanduser()
+    folder = (target.parent if target.suffix == ".toml" else target).resolve()
+    taken: set[str] = set()
+    if rename and folder.is_dir():
+        taken |= {p.stem for p in folder.glob("*.toml")}
+    library = Library()
+    if any(folder == f.resolve() for f in library.folders if f.is_dir()):
+        for name in library.names():
+            if library.find(name).resolve().parent != folder:
+                taken.add(name)
+    return taken
 
 
 @validate_app.command("usd")

@@ -22,6 +22,10 @@ from lookdev.pipeline.proof.settings import DEFAULT_MAX_SPP, DEFAULT_NOISE, DEFA
 from .common import console, err_console, print_json, table
 
 
+class ProofContext(StrEnum):
+    universal = "universal"
+
+
 class Rig(StrEnum):
     """``--rig``: the values of :data:`lookdev.pipeline.proof.rig.RIGS`."""
 
@@ -201,6 +205,15 @@ def proof(
             "spp/noise/time; static, opens from disk, offline.",
         ),
     ] = False,
+    context: Annotated[
+        ProofContext | None,
+        typer.Option(
+            "--context",
+            help="'universal': also proof, beside each preset, its USD universal context "
+            "as PRESET-universal: the UsdPreviewSurface values rendered by that surface's "
+            "own BRDF, what a DCC preview shows (export usd --report measures the difference).",
+        ),
+    ] = None,
 ) -> None:
     """Render turntable proofs: every PRESET under every --ibl.
 
@@ -272,6 +285,7 @@ def proof(
             report=report,
             library=library,
             progress=show,
+            context=None if context is None else context.value,
             geometry=geometry,
             denoise=denoise,
         )

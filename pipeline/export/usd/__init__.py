@@ -29,6 +29,8 @@ def export_materials(
     split: str | Path | None = None,
     progress: Callable[[int, int, str], None] | None = None,
     preview_opacity: str = "keep",
+    meters_per_unit: float = 1.0,
+    report: bool = False,
     collect: bool = False,
     preview_geometry: bool = False,
 ):
@@ -42,11 +44,16 @@ def export_materials(
     ``progress(done, total, name)`` is called after each material's network source is
     made (varying parameters are baked then). Maps are baked into a scratch folder beside
     ``out`` and only copied into place when every file could be written.
+    ``preview_opacity``: see :data:`.names.PREVIEW_OPACITY`. ``meters_per_unit``: the
+    stage's ``metersPerUnit`` (lengths are written in its units). ``report``: measure each
+    material's universal context against the material (:mod:`.fidelity`), in the
+    result's ``fidelity``.
     ``preview_opacity``: see :data:`.names.PREVIEW_OPACITY`. ``collect`` copies the
     presets' own texture files beside ``out``; ``preview_geometry`` adds a sphere per
     material (:func:`.writer.export_usd`).
     """
     from .network import CONTEXTS
+    from .record import preset_record
     from .sources import source_for
     from .writer import export_usd as write
 
@@ -59,11 +66,18 @@ def export_materials(
         textures = f"{out.stem}_textures"
         texture_dir = Path(scratch, textures) if package else out.parent / textures
         sources = []
+        measured: dict = {}
         for material in materials:
-            sources.append(source_for(material, texture_dir, scratch=Path(scratch), bake=bake))
+            source = source_for(material, texture_dir, scratch=Path(scratch), bake=bake)
+            source.record = preset_record(material)
+            sources.append(source)
+            if report:
+                from .fidelity import fidelity
+
+                measured[material.name] = fidelity(material, source, preview_opacity)
             if progress is not None:
                 progress(len(sources), count or len(sources), material.name)
-        return write(
+        result = write(
             sources,
             out,
             contexts=contexts,
@@ -72,9 +86,12 @@ def export_materials(
             split_dir=None if split is None else Path(split),
             workdir=Path(scratch),
             preview_opacity=preview_opacity,
+            meters_per_unit=meters_per_unit,
             collect=collect,
             preview_geometry=preview_geometry,
         )
+        result.fidelity = measured
+        return result
 
 
 def loss_notes(
@@ -92,6 +109,10 @@ def loss_notes(
     from .writer import losses_of, material_spec
 
     contexts = tuple(contexts) if contexts else CONTEXTS
+    from lookdev.materials.preview_surface import MODEL as PREVIEW
+
+    if getattr(material, "model", None) == PREVIEW.name:  # proof --context universal's:
+        return dict.fromkeys(contexts, "")  # it is an export's universal context already
     with tempfile.TemporaryDirectory(prefix="lookdev-losses-") as scratch:
         source = source_for(material, Path(scratch, "textures"), scratch=Path(scratch))
         spec = material_spec(source, contexts, preview_opacity)

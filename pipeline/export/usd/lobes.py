@@ -53,7 +53,8 @@ DEFAULTS: dict[str, dict[str, Any]] = {
     "pixar": {**PixarParams().model_dump(), "eta": PixarParams().eta},
     "pixar_weights": {
         **dict.fromkeys(("front", "behind", "specN", "specG", "reflN", "reflG"), (0.0,) * 3),
-        **dict.fromkeys(("reflTN", "f0"), (0.0,) * 3),
+        **dict.fromkeys(("reflTN", "f0", "preview_base"), (0.0,) * 3),
+        "preview_metallic": 0.0,
         **dict.fromkeys(("spec_roughness", "refl_roughness", "highlight_roughness"), 0.0),
         "eta": PixarParams().eta,
     },

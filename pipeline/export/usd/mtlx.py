@@ -23,6 +23,7 @@ from lookdev.materials import colour
 from .live import mixed_input
 from .names import SURFACE_IDS, Slot, mapped_params, table_for
 from .network import (
+    LOCAL,
     Connection,
     ExportError,
     Image,
@@ -30,12 +31,13 @@ from .network import (
     Network,
     Node,
     Source,
+    local_subsurface,
     loss_note,
     plain_value,
     prim_name,
+    subsurface_radius,
     surface_inputs,
 )
-from .preview import SPECULAR_WORKFLOW
 from .textures import MTLX_ADDRESS, affine, converted, output_of
 
 SURFACE = "mtlx_surface"
@@ -111,17 +113,23 @@ def node_defaults(node_id: str) -> dict[str, Any]:
     return out
 
 
-def build(source: Source) -> Network:
-    """The MaterialX network of ``source`` (surface plus image nodes)."""
+def build(source: Source, meters_per_unit: float = 1.0) -> Network:
+    """The MaterialX network of ``source`` (surface plus image nodes); lengths in scene
+    units of ``meters_per_unit`` (:func:`.network.subsurface_radius`)."""
     nodes: list[Node] = []
     node_id = SURFACE_IDS[("mtlx", source.model)]
     table = table_for("mtlx", source.model)
     inputs = surface_inputs(source, table, node_defaults(node_id), nodes, _live_or_baked(source))
-    if source.model in SPECULAR_WORKFLOW:
-        inputs["useSpecularWorkflow"] = ("int", 1)
     extra = [EXTRA_LOSS[source.model]] if source.model in EXTRA_LOSS else []
+    if source.model == "disney":
+        radius = subsurface_radius(source, inputs, "subsurfaceDistance", meters_per_unit)
+        extra.append(radius)
+        extra.append(_frosted(source))
+        extra = [e for e in extra if e]
     if source.normal_map is not None and source.model == "disney":
         extra.append(f"{node_id} has no normal input: the normal map is not applied")
+    elif source.normal_map is not None and source.model in TANGENT_NORMAL_MODELS:
+        inputs[NORMAL_INPUT[source.model]] = _tangent_normal(nodes, source.normal_map)
     elif source.normal_map is not None:
         inputs[NORMAL_INPUT[source.model]] = _normal(nodes, source.normal_map)
     mapped = mapped_params("mtlx", source.model)
@@ -132,6 +140,8 @@ def build(source: Source) -> Network:
         displacement = _displacement(nodes, source.height)
     note = loss_note(source, node_id, mapped, "; ".join(extra))
     surface = Node(SURFACE, node_id, inputs, {"out": "token"}, {"loss": note})
+    if source.model == "disney" and local_subsurface(source):
+        surface.custom["subsurface_radius"] = LOCAL
     return Network("mtlx", Connection(SURFACE, "out"), [surface, *nodes], displacement)
 
 
@@ -149,13 +159,49 @@ def _displacement(nodes: list[Node], image: Image) -> Connection:
 
 
 NORMAL_INPUT = {"pixar": "geometry_normal", "pixar_weights": "normal"}
+TANGENT_NORMAL_MODELS = ("pixar_weights",)
+"""Models whose MaterialX surface (``ND_UsdPreviewSurface_surfaceshader``) takes a
+tangent-space normal in −1..1 and applies ``normalmap`` in its own graph; OpenPBR's
+``geometry_normal`` takes a world-space normal (``ND_normalmap_float``'s output)."""
 EXTRA_LOSS = {
-    "pixar_weights": "UsdPreviewSurface node in its specular workflow: one highlight lobe, "
+    "pixar_weights": "UsdPreviewSurface node in its metallic workflow: one highlight lobe "
+    "(energy-weighted roughness, F0 and diffuse solved for base colour and metallic), "
     "no transmitted lobes",
-    "pixar": "OpenPBR has one specular lobe: Smits' specular and reflection share the "
-    "broad lobe's roughness; no transmitted diffuse; lobe scales fold into colours only "
-    "where a colour exists",
+    "pixar": "OpenPBR has one specular lobe: Smits' specular and reflection lobes share "
+    "their energy-weighted roughness (the lobe carrying more light sets the width; the "
+    "other's own width is lost); no transmitted diffuse; lobe scales fold into colours "
+    "only where a colour exists",
 }
+
+
+@cache
+def fixed_transmission_roughness() -> str | None:
+    """The transmission roughness ``ND_disney_principled``'s graph fixes (its
+    ``dielectric_bsdf`` in mode T reads a constant, not an input), or None when the
+    installed MaterialX exposes it."""
+    graph = _library().getNodeDef("ND_disney_principled").getImplementation()
+    for node in graph.getNodes():
+        if node.getCategory() == "dielectric_bsdf":
+            rough = node.getInput("roughness")
+            if rough is not None and not rough.getInterfaceName() and not rough.getNodeName():
+                return rough.getValueString()
+    return None
+
+
+def _frosted(source: Source) -> str:
+    """Frosted glass: the loss sentence when transmission is live and rough."""
+    fixed = fixed_transmission_roughness()
+    rough = source.live_values["roughness"]
+    if (
+        fixed is None
+        or not source.lobes["spec_trans"]
+        or ("roughness" not in source.maps and rough <= 0.0)
+    ):
+        return ""
+    return (
+        f"ND_disney_principled refracts with a fixed roughness ({fixed}): "
+        f"frosted transmission (roughness={rough:g}) renders clear"
+    )
 
 
 def _sheen(values: dict[str, Any], extra: list[str]) -> set[str]:
@@ -200,6 +246,33 @@ def _normal(nodes: list[Node], image: Image) -> tuple[str, Any]:
         )
     )
     return "vector3f", Connection("mtlx_normal_map", "out")
+
+
+def _tangent_normal(nodes: list[Node], image: Image) -> tuple[str, Any]:
+    """The map decoded to a tangent-space vector, 2·texel − 1, without ``normalmap``:
+    the surface's graph applies it (feeding its world-space output applied it twice)."""
+    nodes.append(
+        Node(
+            "mtlx_normal_image", "ND_image_vector3", {"file": ("asset", image)}, {"out": "vector3f"}
+        )
+    )
+    nodes.append(
+        Node(
+            "mtlx_normal_scaled",
+            "ND_multiply_vector3FA",
+            {"in1": ("vector3f", Connection("mtlx_normal_image", "out")), "in2": ("float", 2.0)},
+            {"out": "vector3f"},
+        )
+    )
+    nodes.append(
+        Node(
+            "mtlx_normal_tangent",
+            "ND_subtract_vector3FA",
+            {"in1": ("vector3f", Connection("mtlx_normal_scaled", "out")), "in2": ("float", 1.0)},
+            {"out": "vector3f"},
+        )
+    )
+    return "vector3f", Connection("mtlx_normal_tangent", "out")
 
 
 def _live_or_baked(source: Source):

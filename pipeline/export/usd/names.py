@@ -215,7 +215,9 @@ OPACITY_SLOTS: dict[str, Slot] = {
 MTLX_PIXAR: tuple[Slot, ...] = (
     Slot("surface_color", "base_color", "color3f"),
     Slot("metallic", "base_metalness", "float"),
-    Slot("spec_roughness", "specular_roughness", "float", lobe="highlights"),
+    # One specular lobe: Smits' two highlight lobes' energy-weighted roughness
+    # (:func:`.pixar.highlight_roughness`), not the broad lobe's.
+    Slot("highlight_roughness", "specular_roughness", "float", lobe="highlights"),
     Slot("specular_tint", "specular_color", "color3f", lobe="highlights"),
     Slot("eta", "specular_ior", "float", lobe="dielectric"),
     Slot("clear", "transmission_weight", "float", lobe="transmission"),
@@ -242,14 +244,17 @@ RI_PIXAR: tuple[Slot, ...] = (
 )
 
 # A layered Pixar material blends to Smits' lobe weights, not to parameters (blend.pixar).
-# UsdPreviewSurface takes them in its specular workflow: the diffuse weight as the
-# diffuse colour, the highlight colour at normal incidence (specN + reflN) as the
-# specular colour, one roughness for both highlight lobes. The diffuse colour is written
+# UsdPreviewSurface takes them in its metallic workflow (:func:`.pixar.metallic_workflow`:
+# the diffuse weight and the highlight colour at normal incidence, specN + reflN, solved
+# per texel for a base colour and a metallic), one roughness for both highlight lobes.
+# Not the specular workflow: DCC importers read specularColor as a tint on their own
+# dielectric F0, and metal regions arrived ~25x too dark. The base colour is written
 # even when black: the surface's default is grey.
 PREVIEW_WEIGHTS: tuple[Slot, ...] = (
-    Slot("front", "diffuseColor", "color3f"),
-    Slot("f0", "specularColor", "color3f", lobe="highlights"),
+    Slot("preview_base", "diffuseColor", "color3f"),
+    Slot("preview_metallic", "metallic", "float"),
     Slot("highlight_roughness", "roughness", "float", lobe="highlights"),
+    Slot("eta", "ior", "float"),
 )
 
 TABLES: dict[tuple[str, str], tuple[Slot, ...]] = {
@@ -301,13 +306,24 @@ DERIVED_FROM: dict[str, frozenset[str]] = {
     **{w: _SMITS_WEIGHT for w in ("front", "behind", "specN", "specG", "reflN", "reflG")},
     "reflTN": _SMITS_WEIGHT,
     "eta": frozenset(("ior", "normal_fresnel")),
+    "highlight_roughness": frozenset(("roughness", "specular_cone_scale", "reflection_cone_scale")),
 }
+WEIGHTS_DERIVED_FROM: dict[str, frozenset[str]] = {
+    "preview_base": frozenset(("front", "f0", "specN", "reflN")),
+    "preview_metallic": frozenset(("front", "f0", "specN", "reflN")),
+    "highlight_roughness": frozenset(("spec_roughness", "refl_roughness")),
+}
+"""A blend's preview quantities → the blended weights they carry (the grazing weights
+specG/reflG are not among them: the surface's Schlick edge replaces them)."""
 """Derived target quantity (:mod:`.pixar`) → the parameters it carries."""
 
 
 def mapped_params(context: str, model: str, preview_opacity: str = "keep") -> set[str]:
     """Our parameters that ``context`` expresses, directly or through derived weights."""
+    derived = WEIGHTS_DERIVED_FROM if model == "pixar_weights" else DERIVED_FROM
     out: set[str] = set()
     for slot in table_for(context, model, preview_opacity):
-        out |= DERIVED_FROM.get(slot.param, {slot.param})
+        out |= derived.get(slot.param, {slot.param})
+        if model == "pixar_weights":
+            out.add(slot.param)
     return out

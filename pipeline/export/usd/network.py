@@ -182,6 +182,8 @@ class Source:
     notes: list[str] = field(default_factory=list)  # losses every context shares
     live: tuple[str, ...] | None = None
     """The model's live lobes (the blend's, maps included); None: judged from ``values``."""
+    record: str = ""
+    """The preset it came from, as JSON (:mod:`.record`), carried for an exact import."""
     height: Image | None = None
     """Heights in scene units (value · scale + bias of the image), for displacement."""
 
@@ -233,6 +235,64 @@ def surface_inputs(
             continue
         inputs[slot.input] = (slot.type, _interface(slot, value))
     return inputs
+
+
+LOCAL_SUBSURFACE_M = 1e-3
+"""The radius (metres) written for Burley 2012's subsurface when a preset gives no
+``scatter_distance``: his subsurface is a local flattening of the diffuse (§5.3), light
+does not travel, so a renderer's diffusion radius must be small against the shading
+(1 mm; skin's mean free paths are of that order). MaterialX's default, one scene unit
+(1 m at metersPerUnit 1), made skin and marble glow through."""
+
+LOCAL = "local"
+"""Shader ``customData`` ``subsurface_radius`` value marking :data:`LOCAL_SUBSURFACE_M`
+(so an import reads it back as no distance)."""
+
+UNIT = "m"
+"""lookdev's length unit: ``scatter_distance`` is in metres (the proof scene's unit); an
+export divides lengths by the stage's ``metersPerUnit``."""
+
+
+def local_subsurface(source: Source) -> bool:
+    """True when only Burley 2012's distance-less subsurface is live (no distance given)."""
+    lobes = source.lobes
+    return (
+        bool(lobes.get("subsurface"))
+        and not lobes.get("scatter")
+        and ("scatter_distance" not in source.maps)
+    )
+
+
+def subsurface_radius(
+    source: Source, inputs: dict[str, tuple[str, Any]], name: str, meters_per_unit: float
+) -> str:
+    """Write the subsurface/scatter radius input ``name`` in the stage's units; the
+    sentence naming what that changes, or ``""``.
+
+    ``scatter_distance`` (metres, :data:`UNIT`) ÷ ``metersPerUnit``; where only the 2012
+    subsurface is live (no distance given), :data:`LOCAL_SUBSURFACE_M` instead.
+    """
+    lobes = source.lobes
+    if "scatter_distance" in source.maps:
+        if meters_per_unit != 1.0:
+            return (
+                f"{name} is the scatter_distance map in metres, not scaled to "
+                f"metersPerUnit {meters_per_unit:g}"
+            )
+        return ""
+    if lobes.get("scatter"):
+        d = source.live_values["scatter_distance"] / meters_per_unit
+        inputs[name] = ("color3f", (d, d, d))
+        return ""
+    if local_subsurface(source):
+        d = LOCAL_SUBSURFACE_M / meters_per_unit
+        inputs[name] = ("color3f", (d, d, d))
+        return (
+            f"Burley 2012's subsurface has no distance (a local flattening of the diffuse); "
+            f"{name} is written as {LOCAL_SUBSURFACE_M * 1e3:g} mm ({d:g} scene units at "
+            f"metersPerUnit {meters_per_unit:g}), so light travels little"
+        )
+    return ""
 
 
 def _interface(slot: Slot, value: Any) -> Any:

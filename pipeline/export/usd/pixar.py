@@ -30,7 +30,7 @@ from lookdev.materials.pixar import (
     view_independent,
     weights,
 )
-from lookdev.materials.pixar_lobes import power_reflection, power_specular
+from lookdev.materials.pixar_lobes import power_specular, reflection_cone
 
 WEIGHTS = ("specN", "specG", "reflN", "reflG", "reflTN")
 """Smits' view-independent weights a target reads (RGB)."""
@@ -66,10 +66,36 @@ def derived(params: PixarParams) -> dict[str, Any]:
     }
     out.update({f"amp_{k}": float(v) for k, v in amplitude.items()})
     out["spec_roughness"] = ggx_roughness(float(power_specular(xp, r, params.specular_cone_scale)))
-    out["refl_roughness"] = ggx_roughness(
-        float(power_reflection(xp, r, params.reflection_cone_scale))
-    )
+    # The reflection lobe through its cone, unfloored: Smits' cone is 0 at roughness 0
+    # ("0, or epsilon in practice"); the model's evaluation floor (CONE_MIN_DEG) is not a
+    # width a target should be given (it made a clear glass 0.09 rough).
+    out["refl_roughness"] = float(cone_roughness(reflection_cone(r, params.reflection_cone_scale)))
+    out["highlight_roughness"] = float(highlight_roughness(out))
     return out
+
+
+def highlight_roughness(w: dict[str, Any]) -> Any:
+    """One roughness for Smits' two highlight lobes: their GGX roughnesses weighted by
+    each lobe's energy (the mean over RGB of its normal + grazing weight).
+
+    A surface with one specular lobe (OpenPBR, UsdPreviewSurface) takes this, so the
+    lobe that carries the light sets the width: pixar_gold (roughness 0.15) keeps a
+    sharp highlight and a clear glass (roughness 0, all in the reflection lobe) stays
+    clear. Scalars or ``(…)`` arrays; RGB weights as ``(…, 3)``.
+
+    >>> w = {"specN": (0, 0, 0), "specG": (0, 0, 0), "reflN": (1, 1, 1), "reflG": (0, 0, 0)}
+    >>> float(highlight_roughness({**w, "spec_roughness": 0.9, "refl_roughness": 0.0}))
+    0.0
+    """
+    import numpy as np
+
+    def energy(a: str, b: str) -> Any:
+        return (np.asarray(w[a], np.float64) + np.asarray(w[b], np.float64)).mean(axis=-1)
+
+    e_spec, e_refl = energy("specN", "specG"), energy("reflN", "reflG")
+    total = e_spec + e_refl
+    weighted = e_spec * np.asarray(w["spec_roughness"]) + e_refl * np.asarray(w["refl_roughness"])
+    return np.where(total > 0.0, weighted / np.where(total > 0.0, total, 1.0), 0.0)
 
 
 def _rgb(value: Any) -> tuple[float, float, float]:
@@ -95,13 +121,15 @@ def cone_roughness(cone_deg: Any) -> Any:
     return np.sqrt(np.minimum(alpha, 1.0))
 
 
-def from_weights(w: dict[str, Any]) -> dict[str, Any]:
+def from_weights(w: dict[str, Any], eta: float | None = None) -> dict[str, Any]:
     """Target quantities of a lobe-weight blend (:mod:`lookdev.pipeline.blend.pixar`).
 
     ``w`` holds the blend's arrays by name (constants as arrays too). Returns the same
     keys :func:`derived` gives for one material, plus ``f0`` (the highlight colour at
     normal incidence, both lobes) and ``highlight_roughness`` (their energy-weighted
-    roughness) for surfaces with a single highlight lobe.
+    roughness) for surfaces with a single highlight lobe, and the same highlight and
+    diffuse in UsdPreviewSurface's metallic workflow (:func:`metallic_workflow`, with
+    the dielectric F0 of ``eta``, the blend's IOR).
     """
     import numpy as np
 
@@ -116,12 +144,9 @@ def from_weights(w: dict[str, Any]) -> dict[str, Any]:
         "refl_roughness": cone_roughness(w["reflection_cone"]),
     }
     out["f0"] = out["specN"] + out["reflN"]
-    e_spec = (out["specN"] + out["specG"]).mean(axis=-1)
-    e_refl = (out["reflN"] + out["reflG"]).mean(axis=-1)
-    total = np.where(e_spec + e_refl > 0.0, e_spec + e_refl, 1.0)
-    out["highlight_roughness"] = (
-        e_spec * out["spec_roughness"] + e_refl * out["refl_roughness"]
-    ) / total
+    out["highlight_roughness"] = highlight_roughness(out)
+    base, metal = metallic_workflow(out["front"], out["f0"], DEFAULT_ETA if eta is None else eta)
+    out["preview_base"], out["preview_metallic"] = base, metal
     amplitude = {
         "diffuse": [rgb("diffN"), rgb("diffG")],
         "diffuse_t": [rgb("diffTN"), rgb("diffTG")],
@@ -132,6 +157,68 @@ def from_weights(w: dict[str, Any]) -> dict[str, Any]:
     }
     out.update({f"amp_{k}": float(max(a.max() for a in v)) for k, v in amplitude.items()})
     return out
+
+
+DEFAULT_ETA = PixarParams().eta
+
+
+def metallic_workflow(front: Any, f0: Any, eta: float) -> tuple[Any, Any]:
+    """(diffuseColor, metallic) of UsdPreviewSurface's metallic workflow whose diffuse
+    at normal incidence is ``front`` and whose highlight F0 is ``f0`` (RGB ``(…, 3)``).
+
+    UsdPreviewSurface spec 2.5, ``metallic``: at 0, F0 comes from ``ior``
+    (a = ((1 − ior)/(1 + ior))²) and the diffuse is ``diffuseColor``; at 1, F0 is
+    ``diffuseColor`` and there is no diffuse; "in between, we interpolate" — as USD's
+    reference implementation does it (:mod:`lookdev.materials.preview_surface`): with
+    base B and metallic m, F0 = ((1 − m) + m·B)·((1 − m)·a + m), and the diffuse seen at
+    normal incidence is B·(1 − m)·(1 − F0). m is the root, by bisection per texel, of
+    Y(F0(m, B(m))) = Y(f0) with B(m) from the diffuse (0 where Y(f0) ≤ a: a dielectric);
+    the colour is then the diffuse's where m is small and the F0's where m is large
+    (blended by m²), clamped to 0..1. Only luminances are matched: F0's tint at a
+    fractional m is the interpolation's, a loss the export names.
+
+    The specular workflow would carry ``f0`` as it is, but DCC importers read
+    ``specularColor`` as a tint on their own dielectric F0 (≈ 0.04), so a metal's F0 of
+    ~1 would arrive ~25 times too dark.
+
+    >>> base, m = metallic_workflow((0.0, 0.0, 0.0), (1.0, 0.78, 0.34), 1.5)
+    >>> round(float(m), 6), [round(float(c), 2) for c in base]
+    (1.0, [1.0, 0.78, 0.34])
+    >>> base, m = metallic_workflow((0.5, 0.1, 0.1), (0.04, 0.04, 0.04), 1.5)
+    >>> float(m), [round(float(c), 4) for c in base]
+    (0.0, [0.5208, 0.1042, 0.1042])
+    """
+    import numpy as np
+
+    from lookdev.materials.colour import luminance
+
+    d = np.asarray(front, np.float64)
+    s = np.asarray(f0, np.float64)
+    a = float(ior_to_f0(eta))
+    ys = luminance(s)
+    dim = 1.0 - np.clip(s, 0.0, 1.0)
+
+    def base_from_diffuse(m: Any) -> Any:
+        return np.clip(d / np.maximum((1.0 - m[..., None]) * dim, 1e-6), 0.0, 1.0)
+
+    def excess(m: Any) -> Any:  # Y(F0) of the preview minus the target's, rising in m
+        mm = m[..., None]
+        spec = (1.0 - mm) + mm * base_from_diffuse(m)
+        return luminance(spec * ((1.0 - mm) * a + mm)) - ys
+
+    lo = np.zeros(np.shape(ys))
+    hi = np.ones(np.shape(ys))
+    for _ in range(40):  # 2^-40: far below float32
+        mid = 0.5 * (lo + hi)
+        high = excess(mid) > 0.0
+        hi = np.where(high, mid, hi)
+        lo = np.where(high, lo, mid)
+    m = np.where(ys <= a, 0.0, 0.5 * (lo + hi))
+    mm = m[..., None]
+    from_f0 = (s / np.maximum((1.0 - mm) * a + mm, 1e-6) - (1.0 - mm)) / np.maximum(mm, 1e-6)
+    base = base_from_diffuse(m)
+    base = np.clip(base + (np.clip(from_f0, 0.0, 1.0) - base) * mm * mm, 0.0, 1.0)
+    return base, m
 
 
 def ior_to_normal_fresnel(ior: float) -> float:

@@ -1,7 +1,11 @@
 """Imported materials as preset files (TOML), written safely.
 
-A preset holds constants; a parameter a texture fed in the USD file is kept as a
-comment naming the map, so nothing read is silently dropped.
+A parameter a texture fed in the USD file becomes its
+:class:`~lookdev.materials.textures.TextureInput` (the table a preset writes for a
+texture-driven parameter: file, channel, colour space, scale/offset, wrap). A lookdev
+export carries its preset whole (:mod:`.record`): that document is written back as it was.
+Names must not clash, with each other or with a preset of the library: such a material
+is refused in one line, or renamed with ``rename``.
 """
 
 from __future__ import annotations
@@ -27,33 +31,74 @@ def preset_name(name: str) -> str:
     return safe or "imported"
 
 
-def preset_toml(material: Imported) -> str:
-    """The preset file text of one imported material."""
+def preset_toml(material: Imported, name: str | None = None) -> str:
+    """The preset file text of one imported material (named ``name`` if given)."""
+    name = name or preset_name(material.name)
+    if material.document is not None:
+        return dump_preset(PresetFile(**{**material.document, "name": name}))
+    params = dict(material.params)
+    for key, texture in material.maps.items():  # a texture-driven parameter (TextureInput)
+        params[key] = {"texture": texture.texture} | texture.model_dump(
+            mode="json", exclude_defaults=True, exclude={"texture"}
+        )
     preset = PresetFile(
-        name=preset_name(material.name),
+        name=name,
         model=material.model,
         description=f"Imported from USD ({', '.join(material.contexts)}).",
-        params=dict(material.params),
+        params=params,
     )
     text = dump_preset(preset)
-    notes = [
-        f"# map: {k} = {str(v)!r} (constant here: the map's mean is not known)"
-        for k, v in sorted(material.maps.items())
-    ]
+    notes = []
     notes += [f"# loss: {line}" for line in material.loss]
     return text + ("\n" + "\n".join(notes) + "\n" if notes else "")
 
 
-def write_presets(found: list[Imported], output: Path | None, *, force: bool = False) -> list[Path]:
+def import_names(
+    found: list[Imported], taken: set[str] | frozenset[str] = frozenset(), *, rename: bool = False
+) -> list[str]:
+    """Preset names for ``found``: unique among themselves and not in ``taken`` (the
+    library's presets). A clash raises one line naming both, unless ``rename``, which
+    appends ``_imported`` (then a number) until the name is free."""
+    names: list[str] = []
+    used = set(taken)
+    for m in found:
+        name = preset_name(m.name)
+        if name in used:
+            if not rename:
+                what = "another material in the file" if name in names else "a library preset"
+                raise ExportError(
+                    f"material {m.name!r} would be preset {name!r}, which {what} already is; "
+                    "give --rename to import it under a new name",
+                    where=m.name,
+                )
+            base, n = f"{name}_imported", 1
+            name = base
+            while name in used:
+                n += 1
+                name = f"{base}{n}"
+        used.add(name)
+        names.append(name)
+    return names
+
+
+def write_presets(
+    found: list[Imported],
+    output: Path | None,
+    *,
+    force: bool = False,
+    names: list[str] | None = None,
+) -> list[Path]:
     """Write each material to ``output`` (a .toml for one, a folder for several).
 
-    Every preset is validated as ``presets validate`` would before anything is written
-    (one line naming the file and field when one is not valid), and an existing preset
-    file is replaced only with ``force``.
+    ``names`` (from :func:`import_names`) name the presets; by default each material's
+    own, refused when two collide. Every preset is validated as ``presets validate``
+    would before anything is written (one line naming the file and field when one is not
+    valid), and an existing preset file is replaced only with ``force``.
     """
+    names = names if names is not None else import_names(found)
     if output is None:
-        for m in found:
-            check_preset(preset_toml(m), f"{preset_name(m.name)}.toml")
+        for m, name in zip(found, names, strict=True):
+            check_preset(preset_toml(m, name), f"{name}.toml")
         return []
     output = output.expanduser()
     if output.suffix == ".toml":
@@ -66,8 +111,8 @@ def write_presets(found: list[Imported], output: Path | None, *, force: bool = F
         if not output.is_dir():
             what = "is a file, not a folder" if output.exists() else "folder does not exist"
             raise ExportError(f"{what} (give a folder or a .toml file)", where=str(output))
-        targets = [output / f"{preset_name(m.name)}.toml" for m in found]
-    texts = [preset_toml(m) for m in found]
+        targets = [output / f"{name}.toml" for name in names]
+    texts = [preset_toml(m, name) for m, name in zip(found, names, strict=True)]
     for path, text in zip(targets, texts, strict=True):
         check_preset(text, str(path), stem=path.stem)
     for path in targets:

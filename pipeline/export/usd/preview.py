@@ -12,6 +12,8 @@ from __future__ import annotations
 from functools import cache
 from typing import Any
 
+import numpy as np
+
 from .names import Slot, mapped_params, table_for
 from .network import (
     ST_PRIMVAR,
@@ -34,7 +36,6 @@ from .textures import (
 )
 
 SURFACE = "preview_surface"
-SPECULAR_WORKFLOW = ("pixar_weights",)  # models whose highlight is a colour, not metallic
 ST_READER = "preview_st"
 SHAPE_NOTES = {
     "disney": {
@@ -48,7 +49,9 @@ SHAPE_NOTES = {
     },
     "pixar_weights": {
         "highlights": "the blend's specular and reflection lobes become one GGX lobe with "
-        "their energy-weighted roughness and Schlick's edge, not their grazing weights",
+        "their energy-weighted roughness and Schlick's edge, not their grazing weights; "
+        "their F0 colour and the diffuse are solved per texel for a base colour and a "
+        "metallic (metallic workflow: a dielectric F0 other than the ior's shifts to metallic)",
         "diffuse": "the diffuse is its weight at normal incidence",
         "diffuse_t": "no transmitted diffuse lobe",
         "transmission": "no refraction: a blend's transmitted lobes are not expressed",
@@ -88,10 +91,9 @@ def build(source: Source, preview_opacity: str = "keep") -> Network:
     nodes: list[Node] = []
     table = table_for("universal", source.model, preview_opacity)
     inputs = surface_inputs(source, table, preview_defaults(), nodes, _texture)
-    if source.model in SPECULAR_WORKFLOW:
-        inputs["useSpecularWorkflow"] = ("int", 1)
     if source.normal_map is not None:
         inputs["normal"] = _normal(nodes, source.normal_map)
+    refit = _fractional_metal(source, inputs) if source.model == "disney" else ""
     displacement = None
     if source.height is not None:
         # UsdPreviewSurface displaces along the normal by `displacement` scene units.
@@ -103,6 +105,8 @@ def build(source: Source, preview_opacity: str = "keep") -> Network:
     transmissive = any(lobes[lobe] for lobe in TRANSMISSION_LOBES.get(source.model, ()))
     if transmissive and preview_opacity == "keep":
         shapes.insert(0, KEPT_OPAQUE)
+    if refit:
+        shapes.append(refit)
     mapped = mapped_params("universal", source.model, preview_opacity)
     shapes += [n.custom.pop("space_note") for n in nodes if n.custom.get("space_note")]
     note = loss_note(source, "UsdPreviewSurface", mapped, "; ".join(shapes))
@@ -112,6 +116,40 @@ def build(source: Source, preview_opacity: str = "keep") -> Network:
     surface = Node(SURFACE, "UsdPreviewSurface", inputs, outputs)
     surface.custom["loss"] = note
     return Network("universal", Connection(SURFACE, "surface"), [surface, *nodes], displacement)
+
+
+def _fractional_metal(source: Source, inputs: dict[str, tuple[str, Any]]) -> str:
+    """A constant metallic strictly between 0 and 1, refitted; the note, or ``""``.
+
+    UsdPreviewSurface interpolates F0 towards a *white* colour (``mix(1, diffuseColor,
+    metallic)``), Burley towards the base colour (§5.4): car paint's metallic 0.4 on a
+    dark red reads F0 ≈ 0.25 grey there instead of ≈ 0.03 red (measured by ``export usd
+    --report``: albedo off by 0.22). So diffuseColor and metallic are solved for Burley's
+    F0 and diffuse (:func:`.pixar.metallic_workflow`, the layered Pixar export's solver).
+    A mapped base colour or metallic is written as it is.
+    """
+    from lookdev.materials.colour import luminance
+
+    from .pixar import metallic_workflow
+
+    values = source.live_values
+    m = float(values["metallic"])
+    if not 0.0 < m < 1.0 or {"metallic", "base_color"} & set(source.maps):
+        return ""
+    base = np.asarray(values["base_color"], np.float64)
+    y = luminance(base)
+    tint = base / y if y > 0.0 else np.ones(3)
+    dielectric = 0.08 * values["specular"] * (1.0 + (tint - 1.0) * values["specular_tint"])
+    f0 = dielectric + (base - dielectric) * m  # Burley §5.4: mix(Cspec0, base, metallic)
+    front = base * (1.0 - m) * (1.0 - np.clip(f0, 0.0, 1.0))
+    colour, metal = metallic_workflow(front, f0, values["ior"])
+    inputs["diffuseColor"] = ("color3f", tuple(float(c) for c in colour))
+    inputs["metallic"] = ("float", float(metal))
+    return (
+        f"metallic={m:g} is refitted to metallic {float(metal):.3g} and diffuseColor "
+        f"({', '.join(f'{c:.3g}' for c in colour)}): the surface interpolates F0 towards "
+        "white, Burley towards the base colour; F0's tint is lost"
+    )
 
 
 def _st(nodes: list[Node]) -> Connection:

@@ -7,8 +7,16 @@ usd-core does not know and where lookdev writes every live input. An input conne
 a texture node gives that texture's file as the parameter's map.
 
 Contexts are read in the order universal, RenderMan, MaterialX, each overriding the
-parameters it expresses more faithfully: a lookdev-written file thus gives back every
-parameter, a foreign ``UsdPreviewSurface`` what that surface can say.
+parameters it expresses more faithfully: a foreign ``UsdPreviewSurface`` gives what that
+surface can say, an OpenPBR or Standard Surface network what :mod:`.foreign` maps. A
+lookdev export gives back its preset exactly, from the record it carries (:mod:`.record`).
+
+Values are followed through connections to the Material's own interface inputs (the
+usdex, Houdini and Omniverse pattern: the shader input connects to ``inputs:X`` on the
+Material, which holds the value). A texture feeding an input is kept as a
+:class:`~lookdev.materials.textures.TextureInput` (file, channel, colour space, scale and
+bias as ``scale``/``offset``, wrap). What a preset cannot hold (alpha and cut-outs, the
+normal, emission, occlusion, displacement, an unreadable map) is named as a loss.
 """
 
 from __future__ import annotations
@@ -19,15 +27,17 @@ from typing import Any
 
 import numpy as np
 
-from lookdev.materials.colour import luminance
 from lookdev.materials.errors import LookdevError
-from lookdev.materials.fresnel import SPECULAR_F0_SCALE, ior_to_specular, specular_to_ior
+from lookdev.materials.fresnel import ior_to_specular, specular_to_ior
+from lookdev.materials.textures import TextureInput
 
+from .foreign import FOREIGN_SURFACES, preview_extras, read_foreign, specular_workflow
 from .lobes import DEFAULTS, active_lobes, effective
 from .names import DERIVED_FROM, SURFACE_IDS, table_for
 from .network import (
     CONTEXT_OUTPUT,
     F0_KEYS,
+    LOCAL,
     Connection,
     ExportError,
     Image,
@@ -38,6 +48,7 @@ from .network import (
 )
 from .pixar import ior_to_normal_fresnel
 from .preview import preview_defaults
+from .record import network_digest, read_record
 
 TEXTURE_FILE_INPUT = {"UsdUVTexture": "file", "PxrTexture": "filename"}
 READ_ORDER = ("universal", "ri", "mtlx")
@@ -60,15 +71,19 @@ class Imported:
     name: str
     model: str
     params: dict[str, Any]
-    maps: dict[str, Path] = field(default_factory=dict)
+    maps: dict[str, TextureInput] = field(default_factory=dict)
     contexts: list[str] = field(default_factory=list)
     loss: list[str] = field(default_factory=list)
+    document: dict[str, Any] | None = None
+    """The whole preset, when the file carried lookdev's record (an exact round trip)."""
 
 
 def read_networks(stage) -> list[MaterialSpec]:
-    """Every material's networks as :class:`~.network.MaterialSpec` (switch prims skipped)."""
-    from pxr import Usd, UsdShade
+    """Every material's networks as :class:`~.network.MaterialSpec` (switch prims skipped);
+    ``custom["meters_per_unit"]`` is the stage's."""
+    from pxr import Usd, UsdGeom, UsdShade
 
+    units = float(UsdGeom.GetStageMetersPerUnit(stage))
     specs = []
     for prim in stage.Traverse(Usd.TraverseInstanceProxies()):
         if not prim.IsA(UsdShade.Material) or _custom(prim).get("switch"):
@@ -79,9 +94,8 @@ def read_networks(stage) -> list[MaterialSpec]:
             net = _network(material, context, output_name)
             if net is not None:
                 networks.append(net)
-        specs.append(
-            MaterialSpec(_custom(prim).get("preset", prim.GetName()), networks, _custom(prim))
-        )
+        custom = {**_custom(prim), "meters_per_unit": units}
+        specs.append(MaterialSpec(custom.get("preset", prim.GetName()), networks, custom))
     return specs
 
 
@@ -155,17 +169,15 @@ def _collect(prim, nodes: dict[str, Node]) -> None:
         node.outputs[out.GetBaseName()] = str(out.GetTypeName())
     for inp in shader.GetInputs():
         kind = str(inp.GetTypeName())
-        source = _source(inp)
-        if source is not None and UsdShade.Material(prim.GetStage().GetPrimAtPath(source[0])):
-            # A Material interface input (lookdev's own, usdex, Houdini): its value.
-            attrs = inp.GetValueProducingAttributes()
-            if attrs and attrs[0].HasAuthoredValue():
-                node.inputs[inp.GetBaseName()] = (kind, _plain(attrs[0].Get()))
-        elif source is not None:
-            node.inputs[inp.GetBaseName()] = (kind, Connection(source[0].name, source[1]))
-            _collect(prim.GetStage().GetPrimAtPath(source[0]), nodes)
-        elif inp.GetAttr().HasAuthoredValue():
-            node.inputs[inp.GetBaseName()] = (kind, _plain(inp.Get()))
+        # Followed through the Material's interface inputs to a shader output or a value.
+        for attr in inp.GetValueProducingAttributes(shaderOutputsOnly=False):
+            base, where = UsdShade.Utils.GetBaseNameAndType(attr.GetName())
+            if where == UsdShade.AttributeType.Output:
+                node.inputs[inp.GetBaseName()] = (kind, Connection(attr.GetPrim().GetName(), base))
+                _collect(attr.GetPrim(), nodes)
+            elif attr.HasAuthoredValue():
+                node.inputs[inp.GetBaseName()] = (kind, _plain(attr.Get()))
+            break
     node.custom.update(_custom(prim))
 
 
@@ -231,50 +243,89 @@ def import_usd(path: Path, skipped: list[str] | None = None) -> list[Imported]:
 
 
 def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
+    document = read_record(spec.custom)
+    edited = document is not None and spec.custom.get("networks") != network_digest(spec.networks)
+    if document is not None and not edited:  # lookdev's own export, as exported
+        result = Imported(spec.name, document.get("model", "layered"), {}, document=document)
+        result.params = dict(document.get("params", {}))
+        result.contexts.append("record")
+        return result
     model = spec.custom.get("model", "disney")
     values = dict(DEFAULTS[model])
     result = Imported(spec.name, model, {})
+    if edited:
+        result.loss.append(
+            "the networks were edited after lookdev exported them: read from the networks, "
+            "not from the preset record the file carries"
+        )
     by_context = {net.context: net for net in spec.networks}
+    spelling = spec.custom.get("spelling") or "ior"
     for context in READABLE[model]:
         net = by_context.get(context)
+        foreign = _foreign(net) if model == "disney" else None
+        if foreign is not None:
+            _read_foreign(foreign, spec.custom.get("meters_per_unit", 1.0), values, result)
+            result.contexts.append(context)
+            continue
         surface = _surface(net, context, model)
         if surface is None:
             continue
-        _read_surface(net, surface, context, model, values, result)
-        if context == "universal" and model == "disney":
-            _specular_workflow(surface, values, result)
+        units = spec.custom.get("meters_per_unit", 1.0)
+        _read_surface(net, surface, context, model, values, result, units)
+        if context == "universal":
+            nodes = {n.name: n for n in net.nodes}
+            result.loss.extend(preview_extras(surface, nodes, _texture_file))
+            if model == "disney" and _specular_workflow(surface, values, result):
+                spelling = "specular"
         result.contexts.append(context)
         if surface.custom.get("loss"):
             result.loss.append(f"{context}: {surface.custom['loss']}")
     if not result.contexts:
         return None
-    spelling = spec.custom.get("spelling") or "ior"
     _to_preset_space(values, space, result)
     result.params = _preset_params(values, model, spelling)
     return result
 
 
-def _specular_workflow(surface: Node, values: dict[str, Any], result: Imported) -> None:
-    """A foreign UsdPreviewSurface in its specular workflow: its specular colour is an F0.
+def _foreign(net: Network | None) -> Node | None:
+    """The OpenPBR or Standard Surface shader a network ends in, if it does."""
+    if net is None:
+        return None
+    node = next((n for n in net.nodes if n.name == net.terminal.node), None)
+    return node if node is not None and node.id in FOREIGN_SURFACES else None
 
-    Burley §5.4: F0 = 0.08 · specular, so ``specular`` = Y(specularColor) / 0.08 with
-    metallic 0 (that workflow has none). The colour's tint has no Disney equivalent.
-    """
+
+def _read_foreign(surface: Node, units: float, values: dict[str, Any], result: Imported):
+    from .mtlx import node_defaults
+
+    read, maps, losses = read_foreign(surface, node_defaults(surface.id), units)
+    values.update(read)
+    if "ior" in read:
+        values["specular"] = ior_to_specular(read["ior"])
+    for param, name in maps.items():
+        result.loss.append(f"mtlx: {surface.id} {name} is a connected network (not imported)")
+        values.pop(param, None)
+    result.loss.extend(f"mtlx: {line}" for line in losses)
+
+
+def _specular_workflow(surface: Node, values: dict[str, Any], result: Imported) -> bool:
+    """A foreign UsdPreviewSurface in its specular workflow (:func:`.foreign.specular_workflow`):
+    True when it was one."""
     flag = surface.inputs.get("useSpecularWorkflow")
     if flag is None or not flag[1]:
-        return
-    kind, colour = surface.inputs.get("specularColor", ("color3f", (0.0, 0.0, 0.0)))
+        return False
+    colour = surface.inputs.get("specularColor", ("color3f", (0.0, 0.0, 0.0)))[1]
     if isinstance(colour, Connection):
         result.loss.append("universal: specularColor is a texture; its mean is unknown")
-        return
-    f0 = luminance(colour)
-    values["metallic"] = 0.0
-    values["specular"] = min(f0, 1.0) / SPECULAR_F0_SCALE  # F0 ≤ 1: specular ≤ 12.5
+        return True
+    diffuse = values["base_color"]
+    if not isinstance(diffuse, tuple):
+        diffuse = (float(diffuse),) * 3
+    read, losses = specular_workflow(tuple(diffuse), tuple(colour))
+    values.update(read)
     values["ior"] = specular_to_ior(values["specular"])
-    if max(colour) - min(colour) > 1e-6:
-        result.loss.append(
-            f"universal: the tint of specularColor {colour} (only its luminance is read)"
-        )
+    result.loss.extend(losses)
+    return True
 
 
 def _surface(net: Network | None, context: str, model: str) -> Node | None:
@@ -286,12 +337,14 @@ def _surface(net: Network | None, context: str, model: str) -> Node | None:
     return node
 
 
-def _read_surface(net, surface, context, model, values, result) -> None:
+def _read_surface(net, surface, context, model, values, result, units: float = 1.0) -> None:
     """Values of one surface into ``values`` (our names), maps into ``result.maps``.
 
     Unwritten inputs of a lobe take the target's default only once the written ones
     show the lobe live: lookdev prunes a dead lobe's inputs, and their target defaults
-    (MaterialX's ``subsurfaceDistance`` = 1) must not bring it back to life.
+    (MaterialX's ``subsurfaceDistance`` = 1) must not bring it back to life. Lengths
+    come back in metres (× the stage's ``units``, metersPerUnit); a radius lookdev wrote
+    for Burley 2012's distance-less subsurface (marked on the shader) is no distance.
     """
     defaults = _defaults(context, surface.id)
     nodes = {n.name: n for n in net.nodes}
@@ -300,16 +353,26 @@ def _read_surface(net, surface, context, model, values, result) -> None:
     pending = []
     if model == "pixar" and context != "universal":
         table = tuple(s for s in table if s.param not in DERIVED_FROM)
+    local = surface.custom.get("subsurface_radius") == LOCAL
     for slot in table:
         if slot.param == "ior" and has_specular:
             continue  # there `ior` only refracts and equals the specular's IOR by construction
+        if slot.param == "scatter_distance" and local:
+            continue
         given = surface.inputs.get(slot.input)
         if given is not None and isinstance(given[1], Connection):
-            path = _texture_file(nodes, given[1])  # None for a live mix chain
-            if path is not None:
-                result.maps.setdefault(slot.param, path)
+            texture = _texture_input(nodes, given[1], slot)  # None for a live mix chain
+            if texture is not None and slot.texture_linear is None:
+                result.loss.append(
+                    f"{context}: {slot.input} reads the map {texture.texture} through a "
+                    f"conversion {slot.param} has no texture form for (not imported)"
+                )
+            elif texture is not None:
+                result.maps.setdefault(slot.param, texture)
         elif given is not None:
             values[slot.param] = slot.from_target(given[1])
+            if slot.param == "scatter_distance":
+                values[slot.param] *= units
         elif defaults is not None and slot.input in defaults:
             pending.append(slot)
     lobes = active_lobes(values, model)
@@ -329,6 +392,44 @@ def _defaults(context: str, node_id: str) -> dict[str, Any] | None:
 
         return node_defaults(node_id)
     return None
+
+
+WRAP = {"repeat": "periodic", "clamp": "clamp", "black": "black", "mirror": "mirror"}
+"""UsdUVTexture ``wrapS`` → :class:`TextureInput` ``wrap``."""
+COLOUR_SPACE = {"raw": "Raw", "sRGB": "sRGB - Texture"}
+"""UsdUVTexture ``sourceColorSpace`` → the OCIO config's name (``auto``: by file rule)."""
+
+
+def _texture_input(nodes: dict[str, Node], conn: Connection, slot) -> TextureInput | None:
+    """The :class:`TextureInput` of the texture node feeding ``slot``: its file, output
+    channel, colour space, UsdUVTexture scale/bias as scale/offset and wrap. The slot's
+    own conversion is not applied (it is named by the input it feeds)."""
+    path = _texture_file(nodes, conn)
+    if path is None:
+        return None
+    node = nodes[conn.node]
+    fields: dict[str, Any] = {"texture": str(path)}
+    if conn.output in ("r", "g", "b", "a", "rgb"):
+        fields["channel"] = conn.output
+    space = node.inputs.get("sourceColorSpace", (None, None))[1]
+    if space in COLOUR_SPACE:
+        fields["colorspace"] = COLOUR_SPACE[space]
+    channel = {"r": 0, "g": 1, "b": 2, "a": 3}.get(conn.output, 0)
+    scale = node.inputs.get("scale", (None, None))[1]
+    bias = node.inputs.get("bias", (None, None))[1]
+    s = float(scale[channel]) if isinstance(scale, tuple) else 1.0
+    o = float(bias[channel]) if isinstance(bias, tuple) else 0.0
+    # The input is a·param + b (the slot's affine map): param = (texel·s + o − b)/a.
+    a, b = slot.texture_linear or (1.0, 0.0)
+    s, o = s / a, (o - b) / a
+    if s != 1.0:
+        fields["scale"] = s
+    if o != 0.0:
+        fields["offset"] = o
+    wrap = node.inputs.get("wrapS", (None, None))[1]
+    if wrap in WRAP:
+        fields["wrap"] = WRAP[wrap]
+    return TextureInput.parse(fields)
 
 
 def _texture_file(nodes: dict[str, Node], conn: Connection) -> Path | None:

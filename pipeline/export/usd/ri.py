@@ -20,13 +20,16 @@ from typing import Any
 
 from .names import SURFACE_IDS, Slot, mapped_params, table_for
 from .network import (
+    LOCAL,
     Connection,
     ExportError,
     Image,
     Network,
     Node,
     Source,
+    local_subsurface,
     loss_note,
+    subsurface_radius,
     surface_inputs,
 )
 from .textures import affine, converted, output_of, preview_color_space
@@ -67,11 +70,14 @@ SURFACE = "ri_surface"
 RI_DEFAULTS = {"metallic": 0.0, "anisotropic": 0.0, "specularTint": 0.0}
 
 
-def build(source: Source) -> Network:
-    """The RenderMan network of ``source``."""
+def build(source: Source, meters_per_unit: float = 1.0) -> Network:
+    """The RenderMan network of ``source``; lengths in scene units of ``meters_per_unit``."""
     nodes: list[Node] = []
     table = table_for("ri", source.model)
     inputs = surface_inputs(source, table, RI_DEFAULTS, nodes, _texture)
+    radius = ""
+    if source.model == "disney":
+        radius = subsurface_radius(source, inputs, "scatterDistances", meters_per_unit)
     if source.normal_map is not None:
         nodes.append(
             Node(
@@ -84,6 +90,8 @@ def build(source: Source) -> Network:
         inputs["bumpNormal"] = ("normal3f", Connection("ri_normal_map", "resultN"))
     node_id = SURFACE_IDS[("ri", source.model)]
     extra = [EXTRA_LOSS[source.model]] if source.model in EXTRA_LOSS else []
+    if radius:
+        extra.append(radius)
     displacement = None
     if source.height is not None:
         displacement = _displacement(nodes, source.height)
@@ -93,6 +101,8 @@ def build(source: Source) -> Network:
             extra.append(GLASS_REFLECTION)
     note = loss_note(source, node_id, mapped_params("ri", source.model), "; ".join(extra))
     surface = Node(SURFACE, node_id, inputs, {"bxdf_out": "token"}, {"loss": note})
+    if source.model == "disney" and local_subsurface(source):
+        surface.custom["subsurface_radius"] = LOCAL
     net = Network("ri", Connection(SURFACE, "bxdf_out"), [surface, *nodes], displacement)
     check_network(net, source.name)
     return net

@@ -228,7 +228,7 @@ def weights_source(hub: BlendedMaterial, texture_dir: Path) -> Source:
     eta = DEFAULTS["pixar_weights"]["eta"] if ior is None else float(np.mean(ior))
     values: dict[str, Any] = {"eta": eta}
     maps: dict[str, Image] = {}
-    for name, value in from_weights(arrays).items():
+    for name, value in from_weights(arrays, eta).items():
         if np.ndim(value) >= 2:
             path = texture_dir / f"{hub.name}_{name}.exr"
             maps[name] = Image(path, np.flipud(value).astype(np.float32), write=True)

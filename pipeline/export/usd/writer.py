@@ -8,6 +8,7 @@ succeeded, so a failure leaves no partial file (:class:`Staging`).
 
 from __future__ import annotations
 
+import math
 import os
 import tempfile
 from dataclasses import dataclass, field
@@ -43,18 +44,29 @@ USD_SUFFIXES = (".usda", ".usdc", ".usd")
 
 
 def material_spec(
-    source: Source, contexts: tuple[str, ...], preview_opacity: str = "keep"
+    source: Source,
+    contexts: tuple[str, ...],
+    preview_opacity: str = "keep",
+    meters_per_unit: float = 1.0,
 ) -> MaterialSpec:
-    """The networks of ``source`` for each of ``contexts`` and the material's metadata."""
+    """The networks of ``source`` for each of ``contexts`` and the material's metadata
+    (lengths in scene units of ``meters_per_unit``, the stage's)."""
     custom = {
         "preset": source.name,
         "model": source.model,
         "spelling": source.spelling,
     }
     networks = [
-        preview.build(source, preview_opacity) if c == "universal" else BUILDERS[c](source)
+        preview.build(source, preview_opacity)
+        if c == "universal"
+        else BUILDERS[c](source, meters_per_unit)
         for c in contexts
     ]
+    if source.record:  # the preset, trusted while the networks are these (.record)
+        from .record import network_digest
+
+        custom["record"] = source.record
+        custom["networks"] = network_digest(networks)
     return MaterialSpec(source.name, networks, custom)
 
 
@@ -112,12 +124,13 @@ def relative_asset(path: Path, base: Path) -> str:
     return rel if rel.startswith("../") else f"./{rel}"
 
 
-def new_layer(default_prim: str = "Materials"):
-    """An empty anonymous layer with the stage metadata validators expect."""
+def new_layer(default_prim: str = "Materials", meters_per_unit: float = 1.0):
+    """An empty anonymous layer with the stage metadata validators expect; lengths
+    written into it are in units of ``meters_per_unit`` metres."""
     layer = Sdf.Layer.CreateAnonymous(".usda")
     layer.defaultPrim = default_prim
     layer.pseudoRoot.SetInfo("upAxis", "Y")
-    layer.pseudoRoot.SetInfo("metersPerUnit", 1.0)
+    layer.pseudoRoot.SetInfo("metersPerUnit", float(meters_per_unit))
     # The stage's colour management system (UsdStage colorManagementSystem). The config is
     # recorded as data, not as colorConfiguration: that is an asset path, which would make
     # a built-in ocio:// config (or a file on this machine) an unresolvable dependency.
@@ -295,6 +308,8 @@ class ExportResult:
     materials: list[str]
     images: list[Path]
     losses: dict[str, dict[str, str]] = field(default_factory=dict)
+    fidelity: dict[str, Any] = field(default_factory=dict)
+    """material → :class:`.fidelity.Fidelity` when the export was asked to measure."""
 
 
 def losses_of(specs: list[MaterialSpec]) -> dict[str, dict[str, str]]:
@@ -318,6 +333,7 @@ def export_usd(
     split_dir: Path | None = None,
     workdir: Path | None = None,
     preview_opacity: str = "keep",
+    meters_per_unit: float = 1.0,
     collect: bool = False,
     preview_geometry: bool = False,
 ) -> ExportResult:
@@ -327,6 +343,8 @@ def export_usd(
     ``mtlx_path``: also a standalone MaterialX document. ``workdir`` (packages): where the
     stage is staged before packaging; textures below it keep their path relative to it
     inside the ``.usdz``. ``preview_opacity``: see :data:`.names.PREVIEW_OPACITY`.
+    ``meters_per_unit``: the stage's ``metersPerUnit``; lengths (the subsurface radius,
+    lookdev's ``scatter_distance`` in metres) are written in those units.
     ``collect``: copy the presets' own texture files into ``<out stem>_textures`` beside
     ``out`` (a package always does). ``preview_geometry``: a sphere per material bound
     to it. Nothing is left behind on error.
@@ -350,7 +368,11 @@ def export_usd(
             f"preview opacity {preview_opacity!r}: use {' or '.join(PREVIEW_OPACITY)}",
             where=str(out),
         )
-    specs = [material_spec(s, contexts, preview_opacity) for s in sources]
+    if not (meters_per_unit > 0.0 and math.isfinite(meters_per_unit)):
+        raise ExportError(
+            f"metersPerUnit {meters_per_unit!r}: give a positive finite number", where=str(out)
+        )
+    specs = [material_spec(s, contexts, preview_opacity, meters_per_unit) for s in sources]
     _check_names(specs, out)
     if package:
         publish.collect(specs, Path(workdir or out.parent) / f"{out.stem}_textures")
@@ -359,7 +381,7 @@ def export_usd(
         publish.collect(specs, out.parent / f"{out.stem}_textures")
     images = images_of(specs)
     check_images(images)
-    layout = {"name": out.name, "geometry": preview_geometry}
+    layout = {"name": out.name, "geometry": preview_geometry, "meters_per_unit": meters_per_unit}
     with Staging() as staging:  # commits on success; removes every temporary otherwise
         if package:
             written = _write_package(
@@ -428,7 +450,7 @@ def _write_package(specs, images, out: Path, workdir: Path, staging: Staging, la
 def _one_layer(specs: list[MaterialSpec], base: Path, layout: dict[str, Any]):
     """Every material in one layer, with the ``Look`` switch when there are several, the
     asset's metadata and, if asked, preview geometry."""
-    layer = new_layer()
+    layer = new_layer(meters_per_unit=layout["meters_per_unit"])
     paths = author(layer, specs, base)
     if len(specs) > 1:
         add_switch(layer, {prim_name(s.name): ("", p) for s, p in zip(specs, paths, strict=True)})
@@ -444,13 +466,13 @@ def _finish(layer, paths: list[str], layout: dict[str, Any]) -> None:
 
 def _write_split(specs, out: Path, folder: Path, staging: Staging, layout) -> list[Path]:
     files, targets = [], {}
-    library = new_layer()
+    library = new_layer(meters_per_unit=layout["meters_per_unit"])
     scope = Sdf.CreatePrimInLayer(library, "/Materials")
     scope.specifier, scope.typeName = Sdf.SpecifierDef, "Scope"
     for spec in specs:
         name = prim_name(spec.name)
         path = folder / f"{name}.usda"
-        layer = new_layer()
+        layer = new_layer(meters_per_unit=layout["meters_per_unit"])
         (prim_path,) = author(layer, [spec], folder)
         publish.asset_metadata(layer, ROOT, path.name, 1)
         _export_layer(layer, staging.temp_for(path), path)

@@ -16,11 +16,18 @@ def test_bench_usd_json_reports_both_paths_on_the_same_networks(cli):
     assert data["materials"] == 20 and data["contexts"] == 3
     assert data["same_layers"] is True  # the naive reference authors exactly our networks
     assert data["fast_s"] > 0 and data["naive_s"] > 0
-    ratio = (
-        data["naive_materials_per_s"]
-        and data["fast_materials_per_s"] / data["naive_materials_per_s"]
-    )
+    assert data["rounds"] == 1  # one round: the median is that round's ratio
+    ratio = data["naive_s"] / data["fast_s"]
     assert data["ratio_fast_to_naive"] == pytest.approx(ratio)
+    assert data["ratio_fast_to_naive_min"] == data["ratio_fast_to_naive_max"]
+
+
+def test_bench_usd_reports_median_and_spread_of_interleaved_rounds(cli):
+    data = json.loads(cli("bench", "usd", "-n", "10", "--repeat", "3", "--json").out)
+    assert data["rounds"] == 3
+    for key in ("ratio_fast_to_naive", "end_to_end_materials_per_s"):
+        assert data[f"{key}_min"] <= data[key] <= data[f"{key}_max"], key
+    assert data["end_to_end_materials_per_s"] == pytest.approx(10 / data["end_to_end_s"])
 
 
 def test_bench_usd_table_for_people(cli):

@@ -364,10 +364,25 @@ def test_import_refuses_to_overwrite_without_force(cli, exported, tmp_path):
 
 
 def test_import_names_the_layered_pixar_material_it_skips_and_exits_2(cli, exported, tmp_path):
-    r = cli("import", "usd", str(exported), "-o", str(tmp_path))
+    # lookdev's own export carries the layered preset whole (issue 15): both come back.
+    both = tmp_path / "both"
+    both.mkdir()
+    assert cli("import", "usd", str(exported), "-o", str(both)).code == 0
+    assert sorted(p.name for p in both.iterdir()) == ["gold.toml", "pixar_painted_metal.toml"]
+    # Without that record (another tool re-wrote the file), its lobe weights are skipped.
+    from pxr import Sdf
+
+    layer = Sdf.Layer.OpenAsAnonymous(str(exported))
+    prim = layer.GetPrimAtPath("/Materials/pixar_painted_metal")
+    prim.customData = {"lookdev": {"model": "pixar_weights"}}
+    stripped = tmp_path / "stripped.usda"
+    layer.Export(str(stripped))
+    out = tmp_path / "out"
+    out.mkdir()
+    r = cli("import", "usd", str(stripped), "-o", str(out))
     one_line_error(r, "imported 1 of 2 materials", "pixar_painted_metal", "layered Pixar")
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["gold.toml"]
-    assert cli("presets", "validate", str(tmp_path / "gold.toml")).code == 0
+    assert sorted(p.name for p in out.iterdir()) == ["gold.toml"]
+    assert cli("presets", "validate", str(out / "gold.toml")).code == 0
 
 
 @pytest.mark.parametrize(

@@ -268,7 +268,7 @@ def test_package_holds_stage_and_textures(tmp_path):
 
 def test_layered_pixar_exports_its_lobe_weights(tmp_path):
     """A Pixar stack blends to Smits' weights: PxrSurface takes them, the preview surface
-    takes them in its specular workflow (its diffuse written black rather than left grey)."""
+    takes them in its metallic workflow (a mirror metal: metallic 1, its F0 as the colour)."""
     from lookdev.library import Layer, Material
     from lookdev.materials.pixar import PixarParams
 
@@ -285,9 +285,9 @@ def test_layered_pixar_exports_its_lobe_weights(tmp_path):
     assert validate_usd(tmp_path / "s.usda").ok
     stage = Usd.Stage.Open(str(tmp_path / "s.usda"))
     preview = stage.GetPrimAtPath("/Materials/stack/preview_surface")
-    assert preview.GetAttribute("inputs:useSpecularWorkflow").Get() == 1
-    assert tuple(preview.GetAttribute("inputs:diffuseColor").Get()) == (0.0, 0.0, 0.0)
-    assert preview.GetAttribute("inputs:specularColor").Get()[0] == pytest.approx(0.9)
+    assert not preview.GetAttribute("inputs:useSpecularWorkflow").IsAuthored()
+    assert preview.GetAttribute("inputs:metallic").Get() == pytest.approx(1.0)
+    assert preview.GetAttribute("inputs:diffuseColor").Get()[0] == pytest.approx(0.9, rel=1e-5)
     ri = stage.GetPrimAtPath("/Materials/stack/ri_surface")
     assert ri.GetAttribute("inputs:diffuseGain").Get() == 0.0
 

@@ -91,7 +91,12 @@ def _assert_same(got: dict, want: DisneyParams, keys: set[str]) -> None:
 def test_universal_round_trip_recovers_what_it_expresses(tmp_path, data):
     params = DisneyParams(**data)
     got = _round_trip(tmp_path, params, ("universal",))
-    _assert_same(got, params, PREVIEW_PARAMS)
+    keys = PREVIEW_PARAMS
+    if 0.0 < np.float32(params.metallic) < 1.0:
+        # A fractional metallic is refitted for the surface's own interpolation (F0
+        # towards white): base colour and metallic change, named in the loss note.
+        keys = keys - {"metallic", "base_color"}
+    _assert_same(got, params, keys)
     unexpressed = set(got) - PREVIEW_PARAMS
     assert not unexpressed, f"read parameters the surface cannot hold: {unexpressed}"
 
@@ -145,8 +150,11 @@ def test_baked_maps_come_back_as_paths(tmp_path):
     export_usd([source], tmp_path / "r.usda", contexts=("universal",))
     (found,) = import_usd(tmp_path / "r.usda")
     assert set(found.maps) == set(source.maps) - {"specular"}  # universal reads F0 as ior
-    for name, path in found.maps.items():
-        assert Path(path).resolve() == (tmp_path / "tex" / source.maps[name].path.name).resolve()
+    for name, texture in found.maps.items():
+        assert (
+            Path(texture.texture).resolve()
+            == (tmp_path / "tex" / source.maps[name].path.name).resolve()
+        )
 
 
 def test_foreign_preview_surface_imports(tmp_path):
@@ -169,7 +177,7 @@ def test_foreign_preview_surface_imports(tmp_path):
     assert found.name == "Ceramic"
     assert found.params["base_color"] == (0.9, 0.85, 0.8)
     assert found.params["ior"] == pytest.approx(1.6)  # a foreign file spells the F0 as IOR
-    assert found.maps["roughness"].name == "rough.png"
+    assert Path(found.maps["roughness"].texture).name == "rough.png"
 
 
 scale = st.sampled_from([0.0, 1.0]) | st.floats(0.0, 2.0)

@@ -1,0 +1,281 @@
+"""What other tools write, read into Disney parameters: OpenPBR and Standard Surface
+networks, the inputs no preset holds, and the specular workflow of UsdPreviewSurface.
+
+Current DCCs (Houdini, Maya, Omniverse, Blender 4) write MaterialX
+``ND_open_pbr_surface_surfaceshader`` or ``ND_standard_surface_surfaceshader``; lookdev
+reads both into Burley's parameters by the tables below (one table per surface, the
+only place their spelling appears). An input with no Disney parameter (emission, a
+coloured specular, coat colour, thin-film …) is named as a loss, never dropped silently.
+
+The documented mapping:
+
+================================  ==========================  ===================================
+OpenPBR                           Standard Surface            Disney (Burley 2012/2015)
+================================  ==========================  ===================================
+base_color × base_weight          base_color × base           base_color
+base_metalness                    metalness                   metallic
+specular_roughness                specular_roughness          roughness
+specular_ior                      specular_IOR                ior
+specular_roughness_anisotropy     specular_anisotropy         anisotropic
+coat_weight × 4                   coat × 4                    clearcoat (Burley weights his 0.25)
+coat_roughness                    coat_roughness              clearcoat_gloss (α = r², App. B.2)
+transmission_weight               transmission                spec_trans
+subsurface_weight                 subsurface                  subsurface
+subsurface_radius × _scale        subsurface_radius × _scale  scatter_distance (mean, × mpu)
+fuzz_weight                       sheen                       sheen (sheen_model conty_kulla)
+geometry_thin_walled              thin_walled                 thin
+================================  ==========================  ===================================
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from lookdev.materials.colour import luminance
+from lookdev.materials.fresnel import F0_MAX, SPECULAR_F0_SCALE
+
+from .names import CLEARCOAT_PREVIEW_SCALE, roughness_to_gloss
+from .network import Connection, Node
+
+__all__ = [
+    "FOREIGN_SURFACES",
+    "preview_extras",
+    "read_foreign",
+    "specular_workflow",
+]
+
+OPENPBR = "ND_open_pbr_surface_surfaceshader"
+STANDARD = "ND_standard_surface_surfaceshader"
+
+# (our parameter, their input, their weight input or None, conversion)
+_COAT = 1.0 / CLEARCOAT_PREVIEW_SCALE
+
+
+def _mean(v: Any) -> float:
+    return sum(v) / 3.0 if isinstance(v, tuple) else float(v)
+
+
+TABLES: dict[str, dict[str, tuple[str, str | None, Any]]] = {
+    OPENPBR: {
+        "base_color": ("base_color", "base_weight", None),
+        "metallic": ("base_metalness", None, None),
+        "roughness": ("specular_roughness", None, None),
+        "ior": ("specular_ior", None, None),
+        "anisotropic": ("specular_roughness_anisotropy", None, None),
+        "clearcoat": ("coat_weight", None, lambda v: v * _COAT),
+        "clearcoat_gloss": ("coat_roughness", None, roughness_to_gloss),
+        "spec_trans": ("transmission_weight", None, None),
+        "subsurface": ("subsurface_weight", None, None),
+        "scatter_distance": ("subsurface_radius", "subsurface_radius_scale", _mean),
+        "sheen": ("fuzz_weight", None, None),
+        "thin": ("geometry_thin_walled", None, bool),
+    },
+    STANDARD: {
+        "base_color": ("base_color", "base", None),
+        "metallic": ("metalness", None, None),
+        "roughness": ("specular_roughness", None, None),
+        "ior": ("specular_IOR", None, None),
+        "anisotropic": ("specular_anisotropy", None, None),
+        "clearcoat": ("coat", None, lambda v: v * _COAT),
+        "clearcoat_gloss": ("coat_roughness", None, roughness_to_gloss),
+        "spec_trans": ("transmission", None, None),
+        "subsurface": ("subsurface", None, None),
+        "scatter_distance": ("subsurface_radius", "subsurface_scale", _mean),
+        "sheen": ("sheen", None, None),
+        "thin": ("thin_walled", None, bool),
+    },
+}
+"""surface id → our parameter → (their input, the input that scales it, conversion)."""
+
+UNREAD: dict[str, tuple[str, ...]] = {
+    OPENPBR: (
+        "emission_luminance",
+        "emission_color",
+        "specular_color",
+        "specular_weight",
+        "coat_color",
+        "coat_ior",
+        "thin_film_weight",
+        "geometry_normal",
+        "geometry_coat_normal",
+        "geometry_opacity",
+        "transmission_color",
+        "transmission_depth",
+        "subsurface_color",
+        "fuzz_color",
+        "fuzz_roughness",
+        "base_diffuse_roughness",
+    ),
+    STANDARD: (
+        "emission",
+        "emission_color",
+        "specular",
+        "specular_color",
+        "coat_color",
+        "coat_IOR",
+        "thin_film_thickness",
+        "normal",
+        "coat_normal",
+        "opacity",
+        "transmission_color",
+        "transmission_depth",
+        "subsurface_color",
+        "sheen_color",
+        "sheen_roughness",
+        "diffuse_roughness",
+    ),
+}
+"""Inputs with no Disney parameter: named as losses when authored away from the default."""
+
+FOREIGN_SURFACES = frozenset(TABLES)
+
+
+def read_foreign(
+    surface: Node, defaults: dict[str, Any], meters_per_unit: float
+) -> tuple[dict[str, Any], dict[str, str], list[str]]:
+    """(values, maps, losses) of an OpenPBR or Standard Surface shader ``surface``.
+
+    ``defaults`` are the node's MaterialX defaults (an unauthored input renders at its
+    default); ``maps`` names the inputs fed by a connection (their node is not followed
+    here); lengths are converted to metres by ``meters_per_unit``.
+    """
+    table = TABLES[surface.id]
+    values: dict[str, Any] = {}
+    maps: dict[str, str] = {}
+    losses: list[str] = []
+
+    def given(name: str) -> Any:
+        if name in surface.inputs:
+            return surface.inputs[name][1]
+        return defaults.get(name)
+
+    for param, (name, scale_by, convert) in table.items():
+        value, scale = given(name), given(scale_by) if scale_by else None
+        if isinstance(value, Connection) or isinstance(scale, Connection):
+            maps[param] = name
+            continue
+        if value is None:
+            continue
+        if scale is not None:
+            value = (
+                tuple(x * _mean(scale) for x in value)
+                if isinstance(value, tuple)
+                else value * _mean(scale)
+            )
+        values[param] = convert(value) if convert else value
+    if "sheen" in values:
+        values["sheen_model"] = "conty_kulla"
+    if "scatter_distance" in values:
+        values["scatter_distance"] *= meters_per_unit
+    for name in UNREAD[surface.id]:
+        if name in surface.inputs and not _at_default(surface.inputs[name][1], defaults.get(name)):
+            value = surface.inputs[name][1]
+            shown = "a connected map" if isinstance(value, Connection) else _short(value)
+            losses.append(f"{surface.id} {name} = {shown} has no Disney parameter")
+    return values, maps, losses
+
+
+def _at_default(value: Any, default: Any) -> bool:
+    if isinstance(value, Connection) or default is None:
+        return False
+    if isinstance(value, tuple) and isinstance(default, tuple):
+        return all(abs(a - b) < 1e-6 for a, b in zip(value, default, strict=False))
+    try:
+        return abs(float(value) - float(default)) < 1e-6
+    except (TypeError, ValueError):
+        return value == default
+
+
+def _short(v: Any) -> str:
+    if isinstance(v, tuple):
+        return "(" + ", ".join(f"{x:g}" for x in v) + ")"
+    return f"{v:g}" if isinstance(v, float) else str(v)
+
+
+PREVIEW_EXTRAS = ("normal", "emissiveColor", "occlusion", "displacement")
+"""UsdPreviewSurface inputs with no preset parameter (besides opacity, read apart)."""
+
+
+def preview_extras(surface: Node, nodes: dict[str, Node], texture_of) -> list[str]:
+    """Loss lines for the UsdPreviewSurface inputs a preset cannot hold: the normal,
+    emission, occlusion and displacement, and ``opacity`` read as alpha.
+
+    ``opacity`` < 1 is alpha in every DCC importer: with ``opacityThreshold`` > 0 it is
+    a cut-out (the spec's masked mode). A preset has neither alpha nor a cut-out, so the
+    material is imported opaque and the alpha named; it is never turned into glass.
+    """
+    out = []
+    for name in PREVIEW_EXTRAS:
+        if name not in surface.inputs:
+            continue
+        value = surface.inputs[name][1]
+        if isinstance(value, Connection):
+            path = texture_of(nodes, value)
+            shown = f"the map {path}" if path is not None else "a connected network"
+            out.append(f"universal: {name} = {shown}: a preset has no {name} (not imported)")
+        elif name == "emissiveColor" and max(value) > 0.0:
+            out.append(f"universal: emissiveColor = {_short(value)}: a preset has no emission")
+        elif name == "occlusion" and value < 1.0:
+            out.append(f"universal: occlusion = {value:g}: a preset has no occlusion")
+        elif name == "displacement" and value != 0.0:
+            out.append(f"universal: displacement = {value:g}: a preset has no displacement")
+    opacity = surface.inputs.get("opacity")
+    threshold = surface.inputs.get("opacityThreshold", ("float", 0.0))[1]
+    if opacity is not None:
+        value = opacity[1]
+        if isinstance(value, Connection):
+            path = texture_of(nodes, value)
+            shown = f"the map {path}" if path is not None else "a connected network"
+        elif value >= 1.0:
+            return out
+        else:
+            shown = f"{value:g}"
+        cut = (
+            f"a cut-out (opacityThreshold {_short(threshold)})"
+            if isinstance(threshold, Connection) or threshold > 0.0
+            else "alpha"
+        )
+        out.append(
+            f"universal: opacity = {shown} is {cut}: a preset has no alpha or cut-out; "
+            "imported opaque (not as transmission)"
+        )
+    return out
+
+
+def specular_workflow(
+    diffuse: tuple[float, float, float], colour: tuple[float, float, float]
+) -> tuple[dict[str, Any], list[str]]:
+    """Disney values of a UsdPreviewSurface in its specular workflow, and the losses.
+
+    A grey-ish F0 up to Burley's plausible range (Y(F0) ≤ 0.08, ``specular`` ≤ 1) is a
+    dielectric: ``specular`` = Y(F0)/0.08 (§5.4), metallic 0. A brighter F0 (copper
+    ≈ 0.95) is a metal: base colour and metallic are solved as the layered Pixar export
+    solves them (:func:`.pixar.metallic_workflow`, dielectric F0 0.04), so no IOR beyond
+    the preset's range is ever made; F0 is clamped by :data:`~lookdev.materials.fresnel.F0_MAX`
+    (the one clamp) before any conversion.
+    """
+    from .pixar import metallic_workflow
+
+    f0 = min(luminance(colour), F0_MAX)
+    losses = []
+    if f0 <= SPECULAR_F0_SCALE:
+        values = {"metallic": 0.0, "specular": f0 / SPECULAR_F0_SCALE, "base_color": diffuse}
+        if max(colour) - min(colour) > 1e-6:
+            losses.append(
+                f"universal: the tint of specularColor {_short(colour)} (only its luminance "
+                "is read, as Burley's specular)"
+            )
+        return values, losses
+    base, metal = metallic_workflow(diffuse, colour, 1.5)
+    values = {
+        "metallic": float(metal),
+        "specular": 0.5,
+        "base_color": tuple(float(c) for c in base),
+    }
+    losses.append(
+        f"universal: specular workflow (specularColor {_short(colour)}, F0 luminance "
+        f"{f0:.3g} > {SPECULAR_F0_SCALE:g}) converted to metallic {float(metal):.3g}, base "
+        f"colour {_short(tuple(round(float(c), 4) for c in base))}: a specular above "
+        f"{1.0:g} (IOR > 1.8) would not be a dielectric"
+    )
+    return values, losses

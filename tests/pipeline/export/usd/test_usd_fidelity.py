@@ -1,0 +1,182 @@
+"""UsdPreviewSurface measured (issue 15 §3) and the mappings it decided: the spec's BRDF,
+the --report table, OpenPBR's roughness for Pixar presets, the metallic workflow of
+layered Pixar presets, subsurface units, frosted glass and the tangent-space normal."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pxr")
+from pxr import Usd  # noqa: E402
+
+from lookdev.materials.arrays import NumpyOps  # noqa: E402
+from lookdev.materials.bsdf import evaluate  # noqa: E402
+from lookdev.materials.fresnel import ior_to_f0  # noqa: E402
+from lookdev.materials.preview_surface import MODEL, PreviewParams  # noqa: E402
+from lookdev.pipeline import api  # noqa: E402
+from lookdev.pipeline.analysis.albedo import albedo_monte_carlo  # noqa: E402
+from lookdev.pipeline.export.usd.pixar import metallic_workflow  # noqa: E402
+
+
+def _prepare(xp, params):
+    """The prepared values as plain RGB (channel-first colours are (3, 1))."""
+    return {
+        k: np.ravel(v) if isinstance(v, np.ndarray) else v
+        for k, v in MODEL.prepare(xp, params).items()
+    }
+
+
+def test_preview_brdf_follows_the_spec_at_its_edges():
+    """Spec 2.5: metallic 1 → F0 = F90 = albedo, no diffuse; metallic 0 → F0 from ior,
+    F90 white; a white furnace keeps a white rough dielectric near 1 at normal view."""
+    gold = PreviewParams(diffuse_color=(1.0, 0.78, 0.34), metallic=1.0, roughness=0.5)
+    p = _prepare(NumpyOps(), gold)
+    np.testing.assert_allclose(p["f0"], [1.0, 0.78, 0.34])
+    np.testing.assert_allclose(p["f90"], [1.0, 0.78, 0.34])
+    np.testing.assert_allclose(p["diffuse"], 0.0)
+    plastic = PreviewParams(diffuse_color=(0.5, 0.5, 0.5), metallic=0.0, ior=1.5)
+    p = _prepare(NumpyOps(), plastic)
+    np.testing.assert_allclose(p["f0"], ior_to_f0(1.5))
+    np.testing.assert_allclose(p["f90"], 1.0)
+    white = PreviewParams(diffuse_color=(1.0, 1.0, 1.0), roughness=0.5)
+    a = albedo_monte_carlo(MODEL, white, [0.0], n_samples=20000)
+    assert a.albedo[0, 0] == pytest.approx(1.0, abs=0.02)
+    # Below the horizon nothing; reciprocal in wi and wo.
+    wi, wo = np.array([0.3, 0.1, 0.9]), np.array([-0.5, 0.2, 0.8])
+    wi, wo = wi / np.linalg.norm(wi), wo / np.linalg.norm(wo)
+    np.testing.assert_allclose(evaluate(MODEL, white, wi, wo), evaluate(MODEL, white, wo, wi))
+    assert not evaluate(MODEL, white, -wi, wo).any()
+
+
+def test_preview_sampler_agrees_with_its_density():
+    """E(θ) by the sampler equals E(θ) by quadrature of eval for a rough lobe (the
+    sampler's weight f·cos/pdf is consistent with pdf)."""
+    from lookdev.pipeline.analysis.albedo import albedo_quadrature
+
+    p = PreviewParams(
+        diffuse_color=(0.8, 0.2, 0.1), roughness=0.6, clearcoat=0.5, clearcoat_roughness=0.4
+    )
+    th = np.radians([0.0, 45.0, 70.0])
+    mc = albedo_monte_carlo(MODEL, p, th, n_samples=40000)
+    quad = albedo_quadrature(MODEL, p, th, n_mu=96, n_phi=96)
+    np.testing.assert_allclose(mc.albedo, quad.albedo, atol=5 * mc.stderr.max() + 2e-3)
+
+
+def test_export_report_prints_and_carries_the_fidelity(cli, tmp_path):
+    out = tmp_path / "r.usda"
+    result = cli(
+        "export", "usd", "gold", "plastic_glossy", "glass_clear", "-o", str(out), "--report"
+    )
+    assert result.code == 0, result.err
+    assert "UsdPreviewSurface vs the material" in result.out
+    summary = json.loads(
+        cli("export", "usd", "gold", "glass_clear", "-o", str(out), "--report", "--json").out
+    )
+    rows = {r["material"]: r for r in summary["fidelity"]}
+    assert len(rows["gold"]["albedo_source"]) == len(rows["gold"]["angles_deg"]) == 6
+    # Gold's metallic preview is close to Burley's metal at normal view; glass, kept
+    # opaque in the preview, is far (its transmission is the named loss).
+    assert abs(rows["gold"]["albedo_preview"][0][0] - rows["gold"]["albedo_source"][0][0]) < 0.05
+    assert rows["glass_clear"]["rms"] > 3 * rows["gold"]["rms"]
+
+
+def test_openpbr_takes_the_energy_weighted_highlight_roughness(tmp_path):
+    out = tmp_path / "p.usda"
+    api.export_usd(["pixar_gold", "pixar_clear_glass"], out, ("mtlx",))
+    stage = Usd.Stage.Open(str(out))
+
+    def rough(name):
+        return stage.GetAttributeAtPath(
+            f"/Materials/{name}/mtlx_surface.inputs:specular_roughness"
+        ).Get()
+
+    assert rough("pixar_clear_glass") == 0.0  # was 1.0: fully frosted
+    # pixar_gold (Smits roughness 0.15): broad lobe 0.63, sharp 0.156; two thirds of its
+    # highlight energy is in the broad lobe, so the weighted roughness is 0.47 (was 0.63).
+    assert rough("pixar_gold") == pytest.approx(0.4676, abs=1e-3)
+
+
+def test_layered_pixar_metal_keeps_its_reflectance_in_the_metallic_workflow():
+    """Before: specularColor = F0, which DCC importers read as a tint on their own F0
+    0.04 (a 25x loss on a metal); now the preview's own F0 equals Smits' F0."""
+    f0 = np.array([0.9, 0.7, 0.3])
+    base, m = metallic_workflow(np.zeros(3), f0, 1.5)
+    prepared = _prepare(
+        NumpyOps(),
+        PreviewParams(diffuse_color=tuple(base), metallic=float(m), ior=1.5),
+    )
+    seen_after = np.asarray(prepared["f0"])
+    seen_before = 0.04 * f0  # specular tint on a DCC's dielectric F0
+    np.testing.assert_allclose(seen_after, f0, rtol=1e-6)
+    assert (seen_after / seen_before).min() == pytest.approx(25.0)
+    # A dielectric region stays a dielectric with its diffuse.
+    base, m = metallic_workflow(np.array([0.5, 0.1, 0.1]), np.full(3, 0.04), 1.5)
+    assert float(m) == 0.0 and base[0] * (1 - 0.04) == pytest.approx(0.5)
+
+
+def test_subsurface_radius_is_in_scene_units(tmp_path):
+    out = tmp_path / "s.usda"
+    result = api.export_usd(["marble"], out, ("mtlx",), meters_per_unit=0.01)
+    stage = Usd.Stage.Open(str(out))
+    assert stage.GetMetadata("metersPerUnit") == 0.01
+    radius = stage.GetAttributeAtPath(
+        "/Materials/marble/mtlx_surface.inputs:subsurfaceDistance"
+    ).Get()
+    assert tuple(radius) == pytest.approx((0.1, 0.1, 0.1))  # 1 mm in centimetres
+    assert "1 mm" in result.losses["marble"]["mtlx"]
+
+
+def test_frosted_glass_is_a_named_loss_in_materialx(tmp_path):
+    result = api.export_usd(["glass_frosted", "glass_clear"], tmp_path / "g.usda", ("mtlx",))
+    assert "renders clear" in result.losses["glass_frosted"]["mtlx"]
+    assert "renders clear" not in result.losses["glass_clear"].get("mtlx", "")
+
+
+def test_layered_pixar_normal_map_is_not_applied_twice():
+    from lookdev.pipeline.export.usd import mtlx
+    from lookdev.pipeline.export.usd.network import Image, Source
+
+    source = Source("s", "pixar_weights", {}, normal_map=Image(Path("n.exr")))
+    nodes = []
+    kind, conn = mtlx._tangent_normal(nodes, source.normal_map)
+    assert [n.id for n in nodes] == [
+        "ND_image_vector3",
+        "ND_multiply_vector3FA",
+        "ND_subtract_vector3FA",
+    ]
+    assert "ND_normalmap_float" not in {n.id for n in nodes}  # the surface's graph applies it
+    assert math.isclose(nodes[1].inputs["in2"][1], 2.0) and math.isclose(
+        nodes[2].inputs["in2"][1], 1.0
+    )
+
+
+def test_the_universal_proof_renders_the_preview_surface_s_own_brdf():
+    from lookdev.library import Library, load_material
+    from lookdev.pipeline.blend import blend
+    from lookdev.pipeline.export.usd.fidelity import preview_hub
+
+    lib = Library(use_env=False)
+    velvet = preview_hub(blend(load_material("velvet", lib), 8))
+    assert velvet.name == "velvet-universal"
+    assert velvet.bsdf_model.name == "usd_preview_surface"  # not Burley's with sheen off
+    rust = preview_hub(blend(load_material("rusty_iron", lib), 16))
+    assert set(rust.maps) == {"diffuse_color", "metallic", "roughness"}
+    assert rust.maps["diffuse_color"].shape == (16, 16, 3)
+    gold = preview_hub(blend(load_material("pixar_gold", lib), 8))
+    assert (gold.params.metallic, gold.params.roughness) == (1.0, 0.15)
+    assert gold.live_lobes == ("specular",)  # a pure metal: no diffuse traced
+
+
+@pytest.mark.slow
+def test_proof_context_universal_renders_both(cli, tmp_path):
+    args = ("proof", "gold", "--context", "universal", "--ibl", "studio", "--frames", "1")
+    result = cli(*args, "--light-frames", "0", "--spp", "2", "--resolution", "16", "8",
+                 "-o", str(tmp_path), "--json")  # fmt: skip
+    assert result.code == 0, result.err
+    names = {p["material"] for p in json.loads(result.out)["proofs"]}
+    assert names == {"gold", "gold-universal"}
