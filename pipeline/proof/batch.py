@@ -183,10 +183,17 @@ def run_job(job: Job) -> dict[str, Any]:
 
 def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
     """Build the scene once, then render and write each frame; yields manifest entries."""
-    from .turntable import Turntable, material_bsdf, render_frame
+    from .turntable import Turntable, material_bsdf, material_interior, render_frame
 
     bsdf, depth = material_bsdf(job.material)
-    table = Turntable(bsdf, job.environment, job.settings.resolution, depth, rig=job.settings.rig)
+    table = Turntable(
+        bsdf,
+        job.environment,
+        job.settings.resolution,
+        depth,
+        rig=job.settings.rig,
+        interior=material_interior(job.material),
+    )
     for frame in todo:
         r = render_frame(table, frame, job.settings.spp, seed=frame.index)
         stem = job.folder / f"frame_{frame.index:03d}"

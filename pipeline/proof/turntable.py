@@ -59,6 +59,13 @@ def material_bsdf(hub: Any, *, force_all_lobes: bool = False) -> tuple[dict, int
     return bsdf_dict(hub, force_all_lobes=force_all_lobes), max_depth_for(hub)
 
 
+def material_interior(hub: Any) -> dict[str, Any] | None:
+    """The interior medium of a solid subsurface material at the proof's scale, or None."""
+    from lookdev.pipeline.export.mitsuba.medium import interior_dict
+
+    return interior_dict(hub, shaderball.METERS_PER_UNIT)
+
+
 class Turntable:
     """A loaded shader-ball scene whose rotations are set per frame, never reloaded.
 
@@ -74,10 +81,13 @@ class Turntable:
         max_depth: int,
         *,
         rig: str = DEFAULT_RIG,
+        interior: dict[str, Any] | None = None,
     ):
         import mitsuba as mi
 
-        scene = shaderball.scene_dict(bsdf, environment, resolution, max_depth, rig=rig)
+        scene = shaderball.scene_dict(
+            bsdf, environment, resolution, max_depth, rig=rig, interior=interior
+        )
         scene["sensor_pair"] = _sensor_pair(scene["sensor"])
         self.scene = mi.load_dict(scene)
         self.width = int(resolution[0])

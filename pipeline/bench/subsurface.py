@@ -1,0 +1,186 @@
+"""What path-traced subsurface scattering does and costs, measured by rendering.
+
+* :func:`slab` — a thick slab of a solid subsurface material (a 100 × 100 × 2 box of
+  scatter distance 0.02, so ≥ 50 σt⁻¹ deep and wide) under a uniform white sky, seen
+  straight down by an orthographic camera: the radiance it sends up is its directional
+  albedo at normal incidence, to be compared with its base colour (the claim of Chiang,
+  Kutz & Burley 2016's albedo inversion, :mod:`lookdev.materials.subsurface`). Specular
+  and roughness 0, so the surface adds nothing but the entry into the medium.
+* :func:`furnace` — a white solid subsurface sphere in a uniform white sky (≤ 1).
+* :func:`rim_glow` — the proof cup lit from behind: the radiance of its thin rim with
+  the material's scatter distance against the same preset without one.
+* :func:`cost` — a proof's render time and noise with the medium against the same preset
+  without a distance, at equal spp and (by noise² · time) at equal noise, in one run.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+
+__all__ = ["COLOURS", "cost", "furnace", "rim_glow", "slab"]
+
+COLOURS = {"grey": (0.5, 0.5, 0.5), "skin": (0.8, 0.5, 0.35), "jade": (0.3, 0.6, 0.4)}
+"""The three colours whose slabs are measured (a grey, a warm and a cool one)."""
+SLAB_DISTANCE = 0.02
+SLAB_DEPTH = 4096  # paths end by Russian roulette long before; a slab is a deep walk
+
+
+def _variant() -> Any:
+    import mitsuba as mi
+
+    from lookdev.pipeline.export.mitsuba.scene import _ensure_variant
+
+    _ensure_variant()
+    return mi
+
+
+def _render(scene: dict[str, Any], spp: int, seed: int = 0) -> np.ndarray:
+    mi = _variant()
+    return np.asarray(mi.render(mi.load_dict(scene), spp=spp, seed=seed), dtype=np.float64)
+
+
+def _sky() -> dict[str, Any]:
+    return {"type": "constant", "radiance": {"type": "rgb", "value": [1.0, 1.0, 1.0]}}
+
+
+def slab(colour: tuple[float, float, float], *, spp: int = 256, size: int = 16) -> np.ndarray:
+    """The thick slab's rendered directional albedo (RGB) at normal incidence."""
+    mi = _variant()
+
+    from lookdev.materials.params import DisneyParams
+    from lookdev.pipeline.export.mitsuba import bsdf_dict
+    from lookdev.pipeline.export.mitsuba.medium import integrator, interior_dict
+
+    p = DisneyParams(
+        base_color=colour, specular=0.0, roughness=0.0, scatter_distance=SLAB_DISTANCE
+    )
+    medium = interior_dict(p)
+    scene = {
+        "type": "scene",
+        "integrator": integrator(SLAB_DEPTH, medium),
+        "sensor": {
+            "type": "orthographic",
+            "to_world": mi.ScalarTransform4f()
+            .look_at(origin=[0, 0, 5], target=[0, 0, 0], up=[0, 1, 0])
+            .scale([0.5, 0.5, 1]),
+            "film": {"type": "hdrfilm", "width": size, "height": size, "pixel_format": "rgb"},
+            "sampler": {"type": "independent", "sample_count": spp},
+        },
+        "sky": _sky(),
+        "slab": {
+            "type": "cube",
+            "to_world": mi.ScalarTransform4f().scale([50, 50, 1]),
+            "bsdf": bsdf_dict(p),
+            "interior": medium,
+        },
+    }
+    return _render(scene, spp).reshape(-1, 3).mean(axis=0)
+
+
+def furnace(*, scatter_distance: float = 0.5, roughness: float = 0.5, spp: int = 256) -> float:
+    """The largest pixel-block mean over a white solid subsurface sphere in a white sky.
+
+    Blocks of 4 × 4 pixels on the sphere (inside 90 % of its radius), so the figure is
+    the brightest region, not one noisy pixel.
+    """
+    from lookdev.materials.params import DisneyParams
+    from lookdev.pipeline.export.mitsuba import scene_dict
+
+    p = DisneyParams(base_color=(1, 1, 1), roughness=roughness, scatter_distance=scatter_distance)
+    size = 64
+    img = _render(scene_dict(p, resolution=(size, size), spp=spp, max_depth=SLAB_DEPTH), spp)
+    y, x = (np.mgrid[:size, :size] + 0.5 - size / 2) / (size / 2 / 1.15 * 0.999)
+    inside = (x * x + y * y) < 0.9**2
+    blocks = img.reshape(size // 4, 4, size // 4, 4, 3).mean(axis=(1, 3))
+    keep = inside.reshape(size // 4, 4, size // 4, 4).all(axis=(1, 3))
+    return float(blocks[keep].max())
+
+
+def _preset_pair(name: str) -> tuple[Any, Any]:
+    from lookdev.api import blend, load
+
+    hub = blend(load(name), 64)
+    flat = blend(load(name), 64)
+    flat.constants = {**flat.constants, "scatter_distance": 0.0}
+    return hub, flat
+
+
+def rim_glow(name: str = "skin", *, spp: int = 64, size: tuple[int, int] = (160, 80)) -> dict:
+    """Mean radiance of the cup's rim under a back light, with and without the distance.
+
+    The environment is black but for a bright disc behind the cup (opposite the camera),
+    so what the rim sends to the camera is light that went through it.
+    """
+    from lookdev.pipeline.proof import shaderball
+    from lookdev.pipeline.proof.turntable import material_bsdf, material_interior
+
+    env = np.zeros((64, 128, 3), dtype=np.float32)
+    env[24:40, 56:72] = 50.0  # the lat-long's centre column: −z, behind the cup
+    out = {}
+    for label, hub in zip(("with", "without"), _preset_pair(name), strict=True):
+        bsdf, depth = material_bsdf(hub)
+        interior = material_interior(hub)
+        scene = shaderball.scene_dict(bsdf, env, size, depth, rig="none", interior=interior)
+        out[label] = _render(scene, spp)
+    rim = _rim_mask(size)
+    w, wo = out["with"][rim].mean(), out["without"][rim].mean()
+    return {"with": float(w), "without": float(wo), "ratio": float(w / max(wo, 1e-12))}
+
+
+def _rim_mask(size: tuple[int, int]) -> np.ndarray:
+    """Pixels of the cup's rim in the proof camera: the cup's shape minus its solid body,
+    found by rendering a shape-ID pass once (the cup's own silhouette's top band)."""
+    from lookdev.pipeline.proof import shaderball
+
+    scene = shaderball.scene_dict(
+        {"type": "diffuse"}, np.ones((8, 16, 3), np.float32), size, 2, rig="none"
+    )
+    scene["integrator"] = {"type": "aov", "aovs": "pos:position"}
+    pos = _render(scene, 4)[..., :3]
+    centre = np.asarray(shaderball.CUP_CENTER)
+    r = np.linalg.norm(pos - centre, axis=-1)
+    # the rim: points on the cup near its outer radius that lie on the rim's torus band
+    near = np.abs(r - (1.0 - shaderball.CUP_WALL / 2)) < shaderball.CUP_WALL / 2 + 1e-3
+    return near & (pos[..., 1] > 0.2) & (np.abs(pos[..., 0] - centre[0]) < 1.1)
+
+
+def cost(name: str = "skin", *, spp: int = 16, repeats: int = 2) -> dict[str, float]:
+    """Render time and relative noise of a proof frame with and without the distance,
+    interleaved in one process; the equal-noise ratio is (time · noise²) over (time ·
+    noise²), since noise² falls as 1/spp."""
+    from lookdev.pipeline.proof import ibl
+    from lookdev.pipeline.proof.turntable import (
+        Frame,
+        Turntable,
+        material_bsdf,
+        material_interior,
+        render_frame,
+    )
+
+    env = ibl.load("studio").pixels
+    tables = {}
+    for label, hub in zip(("with", "without"), _preset_pair(name), strict=True):
+        bsdf, depth = material_bsdf(hub)
+        tables[label] = Turntable(bsdf, env, (160, 80), depth, interior=material_interior(hub))
+    times = {k: [] for k in tables}
+    noise = {k: [] for k in tables}
+    frame = Frame(0, 0.0, 0.0)
+    for k, t in tables.items():  # warm-up: compile both kernels before timing
+        render_frame(t, frame, spp)
+    for r in range(repeats):
+        for k, t in tables.items():
+            start = time.perf_counter()
+            out = render_frame(t, frame, spp, seed=r + 1)
+            times[k].append(time.perf_counter() - start)
+            noise[k].append(out.noise_relative or 0.0)
+    t_w, t_o = np.median(times["with"]), np.median(times["without"])
+    n_w, n_o = np.mean(noise["with"]), np.mean(noise["without"])
+    return {
+        "time_ratio": float(t_w / t_o),
+        "noise_with": float(n_w),
+        "noise_without": float(n_o),
+        "equal_noise_ratio": float((t_w * n_w**2) / (t_o * n_o**2)),
+    }
