@@ -168,7 +168,7 @@ def cost(name: str = "skin", *, spp: int = 16, repeats: int = 2) -> dict[str, fl
     times = {k: [] for k in tables}
     noise = {k: [] for k in tables}
     frame = Frame(0, 0.0, 0.0)
-    for k, t in tables.items():  # warm-up: compile both kernels before timing
+    for t in tables.values():  # warm-up: compile both kernels before timing
         render_frame(t, frame, spp)
     for r in range(repeats):
         for k, t in tables.items():

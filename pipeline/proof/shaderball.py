@@ -257,7 +257,10 @@ def scene_dict(
         # Each shape sits in a shapegroup placed by an instance: turning an instance
         # re-commits only the top-level acceleration structure (≈ 10 ms, not ≈ 80 ms
         # for moving the shapes themselves; measured in lookdev bench proof).
-        "ball_shape": {"type": "shapegroup", "shape": {"type": "sphere", "bsdf": _material, **inside}},
+        "ball_shape": {
+            "type": "shapegroup",
+            "shape": {"type": "sphere", "bsdf": _material, **inside},
+        },
         "cup_shape": {
             "type": "shapegroup",
             "shape": {
