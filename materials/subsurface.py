@@ -120,7 +120,7 @@ def from_measured(
 
     >>> colour, d, scale = from_measured(*JENSEN_2001["marble"])
     >>> [round(c, 3) for c in colour], round(d * 1000, 3), [round(s, 3) for s in scale]
-    ([0.832, 0.8, 0.785], 0.391, [1.0, 0.851, 0.752])
+    ([1.0, 0.973, 0.938], 0.439, [1.0, 0.842, 0.737])
     """
     ss, sa = np.asarray(sigma_s_reduced, float), np.asarray(sigma_a, float)
     st = (ss + sa) / unit  # per metre

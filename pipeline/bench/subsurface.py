@@ -100,7 +100,7 @@ def furnace(*, scatter_distance: float = 0.5, roughness: float = 0.5, spp: int =
 
 
 def _preset_pair(name: str) -> tuple[Any, Any]:
-    from lookdev.api import blend, load
+    from lookdev import blend, load
 
     hub = blend(load(name), 64)
     flat = blend(load(name), 64)
