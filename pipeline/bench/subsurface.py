@@ -54,9 +54,7 @@ def slab(colour: tuple[float, float, float], *, spp: int = 256, size: int = 16) 
     from lookdev.pipeline.export.mitsuba import bsdf_dict
     from lookdev.pipeline.export.mitsuba.medium import integrator, interior_dict
 
-    p = DisneyParams(
-        base_color=colour, specular=0.0, roughness=0.0, scatter_distance=SLAB_DISTANCE
-    )
+    p = DisneyParams(base_color=colour, specular=0.0, roughness=0.0, scatter_distance=SLAB_DISTANCE)
     medium = interior_dict(p)
     scene = {
         "type": "scene",

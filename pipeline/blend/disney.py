@@ -86,7 +86,8 @@ def check_discrete(stack: Sequence[tuple[str, DisneyParams]]) -> dict[str, Any]:
     """The one value of each discrete parameter, or a :class:`BlendError` naming the layer.
 
     A layer without sheen does not vote on ``sheen_model``, nor one without a scatter
-    distance on its scale (:data:`VOTERS`: the choice changes nothing there). ``stack`` is ``(label, params)`` bottom to top, of the layers that show.
+    distance on its scale (:data:`VOTERS`: the choice changes nothing there). ``stack``
+    is ``(label, params)`` bottom to top, of the layers that show.
     """
     out: dict[str, Any] = {}
     for name in DISCRETE:
