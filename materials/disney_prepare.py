@@ -27,7 +27,14 @@ SHEEN_ALBEDO_GUESS = 0.1  # rough albedo of sheen 1, only used to weight samplin
 ETA_MIN = 1.001  # as Mitsuba: at η = 1 the rough BTDF becomes a delta
 DISNEY_LOBES = (
     Lobe("diffuse", "diffuse", params=("subsurface", "flatness")),
-    Lobe("diff_trans", "diffuse", True, params=("diff_trans",), switches=("diff_trans",)),
+    # A solid's scatter distance turns this lobe on too: it is the entry into the medium.
+    Lobe(
+        "diff_trans",
+        "diffuse",
+        True,
+        params=("diff_trans", "scatter_distance", "scatter_distance_scale"),
+        switches=("diff_trans", "scatter_distance"),
+    ),
     Lobe(
         "sheen",
         "glossy",

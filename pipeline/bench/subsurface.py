@@ -109,14 +109,18 @@ def _preset_pair(name: str) -> tuple[Any, Any]:
 def rim_glow(name: str = "skin", *, spp: int = 64, size: tuple[int, int] = (160, 80)) -> dict:
     """Mean radiance of the cup's rim under a back light, with and without the distance.
 
-    The environment is black but for a bright disc behind the cup (opposite the camera),
-    so what the rim sends to the camera is light that went through it.
+    The environment is black but for a small bright light behind the cup (opposite the
+    camera), so what the rim sends to the camera is light that went through it, or
+    reached it at grazing.
     """
     from lookdev.pipeline.proof import shaderball
     from lookdev.pipeline.proof.turntable import material_bsdf, material_interior
 
-    env = np.zeros((64, 128, 3), dtype=np.float32)
-    env[24:40, 56:72] = 50.0  # the lat-long's centre column: −z, behind the cup
+    _variant()
+    env = np.zeros((128, 256, 3), dtype=np.float32)
+    # An 11° square light just above the horizon, behind the cup (−z: the lat-long's
+    # edge columns; its centre column faces the camera, :data:`.ibl.ORIENTATION`).
+    env[56:64, :4] = env[56:64, -4:] = 500.0
     out = {}
     for label, hub in zip(("with", "without"), _preset_pair(name), strict=True):
         bsdf, depth = material_bsdf(hub)
@@ -129,20 +133,23 @@ def rim_glow(name: str = "skin", *, spp: int = 64, size: tuple[int, int] = (160,
 
 
 def _rim_mask(size: tuple[int, int]) -> np.ndarray:
-    """Pixels of the cup's rim in the proof camera: the cup's shape minus its solid body,
-    found by rendering a shape-ID pass once (the cup's own silhouette's top band)."""
+    """Pixels of the cup's rim in the proof camera (a position pass, rendered once): the
+    points above the cup's opening plane less half a wall, in the cup's own frame."""
     from lookdev.pipeline.proof import shaderball
 
+    _variant()
     scene = shaderball.scene_dict(
         {"type": "diffuse"}, np.ones((8, 16, 3), np.float32), size, 2, rig="none"
     )
     scene["integrator"] = {"type": "aov", "aovs": "pos:position"}
     pos = _render(scene, 4)[..., :3]
-    centre = np.asarray(shaderball.CUP_CENTER)
-    r = np.linalg.norm(pos - centre, axis=-1)
-    # the rim: points on the cup near its outer radius that lie on the rim's torus band
-    near = np.abs(r - (1.0 - shaderball.CUP_WALL / 2)) < shaderball.CUP_WALL / 2 + 1e-3
-    return near & (pos[..., 1] > 0.2) & (np.abs(pos[..., 0] - centre[0]) < 1.1)
+    tilt = shaderball.rotation_x(shaderball.CUP_TILT_DEG)
+    local = (pos - np.asarray(shaderball.CUP_CENTER)) @ tilt  # world → the cup's frame
+    radial = np.hypot(local[..., 0], local[..., 2])
+    dist = np.linalg.norm(local, axis=-1)
+    on_cup = (dist > 1 - shaderball.CUP_WALL - 0.01) & (dist < 1.01) & (pos[..., 1] > 0.05)
+    rim = (local[..., 1] > -shaderball.CUP_WALL / 2) & (radial > 1 - 1.5 * shaderball.CUP_WALL)
+    return on_cup & rim
 
 
 def cost(name: str = "skin", *, spp: int = 16, repeats: int = 2) -> dict[str, float]:
@@ -158,6 +165,7 @@ def cost(name: str = "skin", *, spp: int = 16, repeats: int = 2) -> dict[str, fl
         render_frame,
     )
 
+    _variant()
     env = ibl.load("studio").pixels
     tables = {}
     for label, hub in zip(("with", "without"), _preset_pair(name), strict=True):
