@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["COLOURS", "cost", "furnace", "rim_glow", "slab"]
+__all__ = ["COLOURS", "cost", "furnace", "rim_glow", "run", "slab"]
 
 COLOURS = {"grey": (0.5, 0.5, 0.5), "skin": (0.8, 0.5, 0.35), "jade": (0.3, 0.6, 0.4)}
 """The three colours whose slabs are measured (a grey, a warm and a cool one)."""
@@ -189,4 +189,21 @@ def cost(name: str = "skin", *, spp: int = 16, repeats: int = 2) -> dict[str, fl
         "noise_with": float(n_w),
         "noise_without": float(n_o),
         "equal_noise_ratio": float((t_w * n_w**2) / (t_o * n_o**2)),
+    }
+
+
+def run(*, spp: int = 64, presets: tuple[str, ...] = ("skin", "jade")) -> dict[str, Any]:
+    """Every figure of this module in one run: slab error per colour and channel, the
+    furnace's brightest block, the rim ratios, and the cost against no distance."""
+    slabs = {}
+    for name, colour in COLOURS.items():
+        got = slab(colour, spp=4 * spp)
+        slabs[name] = {"base": list(colour), "rendered": got.tolist(),
+                       "error": (got - np.asarray(colour)).tolist()}  # fmt: skip
+    return {
+        "mapping": "Chiang, Kutz & Burley 2016 albedo inversion, s of Christensen-Burley 2015",
+        "slab": slabs,
+        "furnace_max": furnace(spp=2 * spp),
+        "rim": {name: rim_glow(name, spp=spp) for name in presets},
+        "cost": {name: cost(name, spp=max(spp // 4, 4)) for name in presets},
     }

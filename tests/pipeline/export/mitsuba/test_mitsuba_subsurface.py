@@ -50,3 +50,11 @@ def test_a_thick_slab_reflects_its_base_colour_within_the_documented_error():
 
     colour = COLOURS["skin"]
     assert np.allclose(slab(colour, spp=32, size=8), colour, atol=0.06)
+
+
+def test_subsurface_proofs_trace_the_measured_depth():
+    from lookdev.pipeline.export.mitsuba.depth import DEPTH_SUBSURFACE, max_depth_for
+
+    assert max_depth_for(lookdev.blend(lookdev.load("skin"), 16)) == DEPTH_SUBSURFACE
+    thin = DisneyParams(thin=True, scatter_distance=0.1, diff_trans=0.5)
+    assert max_depth_for(thin) < DEPTH_SUBSURFACE  # thin sheets keep their class
