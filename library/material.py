@@ -29,6 +29,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from lookdev.materials.layers import CombineMask, ConstantMask, Mask, TextureMask, map_textures
 from lookdev.materials.params import DisneyParams
 from lookdev.materials.pixar import PixarParams
+from lookdev.materials.textures import TextureInput
 
 from .errors import PresetError, PresetNotFoundError
 from .preset import MODELS, PresetFile, check_params
@@ -51,6 +52,15 @@ class Material(BaseModel):
     source: Path | None = None
     citation: str | None = Field(None, description="The preset's `source` note (measurements).")
     chain: list[Path] = Field(default_factory=list, description="Files merged, child first.")
+    height: TextureInput | None = Field(
+        None, description="Height map (path absolute), in scene units after scale/offset."
+    )
+    normal_map: TextureMask | None = Field(
+        None, description="Tangent-space normal map of a texture set (path absolute)."
+    )
+    notes: list[str] = Field(
+        default_factory=list, description="What the preset's texture set left out, and why."
+    )
 
     @model_validator(mode="after")
     def _params_fit_the_model(self) -> Material:
@@ -95,8 +105,9 @@ def _resolve(name: str, lookup: Lookup, seen: tuple[str, ...]) -> Material:
         "citation": preset.source,
         "chain": paths,
     }
+    common |= _surface_maps(preset, paths[0])
     if preset.model in MODELS:
-        params = check_params(preset.model, preset.params, where=where)
+        params = check_params(preset.model, _with_set(preset, paths[0]), where=where)
         return Material(params=params, **common)
     return Material(layers=_layers(preset, paths[0], lookup, (*seen, name)), **common)
 
@@ -144,9 +155,8 @@ def _override(parent: PresetFile, child: PresetFile, *, where: str) -> PresetFil
             field="model",
         )
     given = child.model_fields_set
-    update: dict[str, Any] = {
-        k: getattr(child, k) for k in ("description", "tags", "source", "layers") if k in given
-    }
+    inherited = ("description", "tags", "source", "layers", "textures", "height")
+    update: dict[str, Any] = {k: getattr(child, k) for k in inherited if k in given}
     update["params"] = merge_params(parent.params, child.params)
     if parent.model in MODELS:
         check_params(parent.model, update["params"], where=where)
@@ -247,3 +257,38 @@ def multiply_masks(a: Mask, b: Mask) -> Mask:
 def _absolute_texture(texture: TextureMask, *, folder: Path) -> TextureMask:
     """Texture paths in a preset are relative to its file; consumers get absolute ones."""
     return texture.model_copy(update={"path": (folder / texture.path.expanduser()).resolve()})
+
+
+def _with_set(preset: PresetFile, path: Path) -> dict[str, Any]:
+    """The preset's parameters over its texture set's inputs (:mod:`.texture_sets`)."""
+    if preset.textures is None:
+        return preset.params
+    from .texture_sets import expand
+
+    found = expand(preset.textures, path.parent, where=str(path))
+    return {**found.inputs, **preset.params}
+
+
+def _surface_maps(preset: PresetFile, path: Path) -> dict[str, Any]:
+    """Height, normal map and notes of a preset: its own ``height`` (path made absolute)
+    over its texture set's."""
+    out: dict[str, Any] = {}
+    height = preset.height
+    if preset.textures is not None:
+        from .texture_sets import expand
+
+        found = expand(preset.textures, path.parent, where=str(path))
+        out["notes"] = found.notes
+        if found.normal_map is not None:
+            out["normal_map"] = TextureMask(path=Path(found.normal_map["path"]))
+            if found.normal_map["flip_y"]:
+                out["notes"].append(
+                    "normal map is DirectX (+Y down): its green channel is flipped on read"
+                )
+        if height is None and found.height is not None:
+            height = TextureInput.parse(found.height)
+    if height is not None:
+        texture = Path(height.texture).expanduser()
+        absolute = texture if texture.is_absolute() else path.parent / texture
+        out["height"] = height.model_copy(update={"texture": str(absolute)})
+    return out

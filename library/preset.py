@@ -30,6 +30,7 @@ from lookdev.materials import registry
 from lookdev.materials.errors import ParameterError, one_line, register_schema, short_repr
 from lookdev.materials.layers import ConstantMask, LayerSpec
 from lookdev.materials.params import Params
+from lookdev.materials.textures import TextureInput
 
 from .errors import PresetError
 
@@ -83,6 +84,18 @@ class PresetFile(BaseModel):
     layers: list[LayerSpec] = Field(
         default_factory=list, description="Layered presets: layers from bottom to top."
     )
+    textures: str | None = Field(
+        None,
+        description="A texture set: 'asset_<channel>.<UDIM>.png' (relative to the preset) "
+        "fills every parameter whose Substance Painter / Mari channel is found; [params] "
+        "entries win (lookdev.library.texture_sets).",
+    )
+    height: TextureInput | None = Field(
+        None,
+        description="Height map for bump (proofs) and displacement (USD): the value after "
+        "scale and offset is a height in scene units (metres at metersPerUnit = 1), e.g. "
+        "{ texture = 'h.png', scale = 0.01 } for a map whose white is 1 cm.",
+    )
 
     @field_validator("name", "extends")
     @classmethod
@@ -99,6 +112,8 @@ class PresetFile(BaseModel):
             raise ValueError(
                 "'model' is required (disney, pixar or layered) unless 'extends' is given"
             )
+        if self.model == "layered" and self.textures is not None:
+            raise ValueError("a layered preset has no texture set; give it to a layer's preset")
         if self.model == "layered" and self.params:
             raise ValueError("a layered preset has no [params]; give each layer its own")
         if self.model in MODELS and self.layers:

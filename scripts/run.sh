@@ -19,4 +19,14 @@ print("\n".join(sorted({p["material"] for p in json.load(open(sys.argv[1]))["pro
 PY
 )
 lookdev export usd "${PRESETS[@]}" -o "$OUT/proofed.usda"
+
+# The example asset: a pebble mesh over four UDIM tiles and its painted texture set,
+# generated (no downloads), proofed on its own mesh, exported as a self-contained asset.
+ASSET="$OUT/asset"
+python scripts/make_example_asset.py "$ASSET/source"
+lookdev proof "$ASSET/source/pebble.toml" --geometry "$ASSET/source/pebble.obj" \
+    --ibl studio --frames 4 --light-frames 4 -o "$ASSET"
+lookdev export usd "$ASSET/source/pebble.toml" -o "$ASSET/pebble.usda" --collect --preview-geometry \
+    --map-resolution 256
 echo "review page: $OUT/index.html; proofs: $OUT/*/*/contact.png; USD: $OUT/proofed.usda"
+echo "example asset: $ASSET/pebble/studio/contact.png; USD: $ASSET/pebble.usda"

@@ -84,9 +84,10 @@ def _frame_lists(data: dict[str, Any]) -> list[list[Any]]:
 def _frames(folder: Path, data: dict[str, Any]) -> list[tuple[Path, str]]:
     """(file, caption) of the frames a manifest lists, else of the images beside it.
 
-    A listed frame is a path, or an object naming its file as ``path``, ``file``, or a
-    file entry ``png``/``exr`` (``{"file": …}``, as :mod:`lookdev.pipeline.proof.batch`
-    writes them; the PNG is preferred, it went through the proof's view transform); for
+    A listed frame is a path, or an object naming its file in ``images`` (``png`` or
+    ``raw``, as :mod:`lookdev.pipeline.proof.batch` writes them; the PNG is preferred, it
+    went through the proof's view transform), as ``path``, ``file``, or a file entry
+    ``png``/``exr`` (``{"file": …}``); for
     the caption, ``label`` or ``kind`` and ``angle``.
     """
     listed = []
@@ -104,6 +105,11 @@ def _frames(folder: Path, data: dict[str, Any]) -> list[tuple[Path, str]]:
 
 
 def _frame_file(info: dict[str, Any]) -> str | None:
+    images = info.get("images")
+    if isinstance(images, dict):  # a proof frame: its view-transformed PNG, else its EXR
+        for role in ("png", "raw"):
+            if isinstance(images.get(role), str):
+                return images[role]
     for key in ("path", "file", "png", "exr"):
         value = info.get(key)
         value = value.get("file") if isinstance(value, dict) else value

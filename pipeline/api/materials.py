@@ -185,10 +185,11 @@ def blend(
     ((16, 16), ['base_color', 'metallic'])
     """
     from lookdev.pipeline.blend import blend as blend_material
+    from lookdev.pipeline.blend.surface_maps import attach
 
-    return blend_material(
-        _material(material, library), resolution, progress=progress, prune=prune, layering=layering
-    )
+    material = _material(material, library)
+    result = blend_material(material, resolution, progress=progress, prune=prune, layering=layering)
+    return attach(result, material)
 
 
 def bake(

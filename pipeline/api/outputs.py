@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import Executor
@@ -81,6 +82,8 @@ def export_usd(
     library: Any = None,
     progress: Callable[[int, int, str], None] | None = None,
     preview_opacity: str = "keep",
+    collect: bool = False,
+    preview_geometry: bool = False,
 ) -> UsdExport:
     """Write materials as UsdShade materials under ``/Materials`` of ``path``.
 
@@ -88,7 +91,7 @@ def export_usd(
     ----------
     materials
         One or several preset names, paths or :class:`~lookdev.library.Material` s;
-        several make a library whose ``/Look`` prim switches between them.
+        several make a library whose ``/Materials/Look`` prim switches between them.
     path
         ``.usda``, ``.usdc``, ``.usd``, or ``.usdz`` (packaged with its textures).
     contexts
@@ -116,6 +119,12 @@ def export_usd(
         transmissive materials (DCCs read ``opacity`` as alpha) and names the loss;
         ``"transmission"``: the UsdPreviewSurface spec's reading, ``opacity = 1 −
         spec_trans`` (``1 − clear`` for Pixar).
+    collect
+        Copy every texture file a preset reads into ``<name>_textures`` beside ``path``
+        (UDIM tiles included), referenced by relative paths; otherwise the files are
+        referenced where they are, relative to ``path`` where possible.
+    preview_geometry
+        Add a sphere per material, bound to it, in a grid under ``/Materials/Geometry``.
 
     Returns
     -------
@@ -158,6 +167,8 @@ def export_usd(
         split=split,
         progress=progress,
         preview_opacity=preview_opacity,
+        collect=collect,
+        preview_geometry=preview_geometry,
     )
     return UsdExport(
         result.files[0],
@@ -317,8 +328,13 @@ def proof(
     *,
     frames: int = 8,
     light_frames: int = 8,
-    spp: int = 32,
-    resolution: tuple[int, int] = (192, 96),
+    spp: int | None = None,
+    noise: float | None = None,
+    max_spp: int | None = None,
+    time_budget: float | None = None,
+    clamp: float | None = None,
+    pixel_filter: str = "box",
+    resolution: tuple[int, int] | None = None,
     exposure: float = 0.0,
     ibl_width: int = 512,
     rig: str = "full",
@@ -328,6 +344,7 @@ def proof(
     report: bool = False,
     library: Any = None,
     progress: Callable[[Any], None] | None = None,
+    geometry: PathLike | None = None,
 ) -> dict[str, Any]:
     """Render turntable proofs (Burley §6.1): every material under every IBL.
 
@@ -346,9 +363,25 @@ def proof(
         Built-in IBL names or ``.exr``/``.hdr`` files; None: every built-in.
     out
         The batch folder (shared with the workers when on a cluster).
-    frames, light_frames, spp, resolution, exposure
-        Element-rotation frames, lighting-rotation frames, samples per pixel, frame size
-        ``(width, height)``, and stops applied by the PNG view transform.
+    frames, light_frames, resolution, exposure
+        Element-rotation frames, lighting-rotation frames, frame size ``(width, height)``
+        (default :data:`~lookdev.pipeline.proof.settings.DEFAULT_RESOLUTION`), and stops
+        applied by the PNG view transform.
+    spp
+        A fixed count of samples per pixel for every frame. Without it, each frame is
+        rendered in passes to a noise target (:mod:`lookdev.pipeline.proof.passes`).
+    noise, max_spp, time_budget
+        The target (estimated relative RMS noise of the frame, default
+        :data:`~lookdev.pipeline.proof.settings.DEFAULT_NOISE`), the most samples per
+        pixel a frame may take to reach it (default ``DEFAULT_MAX_SPP``), and the most
+        seconds of rendering a frame may take (default: no limit). Each frame's manifest
+        entry says which ended it (``stop``).
+    clamp
+        Limit each camera sample's radiance to this value: hides fireflies, biases the
+        image; for quick previews only. Default None (unclamped); recorded in the manifests.
+    pixel_filter
+        ``"box"`` (default: keeps pixel noise independent, as a denoiser needs) or
+        ``"gaussian"``.
     ibl_width
         Every IBL is resampled to this width (× ½ high) so render kernels are reused.
     rig
@@ -369,6 +402,9 @@ def proof(
     progress
         Called with a :class:`lookdev.pipeline.proof.batch.Progress` about twice a second
         and as each proof finishes (``frames_done``, ``frames_total``, ``finished``).
+    geometry
+        A mesh (PLY, OBJ, or USD geometry) rendered in the cup's place beside the ball,
+        with its own UVs (:mod:`lookdev.pipeline.proof.geometry`).
 
     Returns
     -------
@@ -379,12 +415,24 @@ def proof(
     """
     from lookdev.pipeline.proof import batch
     from lookdev.pipeline.proof import ibl as ibl_module
+    from lookdev.pipeline.proof import settings as proof_settings
 
-    check_proof_settings(resolution, frames, light_frames, spp, exposure, jobs)
-    from lookdev.pipeline.proof.rig import RIGS
-
-    if rig not in RIGS:
-        raise batch.ProofError(f"unknown rig {rig!r}; use {', '.join(RIGS)}", field="--rig")
+    settings = proof_settings.check(
+        proof_settings.Settings(
+            element_frames=frames,
+            light_frames=light_frames,
+            spp=spp,
+            resolution=tuple(resolution or proof_settings.DEFAULT_RESOLUTION),
+            exposure=exposure,
+            noise=noise,
+            max_spp=max_spp,
+            time_budget=time_budget,
+            clamp=clamp,
+            pixel_filter=pixel_filter,
+            rig=rig,
+        ),
+        jobs,
+    )
     lib = library_for(library)
     if materials is None or (not isinstance(materials, str | os.PathLike) and not materials):
         materials = representative_presets(lib)
@@ -392,6 +440,10 @@ def proof(
     # and every texture it names (layers a blend would prune included), every IBL.
     output = Path(out)
     batch.check_writable(output)
+    if geometry is not None:
+        from lookdev.pipeline.proof.geometry import proof_mesh
+
+        settings = dataclasses.replace(settings, geometry=str(proof_mesh(geometry)))
     chosen = _materials(materials, lib)
     for material in chosen:
         check_textures(material)
@@ -400,7 +452,6 @@ def proof(
     ibl_names = list(dict.fromkeys(ibls or ibl_module.builtin_names()))
     environments = [ibl_module.load(name, ibl_width) for name in ibl_names]
     loaded = [hub(m, batch.MAP_RESOLUTION, lib) for m in chosen]
-    settings = batch.Settings(frames, light_frames, spp, tuple(resolution), exposure, rig)
     doc = batch.proof(
         loaded,
         environments,
@@ -438,40 +489,6 @@ def check_textures(material: Any) -> None:
             if tex is not None:
                 TextureFile(tex, 3, where=where)
         check_textures(layer.material)
-
-
-def check_proof_settings(
-    resolution: tuple[int, int],
-    frames: int,
-    light_frames: int,
-    spp: int,
-    exposure: float,
-    jobs: int | None,
-) -> None:
-    """Every numeric setting of a proof batch in its documented range, or one line."""
-    from lookdev.pipeline.proof import batch, tonemap
-
-    error = batch.ProofError
-    if len(tuple(resolution)) != 2:
-        raise error(f"{tuple(resolution)} is not W H", field="--resolution")
-    for side in resolution:
-        check_range(side, batch.MIN_SIDE, batch.MAX_SIDE, field="--resolution", error=error)
-    checks = {"--frames": (frames, 1, 360), "--light-frames": (light_frames, 0, 360)}
-    checks["--spp"] = (spp, 2, 65536)
-    if jobs is not None:
-        checks["--workers"] = (jobs, 1, 1024)
-    for name, (value, low, high) in checks.items():
-        check_range(value, low, high, field=name, error=error)
-    check_range(
-        exposure, -tonemap.EXPOSURE_MAX, tonemap.EXPOSURE_MAX, field="--exposure", error=error
-    )
-    samples = resolution[0] * resolution[1] * spp
-    if samples > batch.MAX_SAMPLES:
-        raise error(
-            f"{resolution[0]}×{resolution[1]} at {spp} spp is {samples:.3g} samples a frame; "
-            f"allowed ≤ {batch.MAX_SAMPLES:.3g} (lower --spp or --resolution)",
-            field="--resolution",
-        )
 
 
 # -- plots ---------------------------------------------------------------------------------------

@@ -99,12 +99,13 @@ class Clock:
 def time_pipeline(bsdf: dict, depth: int, env: Any, s: Settings, rig: str = "full") -> Timing:
     """A whole turntable (scene load included), with the frames' mean noise; ``rig``
     beside the material (:mod:`lookdev.pipeline.proof.rig`)."""
-    from lookdev.pipeline.proof.turntable import Turntable, render_frame
+    from lookdev.pipeline.proof.passes import render_frame
+    from lookdev.pipeline.proof.turntable import Turntable
 
     with Clock() as clock:
         table = Turntable(bsdf, env.pixels, s.resolution, depth, rig=rig)
-        noise = [render_frame(table, f, s.spp, seed=f.index) for f in _frames(s.frames)]
-    mean_noise = float(np.mean([r.noise_relative or 0.0 for r in noise]))
+        noise = [render_frame(table, f, spp=s.spp) for f in _frames(s.frames)]
+    mean_noise = float(np.mean([r.noise or 0.0 for r in noise]))
     return Timing(clock.timing.wall, clock.timing.cpu, mean_noise)
 
 

@@ -46,8 +46,16 @@ def _sky() -> dict[str, Any]:
     return {"type": "constant", "radiance": {"type": "rgb", "value": [1.0, 1.0, 1.0]}}
 
 
-def slab(colour: tuple[float, float, float], *, spp: int = 256, size: int = 16) -> np.ndarray:
-    """The thick slab's rendered directional albedo (RGB) at normal incidence."""
+def _mean_and_error(pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Mean of independent pixel estimates (N, 3) and its standard error."""
+    return pixels.mean(axis=0), pixels.std(axis=0, ddof=1) / np.sqrt(len(pixels))
+
+
+def slab(
+    colour: tuple[float, float, float], *, spp: int = 256, size: int = 16
+) -> tuple[np.ndarray, np.ndarray]:
+    """The thick slab's rendered directional albedo (RGB) at normal incidence, and the
+    standard error of that mean (from the spread of its independent pixels)."""
     mi = _variant()
 
     from lookdev.materials.params import DisneyParams
@@ -75,15 +83,14 @@ def slab(colour: tuple[float, float, float], *, spp: int = 256, size: int = 16) 
             "interior": medium,
         },
     }
-    return _render(scene, spp).reshape(-1, 3).mean(axis=0)
+    return _mean_and_error(_render(scene, spp).reshape(-1, 3))
 
 
-def furnace(*, scatter_distance: float = 0.5, roughness: float = 0.5, spp: int = 256) -> float:
-    """The largest pixel-block mean over a white solid subsurface sphere in a white sky.
-
-    Blocks of 4 × 4 pixels on the sphere (inside 90 % of its radius), so the figure is
-    the brightest region, not one noisy pixel.
-    """
+def furnace(
+    *, scatter_distance: float = 0.5, roughness: float = 0.5, spp: int = 256
+) -> tuple[float, float]:
+    """Mean radiance of a white solid subsurface sphere in a white sky (pixels inside
+    90 % of its radius, all channels) and the standard error of that mean."""
     from lookdev.materials.params import DisneyParams
     from lookdev.pipeline.export.mitsuba import scene_dict
 
@@ -92,9 +99,8 @@ def furnace(*, scatter_distance: float = 0.5, roughness: float = 0.5, spp: int =
     img = _render(scene_dict(p, resolution=(size, size), spp=spp, max_depth=SLAB_DEPTH), spp)
     y, x = (np.mgrid[:size, :size] + 0.5 - size / 2) / (size / 2 / 1.15 * 0.999)
     inside = (x * x + y * y) < 0.9**2
-    blocks = img.reshape(size // 4, 4, size // 4, 4, 3).mean(axis=(1, 3))
-    keep = inside.reshape(size // 4, 4, size // 4, 4).all(axis=(1, 3))
-    return float(blocks[keep].max())
+    mean, error = _mean_and_error(img[inside].mean(axis=-1, keepdims=True))
+    return float(mean[0]), float(error[0])
 
 
 def _preset_pair(name: str) -> tuple[Any, Any]:
@@ -157,12 +163,12 @@ def cost(name: str = "skin", *, spp: int = 16, repeats: int = 2) -> dict[str, fl
     interleaved in one process; the equal-noise ratio is (time · noise²) over (time ·
     noise²), since noise² falls as 1/spp."""
     from lookdev.pipeline.proof import ibl
+    from lookdev.pipeline.proof.passes import render_frame
     from lookdev.pipeline.proof.turntable import (
         Frame,
         Turntable,
         material_bsdf,
         material_interior,
-        render_frame,
     )
 
     _variant()
@@ -173,15 +179,15 @@ def cost(name: str = "skin", *, spp: int = 16, repeats: int = 2) -> dict[str, fl
         tables[label] = Turntable(bsdf, env, (160, 80), depth, interior=material_interior(hub))
     times = {k: [] for k in tables}
     noise = {k: [] for k in tables}
-    frame = Frame(0, 0.0, 0.0)
+    frame = Frame(0, "element", 0.0)
     for t in tables.values():  # warm-up: compile both kernels before timing
-        render_frame(t, frame, spp)
+        render_frame(t, frame, spp=spp)
     for r in range(repeats):
         for k, t in tables.items():
             start = time.perf_counter()
-            out = render_frame(t, frame, spp, seed=r + 1)
+            out = render_frame(t, Frame(r + 1, "element", 45.0 * (r + 1)), spp=spp)
             times[k].append(time.perf_counter() - start)
-            noise[k].append(out.noise_relative or 0.0)
+            noise[k].append(out.noise or 0.0)
     t_w, t_o = np.median(times["with"]), np.median(times["without"])
     n_w, n_o = np.mean(noise["with"]), np.mean(noise["without"])
     return {
@@ -197,13 +203,14 @@ def run(*, spp: int = 64, presets: tuple[str, ...] = ("skin", "jade")) -> dict[s
     furnace's brightest block, the rim ratios, and the cost against no distance."""
     slabs = {}
     for name, colour in COLOURS.items():
-        got = slab(colour, spp=4 * spp)
+        got, std = slab(colour, spp=4 * spp)
         slabs[name] = {"base": list(colour), "rendered": got.tolist(),
-                       "error": (got - np.asarray(colour)).tolist()}  # fmt: skip
+                       "error": (got - np.asarray(colour)).tolist(),
+                       "standard_error": std.tolist()}  # fmt: skip
     return {
         "mapping": "Chiang, Kutz & Burley 2016 albedo inversion, s of Christensen-Burley 2015",
         "slab": slabs,
-        "furnace_max": furnace(spp=2 * spp),
+        "furnace": dict(zip(("mean", "standard_error"), furnace(spp=2 * spp), strict=True)),
         "rim": {name: rim_glow(name, spp=spp) for name in presets},
         "cost": {name: cost(name, spp=max(spp // 4, 4)) for name in presets},
     }

@@ -36,7 +36,9 @@ from lookdev.pipeline.export.usd.mtlx import mtlx_version
 from lookdev.pipeline.export.usd.network import (
     CONTEXT_OUTPUT,
     CONTEXTS,
+    DISPLACEMENT_OUTPUT,
     Connection,
+    Interface,
     MaterialSpec,
     Source,
     source_from_params,
@@ -139,9 +141,15 @@ def spec_paths(specs: list[MaterialSpec]) -> tuple[list[Any], list[tuple[Any, An
         if any(net.context == "mtlx" for net in spec.networks):
             version = path.AppendProperty("config:mtlx:version")
             attributes.append((version, types["string"], Sdf.VariabilityUniform))
+        for name, (kind, _) in spec.interface().items():
+            attr = path.AppendProperty(f"inputs:{name}")
+            attributes.append((attr, types[kind], Sdf.VariabilityVarying))
         for net in spec.networks:
             output = path.AppendProperty(f"outputs:{CONTEXT_OUTPUT[net.context]}")
             attributes.append((output, types["token"], Sdf.VariabilityVarying))
+            if net.displacement is not None:
+                output = path.AppendProperty(f"outputs:{DISPLACEMENT_OUTPUT[net.context]}")
+                attributes.append((output, types["token"], Sdf.VariabilityVarying))
             for node in net.nodes:
                 shader = path.AppendChild(node.name)
                 prims.append(shader)
@@ -193,6 +201,12 @@ def author_naive(specs: list[MaterialSpec], base: Path):
             material.GetPrim().CreateAttribute(
                 "config:mtlx:version", types["string"], True, Sdf.VariabilityUniform
             ).Set(mtlx_version())
+        interface = {
+            name: material.CreateInput(name, types[kind])
+            for name, (kind, _) in spec.interface().items()
+        }
+        for name, (kind, value) in spec.interface().items():
+            interface[name].Set(usd_value(kind, value, base))
         for net in spec.networks:
             shaders = {}
             for node in net.nodes:
@@ -209,11 +223,20 @@ def author_naive(specs: list[MaterialSpec], base: Path):
                     inp = shaders[node.name].CreateInput(name, types[kind])
                     if isinstance(value, Connection):
                         inp.ConnectToSource(shaders[value.node].GetOutput(value.output))
+                    elif isinstance(value, Interface):
+                        inp.ConnectToSource(interface[value.name])
+                        inp.Set(usd_value(kind, value.value, base))
                     else:
                         inp.Set(usd_value(kind, value, base))
+                    if name in node.color_spaces:
+                        inp.GetAttr().SetColorSpace(node.color_spaces[name])
             terminal = shaders[net.terminal.node].GetOutput(net.terminal.output)
             output = material.CreateOutput(CONTEXT_OUTPUT[net.context], types["token"])
             output.ConnectToSource(terminal)
+            if net.displacement is not None:
+                disp = shaders[net.displacement.node].GetOutput(net.displacement.output)
+                name = DISPLACEMENT_OUTPUT[net.context]
+                material.CreateOutput(name, types["token"]).ConnectToSource(disp)
     return stage
 
 

@@ -65,6 +65,13 @@ class BlendedMaterial:
     :class:`lookdev.materials.textures.TextureInput` (path absolute): exporters reference
     the original file (and its colour space) instead of baking :attr:`maps`, which still
     holds the decoded values for every other consumer."""
+    height_map: np.ndarray | None = None
+    """Heights in scene units (float32 (H, W), UV order) for bump and displacement: the
+    preset's ``height`` texture after its scale/offset (:mod:`.surface_maps`)."""
+    map_tiles: tuple[int, int] = (1, 1)
+    """UDIM tiles ``(nu, nv)`` that :attr:`height_map` and a texture set's
+    :attr:`normal_map` span: their texel ``(r, c)`` sits at
+    ``(u, v) = (nu·(c + ½)/W, nv·(r + ½)/H)``."""
 
     @classmethod
     def of_params(cls, params: Any, name: str | None = None) -> BlendedMaterial:
@@ -141,7 +148,7 @@ class BlendedMaterial:
     def arrays(self) -> dict[str, np.ndarray]:
         """Every array of the result by name: the maps and any normal maps."""
         out = dict(self.maps)
-        for name in ("normal_map", "specular_normal_map"):
+        for name in ("normal_map", "specular_normal_map", "height_map"):
             if getattr(self, name) is not None:
                 out[name] = getattr(self, name)
         return out

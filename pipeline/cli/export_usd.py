@@ -68,7 +68,7 @@ def export_usd(
         typer.Option(
             "--split",
             help="One file per material in this folder; -o becomes a library that references "
-            "them, with a variant set 'preset' on /Look to switch between them.",
+            "them, with a variant set 'preset' on /Materials/Look to switch between them.",
         ),
     ] = None,
     all_presets: Annotated[
@@ -87,6 +87,21 @@ def export_usd(
             "opacity = 1 - spec_trans.",
         ),
     ] = PreviewOpacity.keep,
+    collect: Annotated[
+        bool,
+        typer.Option(
+            "--collect",
+            help="Copy the presets' texture files (UDIM tiles included) into NAME_textures "
+            "beside the output and reference them by relative paths.",
+        ),
+    ] = False,
+    preview_geometry: Annotated[
+        bool,
+        typer.Option(
+            "--preview-geometry",
+            help="Add a sphere per material, bound to it, so a DCC's default import shows it.",
+        ),
+    ] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
     """Write presets as UsdShade materials that DCCs and their renderers read.
@@ -99,7 +114,10 @@ def export_usd(
     --preview-opacity transmission. Only what a material needs is written: inputs at the target's
     default and lobes without weight are left out. Layered presets are blended and their
     varying parameters baked to EXR maps beside the file (UsdPreviewSurface has no mix
-    node). With several presets, /Look carries a variant set that switches between them.
+    node). With several presets, /Materials/Look carries a variant set that switches between
+    them. A parameter read from one texture file references that file (its colour space
+    named: sourceColorSpace, colorSpace, colorspace, linearize), or a copy with --collect;
+    a preset's height map becomes displacement in scene units (metersPerUnit = 1).
 
     Examples:
 
@@ -127,6 +145,8 @@ def export_usd(
             library=library,
             progress=progress,
             preview_opacity=preview_opacity.value,
+            collect=collect,
+            preview_geometry=preview_geometry,
         )
     if as_json:
         print_json(result.to_json())

@@ -171,6 +171,16 @@ def new(
             help='KEY=VALUE, VALUE in TOML (0.3, "#aa8844", [0.9, 0.6, 0.2]); repeatable.',
         ),
     ] = None,
+    textures: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--textures",
+            "-t",
+            help="A texture set: 'maps/asset_*.png' (quoted; or the files) named "
+            "asset_<channel>[.<UDIM>].ext with Substance Painter / Mari channel names; "
+            "the preset gets textures = 'asset_<channel>.<UDIM>.png' (model disney).",
+        ),
+    ] = None,
     library: LibraryOpt = None,
     force: Annotated[
         bool, typer.Option("--force", help="Replace a preset of that name in the target library.")
@@ -179,13 +189,22 @@ def new(
 ) -> None:
     """Create preset NAME in the first --library folder, extending --from PARENT.
 
+    With --textures, from a folder of painted maps: each file's channel name
+    (BaseColor, Roughness, Metallic, Normal_OpenGL, Height, …) says which parameter it
+    drives (lookdev.library.texture_sets), UDIM tiles are grouped into one <UDIM> set,
+    and channels no parameter takes (Emissive, AO) are named.
+
     Examples:
 
       lookdev presets new worn_gold --from gold --set roughness=0.45 -L ~/looks
 
       lookdev presets new teal_plastic --model disney --set base_color='"#2a8c8c"' -L ~/looks
+
+      lookdev presets new hero --textures 'maps/hero_*.png' -L ~/looks
     """
     check_name(name, field="NAME")
+    if textures and parent is None and model is None:
+        model = "disney"
     if (parent is None) == (model is None):
         raise PresetError(
             "give exactly one of --from PARENT or --model disney|pixar", field="--from"
@@ -194,10 +213,40 @@ def new(
     if parent is not None:
         lib.find(parent)
     where = str(lib.target() / f"{name}.toml")
-    base = PresetFile.model_construct(name=name, model=model, extends=parent, params={})
+    fields = {"name": name, "model": model, "extends": parent, "params": {}}
+    notes: list[str] = []
+    if textures:
+        fields["textures"], notes = _texture_set(textures, lib.target(), where)
+    base = PresetFile.model_construct(**fields)
     preset = apply_changes(base, parse_assignments(assignments or []), where=where)
     path = lib.save(preset, force=force)
     _report("created", preset.name, path, as_json)
+    for note in notes:
+        err_console.print(f"note: {note}", highlight=False, markup=False)
+
+
+def _texture_set(given: list[str], target: Path, where: str) -> tuple[str, list[str]]:
+    """The ``textures =`` pattern (relative to the preset's folder) of the files
+    ``given`` (globs expanded), and what the set leaves out."""
+    import glob
+    import os
+
+    from lookdev.library.texture_sets import expand, from_files
+
+    paths: list[Path] = []
+    for item in given:
+        item = os.path.expanduser(item)
+        matched = sorted(glob.glob(item)) if any(c in item for c in "*?[") else [item]
+        if not matched:
+            raise PresetError(f"--textures {item!r} matches no files", field="--textures")
+        paths += [Path(p) for p in matched]
+    missing = [p for p in paths if not p.is_file()]
+    if missing:
+        raise PresetError(f"texture {missing[0]} does not exist", field="--textures")
+    pattern, folder = from_files(paths)
+    found = expand(pattern, folder, where=where)
+    rel = os.path.relpath(folder.resolve(), target.resolve())
+    return Path(rel, pattern).as_posix(), found.notes
 
 
 @app.command("set")

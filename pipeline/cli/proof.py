@@ -17,6 +17,8 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
+from lookdev.pipeline.proof.settings import DEFAULT_MAX_SPP, DEFAULT_NOISE, DEFAULT_RESOLUTION
+
 from .common import console, err_console, print_json, table
 
 
@@ -54,14 +56,71 @@ def proof(
         int, typer.Option("--light-frames", "-m", min=0, max=360, help="Lighting-rotation frames.")
     ] = 8,
     spp: Annotated[
-        int, typer.Option("--spp", "-s", min=2, max=65536, help="Samples per pixel per frame.")
-    ] = 32,
+        int | None,
+        typer.Option(
+            "--spp",
+            "-s",
+            help="A fixed count of samples per pixel for every frame (2 .. 65536), instead "
+            "of a noise target.",
+            show_default=False,
+        ),
+    ] = None,
+    noise: Annotated[
+        float | None,
+        typer.Option(
+            "--noise",
+            help="Render each frame in passes until its estimated relative RMS noise is at "
+            f"most this [default: {DEFAULT_NOISE:g}].",
+            show_default=False,
+        ),
+    ] = None,
+    max_spp: Annotated[
+        int | None,
+        typer.Option(
+            "--max-spp",
+            help=f"The most samples per pixel a frame may take to reach --noise "
+            f"[default: {DEFAULT_MAX_SPP}].",
+            show_default=False,
+        ),
+    ] = None,
+    time_budget: Annotated[
+        float | None,
+        typer.Option(
+            "--time-budget",
+            metavar="SECONDS",
+            help="The most rendering seconds a frame may take to reach --noise (no new "
+            "pass starts that would end past it) [default: none].",
+            show_default=False,
+        ),
+    ] = None,
+    clamp: Annotated[
+        float | None,
+        typer.Option(
+            "--clamp",
+            metavar="VALUE",
+            help="Limit each camera sample's radiance to VALUE: hides fireflies but darkens "
+            "what they belong to; for quick previews (recorded in the manifests). "
+            "[default: none, unclamped]",
+            show_default=False,
+        ),
+    ] = None,
+    pixel_filter: Annotated[
+        str,
+        typer.Option(
+            "--pixel-filter",
+            help="Reconstruction filter: box (pixel noise stays independent, as a "
+            "denoiser needs) or gaussian.",
+        ),
+    ] = "box",
     resolution: Annotated[
         tuple[int, int],
         typer.Option(
-            "--resolution", "-r", metavar="W H", help="Frame size in pixels, each 8 .. 8192."
+            "--resolution",
+            "-r",
+            metavar="W H",
+            help="Frame size in pixels, each 8 .. 8192.",
         ),
-    ] = (192, 96),
+    ] = DEFAULT_RESOLUTION,
     output: Annotated[
         Path, typer.Option("--output", "-o", help="Folder for frames, sheets and manifests.")
     ] = Path("proofs"),
@@ -114,6 +173,15 @@ def proof(
     as_json: Annotated[
         bool, typer.Option("--json", help="Print the batch manifest as one JSON object.")
     ] = False,
+    geometry: Annotated[
+        Path | None,
+        typer.Option(
+            "--geometry",
+            "-g",
+            help="A mesh (PLY, OBJ, or USD geometry) shown in the cup's place beside the "
+            "ball, with its own UVs (UDIM tiles included).",
+        ),
+    ] = None,
     report: Annotated[
         bool,
         typer.Option(
@@ -129,9 +197,12 @@ def proof(
 
     Each proof turns the element through --frames frames, then the lighting through
     --light-frames frames, and writes under OUTPUT/PRESET/IBL/: EXR frames, tone-mapped PNG
-    frames, a labelled contact.png and a manifest.json (render time and noise of each
-    frame). Re-running skips frames the manifests vouch for, so an interrupted batch
-    resumes where it stopped.
+    frames, a labelled contact.png and a manifest.json. Each frame is rendered in passes
+    until its estimated relative noise is at most --noise, or --max-spp or --time-budget
+    is reached (or at a fixed --spp); its manifest entry records the spp, the noise
+    reached, why it stopped, its time and the share of its error in fireflies.
+    Re-running skips frames the manifests vouch for, so an interrupted batch resumes
+    where it stopped.
 
     Examples:
 
@@ -139,7 +210,13 @@ def proof(
 
       lookdev proof gold velvet --ibl studio --ibl ~/hdri/loft.exr -o proofs
 
+      lookdev proof copper --noise 0.02 --max-spp 4096 --resolution 960 480
+
+      lookdev proof gold --ibl sky --spp 16 --clamp 20 -r 240 120   # preview
+
       lookdev proof copper --spp 256 --resolution 640 320 --scheduler tcp://farm:8786
+
+      lookdev proof hero.toml --geometry hero.usd --ibl studio
     """
     from lookdev.pipeline import api
     from lookdev.pipeline.proof import batch
@@ -167,6 +244,11 @@ def proof(
             frames=frames,
             light_frames=light_frames,
             spp=spp,
+            noise=noise,
+            max_spp=max_spp,
+            time_budget=time_budget,
+            clamp=clamp,
+            pixel_filter=pixel_filter,
             resolution=resolution,
             exposure=exposure,
             ibl_width=ibl_width,
@@ -176,6 +258,7 @@ def proof(
             report=report,
             library=library,
             progress=show,
+            geometry=geometry,
         )
     if as_json:
         print_json(doc)
@@ -186,11 +269,14 @@ def proof(
             e["ibl"],
             f"{e['rendered']} + {e['skipped']}",
             e["render_seconds"],
-            e["mean_noise_relative"],
+            e.get("mean_spp"),  # .get: a kept entry may come from an older batch
+            e.get("mean_noise_relative"),
+            ", ".join(f"{k} {v}" for k, v in sorted((e.get("stops") or {}).items())),
+            e.get("max_firefly_share"),
         ]
         for e in doc["proofs"]
     ]
-    columns = ["material", "ibl", "new + kept", "render s", "noise"]
+    columns = ["material", "ibl", "new + kept", "render s", "spp", "noise", "stop", "fireflies"]
     console.print(table(f"proofs in {output}", columns, rows))
     console.print(
         f"{doc['wall_seconds']:.1f} s. Contact sheets: {output}/MATERIAL/IBL/contact.png; "

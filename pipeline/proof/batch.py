@@ -7,8 +7,10 @@ Layout of an output folder::
     OUT/<material>/<ibl>/frame_NNN.exr   scene-linear frames
     OUT/<material>/<ibl>/frame_NNN.png   the same through the proof view transform
     OUT/<material>/<ibl>/contact.png     all frames of the turntable, labelled
-    OUT/<material>/<ibl>/manifest.json   every frame: files (size, SHA-256), render
-                                         time, noise estimate; the settings' key
+    OUT/<material>/<ibl>/manifest.json   every frame: images and files (size, SHA-256),
+                                         spp, noise reached and target, why sampling
+                                         stopped, render time, firefly share; the
+                                         settings' key and the pixel filter
 
 A job (one material under one IBL) loads its scene once and renders only the frames its
 manifest does not vouch for: a frame counts as done when its manifest entry exists, the
@@ -29,10 +31,11 @@ import multiprocessing
 import os
 import time
 import traceback
+from collections import Counter
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Executor, Future, ProcessPoolExecutor, wait
 from contextlib import contextmanager
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -42,42 +45,37 @@ from lookdev.library import files
 from lookdev.materials.errors import LookdevError
 
 from . import contact, ibl, rig, tonemap
-from .rig import DEFAULT_RIG
-from .turntable import Frame, frames
+from .settings import MAX_SAMPLES, MAX_SIDE, MIN_SIDE, ProofError, Settings
+from .turntable import Frame
+
+__all__ = [
+    "FORMAT_VERSION",
+    "MANIFEST",
+    "MAP_RESOLUTION",
+    "MAX_SAMPLES",
+    "MAX_SIDE",
+    "MIN_SIDE",
+    "Job",
+    "Progress",
+    "ProofError",
+    "Settings",
+    "check_writable",
+    "executor_for",
+    "file_entry",
+    "frames_done",
+    "make_jobs",
+    "proof",
+    "read_manifest",
+    "run_batch",
+    "run_job",
+    "summary",
+]
 
 MANIFEST = "manifest.json"
 TICK_S = 0.5
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2  # 2: per-frame sampling fields, ``images`` and ``files`` (issue 16)
 MAP_RESOLUTION = 512
 """Texels a side of a layered material's maps in a proof (the blend the proof renders)."""
-MIN_SIDE, MAX_SIDE = 8, 8192
-"""Frame width and height of a proof, in pixels (``--resolution W H``)."""
-MAX_SAMPLES = 2**32 - 1
-"""Most samples a frame may take, width × height × spp: Dr.Jit indexes a render's
-wavefront with 32-bit integers."""
-
-
-class ProofError(LookdevError):
-    """A proof cannot run as asked (output folder, settings, scheduler)."""
-
-
-@dataclass(frozen=True)
-class Settings:
-    """What every turntable of a batch shares."""
-
-    element_frames: int = 8
-    light_frames: int = 8
-    spp: int = 32
-    resolution: tuple[int, int] = (192, 96)
-    exposure: float = 0.0  # display only: applied by the view transform, not the render
-    rig: str = DEFAULT_RIG  # the calibrated rig beside the material (.rig)
-
-    def frames(self) -> list[Frame]:
-        return frames(self.element_frames, self.light_frames)
-
-    def as_json(self) -> dict[str, Any]:
-        """The settings as they read back from a manifest (lists, not tuples)."""
-        return json.loads(json.dumps(asdict(self)))
 
 
 @dataclass
@@ -124,8 +122,12 @@ def read_manifest(folder: Path, key: str) -> dict[int, dict[str, Any]]:
         return {}
     done = {}
     for entry in doc.get("frames", []):
-        files = [entry.get("exr"), entry.get("png")]
-        if all(isinstance(f, dict) and _still_valid(folder, f) for f in files):
+        listed = entry.get("files") if isinstance(entry, dict) else None
+        if (
+            isinstance(listed, dict)
+            and listed
+            and all(isinstance(f, dict) and _still_valid(folder, f) for f in listed.values())
+        ):
             done[int(entry["index"])] = entry
     return done
 
@@ -167,6 +169,8 @@ def run_job(job: Job) -> dict[str, Any]:
         "settings": job.settings.as_json(),
         "rig": rig.manifest_entry(job.settings.rig),
         "ibl_orientation": ibl.ORIENTATION,
+        "filter": job.settings.pixel_filter,
+        "clamp": job.settings.clamp,
         "frames": [done[i] for i in sorted(done)],
     }
     rendered = 0
@@ -183,38 +187,60 @@ def run_job(job: Job) -> dict[str, Any]:
 
 def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
     """Build the scene once, then render and write each frame; yields manifest entries."""
-    from .turntable import Turntable, material_bsdf, material_interior, render_frame
+    from .passes import render_frame
+    from .turntable import Turntable, material_bsdf, material_interior
 
+    s = job.settings
     bsdf, depth = material_bsdf(job.material)
     table = Turntable(
         bsdf,
         job.environment,
-        job.settings.resolution,
+        s.resolution,
         depth,
-        rig=job.settings.rig,
+        s.geometry,
+        rig=s.rig,
+        pixel_filter=s.pixel_filter,
+        clamp=s.clamp,
         interior=material_interior(job.material),
     )
     for frame in todo:
-        r = render_frame(table, frame, job.settings.spp, seed=frame.index)
+        r = render_frame(table, frame, **s.sampling())
         stem = job.folder / f"frame_{frame.index:03d}"
         exr = contact.write_exr(r.image, stem.with_suffix(".exr"))
-        display = tonemap.view(r.image, job.settings.exposure)
-        png = contact.write_png(display, stem.with_suffix(".png"))
-        yield {
-            "index": frame.index,
-            "kind": frame.kind,
-            "angle": frame.angle,
-            "exr": file_entry(exr),
-            "png": file_entry(png),
-            "seconds": round(r.seconds, 4),
-            "noise_rmse": r.noise_rmse,
-            "noise_relative": r.noise_relative,
-        }
+        png = contact.write_png(tonemap.view(r.image, s.exposure), stem.with_suffix(".png"))
+        yield frame_entry(r, {"raw": exr, "png": png}, s)
+
+
+def frame_entry(r: Any, images: dict[str, Path], settings: Settings) -> dict[str, Any]:
+    """A frame's manifest entry (the fields issue 16 agreed, per frame).
+
+    ``images``: the role of each written file (``raw`` EXR, view-transformed ``png``) →
+    its name in the proof's folder; ``files``: the same roles with size and SHA-256,
+    which a resumed run checks. ``noise`` is the estimated relative RMS noise reached
+    (:mod:`.passes`), ``noise_target`` the target (None for a fixed ``spp``), ``stop``
+    why sampling ended, ``time_s`` the frame's rendering seconds.
+    """
+    return {
+        "index": r.frame.index,
+        "kind": r.frame.kind,
+        "angle": r.frame.angle,
+        "images": {role: path.name for role, path in images.items()},
+        "files": {role: file_entry(path) for role, path in images.items()},
+        "spp": r.spp,
+        "passes": r.passes,
+        "noise": r.noise,
+        "noise_rmse": r.noise_rmse,
+        "noise_target": settings.noise,
+        "stop": r.stop,
+        "time_s": round(r.seconds, 4),
+        "firefly_share": r.firefly_share,
+        "clamp": settings.clamp,
+    }
 
 
 def _remove_strays(folder: Path, doc: dict[str, Any]) -> None:
     """Delete frame files the manifest does not list (left by a run with more frames)."""
-    keep = {f[kind]["file"] for f in doc["frames"] for kind in ("exr", "png")}
+    keep = {f["file"] for frame in doc["frames"] for f in frame["files"].values()}
     for path in folder.glob("frame_*"):
         if path.name not in keep:
             path.unlink(missing_ok=True)
@@ -224,12 +250,20 @@ def _sheet(job: Job, doc: dict[str, Any]) -> Path:
 
     images, labels = [], []
     for entry in doc["frames"]:
-        images.append(contact.read_rgb(job.folder / entry["png"]["file"]))
-        labels.append(f"{entry['kind']} {entry['angle']:.0f}°")
-    title = f"{job.material.name} × {job.ibl}  ({job.settings.spp} spp)"
+        images.append(contact.read_rgb(job.folder / entry["images"]["png"]))
+        labels.append(f"{entry['kind']} {entry['angle']:.0f}°  {entry['spp']} spp")
+    title = f"{job.material.name} × {job.ibl}  ({_sampling_label(job.settings)})"
     columns = max(job.settings.element_frames, job.settings.light_frames)
     sheet = contact.contact_sheet(images, labels, title, columns)
     return contact.write_png(sheet, job.folder / "contact.png")
+
+
+def _sampling_label(s: Settings) -> str:
+    if s.spp is not None:
+        return f"{s.spp} spp"
+    budget = f", ≤ {s.time_budget:g} s" if s.time_budget is not None else ""
+    clamp = f", clamped at {s.clamp:g}" if s.clamp is not None else ""
+    return f"noise ≤ {s.noise:g}, ≤ {s.max_spp} spp{budget}{clamp}"
 
 
 # -- a batch (runs in the parent) ----------------------------------------------------------
@@ -441,18 +475,26 @@ def summary(out: Path, jobs: list[Job], results: list[dict[str, Any]], seconds: 
     """
     entries = []
     for job, doc in zip(jobs, results, strict=True):
-        times = [f["seconds"] for f in doc["frames"]]
-        noise = [f["noise_relative"] for f in doc["frames"] if f["noise_relative"] is not None]
+        frames = doc["frames"]
+        noise = [f["noise"] for f in frames if f["noise"] is not None]
         entries.append(
             {
                 "material": doc["material"],
                 "ibl": doc["ibl"],
                 "folder": str(job.folder.relative_to(out)),
-                "frames": len(doc["frames"]),
+                "frames": len(frames),
                 "rendered": doc["rendered"],
                 "skipped": doc["skipped"],
-                "render_seconds": round(sum(times), 3),
+                "filter": doc["filter"],
+                "render_seconds": round(sum(f["time_s"] for f in frames), 3),
+                "mean_spp": float(np.mean([f["spp"] for f in frames])) if frames else None,
                 "mean_noise_relative": float(np.mean(noise)) if noise else None,
+                "max_noise_relative": max(noise) if noise else None,
+                "stops": dict(Counter(f["stop"] for f in frames)),
+                "max_firefly_share": max(
+                    (f["firefly_share"] for f in frames if f["firefly_share"] is not None),
+                    default=None,
+                ),
                 "contact_sheet": str(job.folder.relative_to(out) / "contact.png"),
             }
         )
@@ -495,7 +537,7 @@ def _first_png(out: Path, entry: dict[str, Any]) -> Path | None:
     folder = out / entry["folder"]
     try:
         doc = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
-        first = folder / doc["frames"][0]["png"]["file"]
+        first = folder / doc["frames"][0]["images"]["png"]
     except (OSError, ValueError, KeyError, IndexError, TypeError):
         return None
     return first if first.is_file() else None

@@ -166,8 +166,19 @@ def eye(rig: str = DEFAULT_RIG) -> tuple[np.ndarray, np.ndarray]:
     return origin, target
 
 
-def camera(width: int, height: int, rig: str = DEFAULT_RIG) -> dict[str, Any]:
-    """A perspective camera framing both shapes and the rig, slightly above them."""
+PIXEL_FILTERS = ("box", "gaussian")
+"""Reconstruction filters a proof camera takes; ``box`` is the default (see :func:`camera`)."""
+
+
+def camera(
+    width: int, height: int, rig: str = DEFAULT_RIG, pixel_filter: str = "box"
+) -> dict[str, Any]:
+    """A perspective camera framing both shapes and the rig, slightly above them.
+
+    The pixel filter is a box by default: each sample lands in one pixel, so pixel noise
+    stays independent, which a denoiser relies on (a Gaussian spreads each sample over
+    its neighbours, and OIDN then gains almost nothing: issue 16), and it costs less.
+    """
     import mitsuba as mi
 
     origin, target = eye(rig)
@@ -187,7 +198,7 @@ def camera(width: int, height: int, rig: str = DEFAULT_RIG) -> dict[str, Any]:
             "width": int(width),
             "height": int(height),
             "pixel_format": "rgb",
-            "rfilter": {"type": "gaussian"},
+            "rfilter": {"type": pixel_filter},
         },
         "sampler": {"type": "independent"},
     }
@@ -225,29 +236,37 @@ def scene_dict(
     environment: np.ndarray,
     resolution: tuple[int, int],
     max_depth: int,
+    geometry: str | Path | None = None,
     *,
     rig: str = DEFAULT_RIG,
+    pixel_filter: str = "box",
+    clamp: float | None = None,
     interior: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """The shader-ball scene; the same ``bsdf`` on the ball and the cup, the ``rig``
     (:mod:`.rig`: ``full``, ``balls`` or ``none``) beside them.
 
+    ``geometry``: a PLY already placed in the cup's slot (:func:`.geometry.proof_mesh`)
+    shown instead of the cup, turning about the same centre.
+
     ``environment`` is a lat-long (H, W, 3) float32 array, used as it is (exposure is
     already in its pixels, see :mod:`.ibl`) and oriented by :data:`.ibl.ORIENTATION`.
+    ``clamp``: each camera sample's radiance is limited to that value (:mod:`.clamp`;
+    biased, for previews); None renders unclamped.
     ``interior`` (:func:`lookdev.pipeline.export.mitsuba.medium.interior_dict` at
     :data:`METERS_PER_UNIT`) fills the ball and the cup of a solid subsurface material;
     only then does the scene take ``volpath``.
     """
     import mitsuba as mi
 
-    from lookdev.pipeline.export.mitsuba.medium import integrator
+    from .clamp import integrator
 
     width, height = resolution
     inside = {} if interior is None else {"interior": interior}
     return {
         "type": "scene",
-        "integrator": integrator(max_depth, interior),
-        "sensor": camera(width, height, rig),
+        "integrator": integrator(max_depth, clamp, interior),
+        "sensor": camera(width, height, rig, pixel_filter),
         "environment": {
             "type": "envmap",
             "bitmap": mi.Bitmap(np.ascontiguousarray(environment, dtype=np.float32)),
@@ -265,7 +284,7 @@ def scene_dict(
             "type": "shapegroup",
             "shape": {
                 "type": "ply",
-                "filename": str(cup_ply()),
+                "filename": str(geometry or cup_ply()),
                 "face_normals": False,
                 "bsdf": _material,
                 **inside,

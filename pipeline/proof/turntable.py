@@ -8,21 +8,17 @@ Renders are also frozen (``dr.freeze``): after the first frames are recorded, a 
 replays the recorded kernel launches instead of tracing the integrator and our Python
 BSDF plugins again, which is most of a small frame's fixed cost.
 
-Each frame is rendered as two independent half-sample images: their mean is the frame
-and their difference estimates its noise (the variance of a mean of two independent
-estimates is a quarter of their squared difference), at no extra cost.
+Each render is a pair of independent half-sample images side by side
+(:meth:`Turntable.render_halves`): their mean is the frame and their difference estimates
+its noise at no extra cost; :mod:`.passes` adds such pairs until a noise target is met.
 """
 
 from __future__ import annotations
 
-import math
-import time
 from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
-
-from lookdev.materials.colour import luminance
 
 from . import shaderball
 from .ibl import envmap_to_world
@@ -79,14 +75,25 @@ class Turntable:
         environment: np.ndarray,
         resolution: tuple[int, int],
         max_depth: int,
+        geometry: str | None = None,
         *,
         rig: str = DEFAULT_RIG,
+        pixel_filter: str = "box",
+        clamp: float | None = None,
         interior: dict[str, Any] | None = None,
     ):
         import mitsuba as mi
 
         scene = shaderball.scene_dict(
-            bsdf, environment, resolution, max_depth, rig=rig, interior=interior
+            bsdf,
+            environment,
+            resolution,
+            max_depth,
+            geometry,
+            rig=rig,
+            pixel_filter=pixel_filter,
+            clamp=clamp,
+            interior=interior,
         )
         scene["sensor_pair"] = _sensor_pair(scene["sensor"])
         self.scene = mi.load_dict(scene)
@@ -163,35 +170,3 @@ def _sensor_pair(camera: dict[str, Any]) -> dict[str, Any]:
     view = {k: v for k, v in camera.items() if k not in ("film", "sampler")}
     film = {**camera["film"], "width": 2 * camera["film"]["width"]}
     return {"type": "batch", "a": view, "b": dict(view), "film": film, "sampler": camera["sampler"]}
-
-
-@dataclass(frozen=True)
-class RenderedFrame:
-    """A frame's image and what the manifest records about it."""
-
-    frame: Frame
-    image: np.ndarray
-    seconds: float
-    noise_rmse: float
-    noise_relative: float | None  # None for a black frame
-
-
-def render_frame(table: Turntable, frame: Frame, spp: int, seed: int = 0) -> RenderedFrame:
-    """Render ``frame`` as two half-sample images; their mean and a noise estimate.
-
-    ``noise_rmse`` is the estimated RMS error of the mean image, √(mean((A − B)²)/4),
-    taken on luminance; ``noise_relative`` divides it by the mean luminance (None when
-    the frame is black: JSON has no infinity). An odd ``spp`` is rounded down to even.
-    The halves come from one launch of the paired sensor (:meth:`Turntable.render_halves`);
-    the frame's seed keeps reruns equal.
-    """
-    half = max(1, spp // 2)
-    t0 = time.perf_counter()
-    table.set_frame(frame)
-    a, b = table.render_halves(half, seed=seed)
-    seconds = time.perf_counter() - t0
-    image = 0.5 * (a + b)
-    diff = luminance(a - b)
-    rmse = math.sqrt(float(np.mean(diff.astype(np.float64) ** 2)) / 4.0)
-    mean = float(np.mean(luminance(image)))
-    return RenderedFrame(frame, image, seconds, rmse, rmse / mean if mean > 0 else None)

@@ -155,10 +155,37 @@ def bsdf_dict(
 
     def normal_texture(normals: np.ndarray, name: str) -> dict[str, Any]:
         encoded = _encode_normals(np.asarray(normals, dtype=np.float32))
-        return _bitmap(encoded, True, hub.name, name, texture_dir)
+        return _tiled(_bitmap(encoded, True, hub.name, name, texture_dir), hub)
 
     frames = (hub.normal_map, hub.specular_normal_map)
-    return with_normals(out, model, lobes, frames, normal_texture)
+    return with_bump(hub, with_normals(out, model, lobes, frames, normal_texture), texture_dir)
+
+
+def with_bump(
+    hub: BlendedMaterial, bsdf: dict[str, Any], texture_dir: str | Path | None = None
+) -> dict[str, Any]:
+    """``bsdf`` under Mitsuba's ``bumpmap`` when the material has a height map.
+
+    The map holds heights in scene units (:attr:`BlendedMaterial.height_map`), and
+    ``bumpmap`` offsets the surface by ``scale`` × the texture along the normal when it
+    differentiates the position (Mitsuba 3 ``bumpmap``: ∂p/∂u + n·∂h/∂u), so ``scale``
+    is 1: the proof shows the bump the USD ``displacement`` describes, as shading."""
+    if hub.height_map is None:
+        return bsdf
+    height = _bitmap(hub.height_map, False, hub.name, "height", texture_dir)
+    return {"type": "bumpmap", "height": _tiled(height, hub), "scale": 1.0, "bsdf": bsdf}
+
+
+def _tiled(texture: dict[str, Any], hub: BlendedMaterial) -> dict[str, Any]:
+    """A map spanning UDIM tiles (``hub.map_tiles``) read at UV (u, v) ∈ [0, nu)×[0, nv)."""
+    nu, nv = hub.map_tiles
+    if (nu, nv) == (1, 1):
+        return texture
+    import mitsuba as mi
+
+    texture["to_uv"] = mi.ScalarTransform4f().scale([1.0 / nu, 1.0 / nv, 1.0])
+    texture["wrap_mode"] = "clamp"
+    return texture
 
 
 def _plugin_dict(hub: BlendedMaterial, texture_dir: str | Path | None) -> dict[str, Any]:

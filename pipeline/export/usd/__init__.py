@@ -29,6 +29,8 @@ def export_materials(
     split: str | Path | None = None,
     progress: Callable[[int, int, str], None] | None = None,
     preview_opacity: str = "keep",
+    collect: bool = False,
+    preview_geometry: bool = False,
 ):
     """Write blended materials (:class:`~lookdev.pipeline.blend.BlendedMaterial`) as
     UsdShade materials to ``out``.
@@ -40,7 +42,9 @@ def export_materials(
     ``progress(done, total, name)`` is called after each material's network source is
     made (varying parameters are baked then). Maps are baked into a scratch folder beside
     ``out`` and only copied into place when every file could be written.
-    ``preview_opacity``: see :data:`.names.PREVIEW_OPACITY`.
+    ``preview_opacity``: see :data:`.names.PREVIEW_OPACITY`. ``collect`` copies the
+    presets' own texture files beside ``out``; ``preview_geometry`` adds a sphere per
+    material (:func:`.writer.export_usd`).
     """
     from .network import CONTEXTS
     from .sources import source_for
@@ -68,6 +72,8 @@ def export_materials(
             split_dir=None if split is None else Path(split),
             workdir=Path(scratch),
             preview_opacity=preview_opacity,
+            collect=collect,
+            preview_geometry=preview_geometry,
         )
 
 

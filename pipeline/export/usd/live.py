@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from lookdev.materials.colour import RAW
 from lookdev.materials.layers import TextureMask
 
 from .lobes import canonical
@@ -51,7 +52,8 @@ def _coverage(entry: Any, hub: Any, index: int, texture_dir: Path) -> Image | fl
     if entry.uniform:
         return float(entry.low)
     if entry.presence == 1.0 and _plain_texture(entry.mask):
-        return Image(Path(entry.mask.path))
+        # the mask file itself, read as data (collected with --collect)
+        return Image(Path(entry.mask.path), colorspace=RAW, reference=True)
     from lookdev.pipeline.blend import MaskSampler
 
     width, height = hub.resolution

@@ -18,6 +18,8 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
+from lookdev.materials import colour
+
 from .live import mixed_input
 from .names import SURFACE_IDS, Slot, mapped_params, table_for
 from .network import (
@@ -29,16 +31,18 @@ from .network import (
     Node,
     Source,
     loss_note,
+    plain_value,
     prim_name,
     surface_inputs,
 )
 from .preview import SPECULAR_WORKFLOW
-from .textures import converted
+from .textures import MTLX_ADDRESS, affine, converted, output_of
 
 SURFACE = "mtlx_surface"
 MX_TYPES = {
     "float": "float",
     "color3f": "color3",
+    "color4f": "color4",
     "float3": "color3",
     "vector3f": "vector3",
     "normal3f": "vector3",
@@ -59,6 +63,32 @@ def _library():
     lib = mx.createDocument()
     mx.loadLibraries(mx.getDefaultDataLibraryFolders(), mx.getDefaultDataSearchPath(), lib)
     return lib
+
+
+@cache
+def _mtlx_spaces() -> frozenset[str]:
+    """MaterialX's colour-space names: its ``cmlib`` conversions' sources, and the
+    default working space ``lin_rec709``."""
+    names = {"lin_rec709"}
+    for nodedef in _library().getNodeDefs():
+        n = nodedef.getName()
+        if n.startswith("ND_") and "_to_" in n:
+            names.add(n[3:].split("_to_")[0])
+    return frozenset(names)
+
+
+def mtlx_color_space(space: str | None) -> str | None:
+    """The MaterialX ``colorspace`` of a file in OCIO ``space`` (None for data): the
+    space's name or an alias MaterialX knows, else the OCIO name (read by MaterialX's
+    OCIO colour management)."""
+    if space is None or colour.is_data(space):
+        return None
+    cs = colour.config().getColorSpace(colour.canonical(space))
+    known = {n.lower(): n for n in _mtlx_spaces()}
+    for name in (cs.getName(), *cs.getAliases()):
+        if name.lower() in known:
+            return known[name.lower()]
+    return cs.getName()
 
 
 @cache
@@ -97,9 +127,25 @@ def build(source: Source) -> Network:
     mapped = mapped_params("mtlx", source.model)
     if source.model == "disney" and source.lobes["sheen"]:
         mapped |= _sheen(source.live_values, extra)
+    displacement = None
+    if source.height is not None:
+        displacement = _displacement(nodes, source.height)
     note = loss_note(source, node_id, mapped, "; ".join(extra))
     surface = Node(SURFACE, node_id, inputs, {"out": "token"}, {"loss": note})
-    return Network("mtlx", Connection(SURFACE, "out"), [surface, *nodes])
+    return Network("mtlx", Connection(SURFACE, "out"), [surface, *nodes], displacement)
+
+
+def _displacement(nodes: list[Node], image: Image) -> Connection:
+    """``ND_displacement_float``: the height (scene units) along the normal, scale 1."""
+    kind, height = _image(nodes, "mtlx_height", image, "float", (image.scale, image.bias))
+    node = Node(
+        "mtlx_displacement",
+        "ND_displacement_float",
+        {"displacement": (kind, height)},
+        {"out": "token"},
+    )
+    nodes.append(node)
+    return Connection(node.name, "out")
 
 
 NORMAL_INPUT = {"pixar": "geometry_normal", "pixar_weights": "normal"}
@@ -138,11 +184,13 @@ def _sheen(values: dict[str, Any], extra: list[str]) -> set[str]:
 
 def _normal(nodes: list[Node], image: Image) -> tuple[str, Any]:
     """A tangent-space normal map through ``ND_normalmap_float`` (0..1 encoded)."""
-    nodes.append(
-        Node(
-            "mtlx_normal_image", "ND_image_vector3", {"file": ("asset", image)}, {"out": "vector3f"}
-        )
+    node = Node(
+        "mtlx_normal_image", "ND_image_vector3", {"file": ("asset", image)}, {"out": "vector3f"}
     )
+    if image.wrap != "periodic":
+        node.inputs["uaddressmode"] = ("string", MTLX_ADDRESS[image.wrap])
+        node.inputs["vaddressmode"] = ("string", MTLX_ADDRESS[image.wrap])
+    nodes.append(node)
     nodes.append(
         Node(
             "mtlx_normal_map",
@@ -168,12 +216,71 @@ def _live_or_baked(source: Source):
 
 
 def _texture(nodes: list[Node], slot: Slot, image: Image) -> tuple[str, Any]:
-    if slot.texture_linear != (1.0, 0.0):
-        image = converted(image, slot)
-    kind = "color3" if slot.type == "color3f" else "float"
-    name = f"mtlx_{slot.param}"
-    nodes.append(Node(name, f"ND_image_{kind}", {"file": ("asset", image)}, {"out": slot.type}))
-    return slot.type, Connection(name, "out")
+    linear = affine(image, slot)
+    if linear is None:
+        image, linear = converted(image, slot), (1.0, 0.0)
+    return _image(nodes, f"mtlx_{slot.param}", image, slot.type, linear)
+
+
+def _image(
+    nodes: list[Node], name: str, image: Image, slot_type: str, linear: tuple[float, float]
+) -> tuple[str, Any]:
+    """``ND_image_*`` reading ``image`` (colour space, address mode, default = the
+    parameter's mean), a channel picked by ``ND_extract_color4`` when it is not the
+    first, and the affine part of the value rule as ``ND_multiply``/``ND_add``."""
+    colour = slot_type == "color3f"
+    output = output_of(image, slot_type)
+    scale, bias = linear
+    raw = (lambda x: x) if scale == 0 else (lambda x: (x - bias) / scale)
+    inputs: dict[str, tuple[str, Any]] = {"file": ("asset", image)}
+    if image.wrap != "periodic":
+        inputs["uaddressmode"] = ("string", MTLX_ADDRESS[image.wrap])
+        inputs["vaddressmode"] = ("string", MTLX_ADDRESS[image.wrap])
+    picked = output in ("g", "b", "a")
+    kind = "color3" if colour else ("color4" if picked else "float")
+    if image.fallback is not None and not picked:
+        f = image.fallback
+        inputs["default"] = (
+            ("color3f", tuple(raw(x) for x in f) if isinstance(f, tuple) else (raw(f),) * 3)
+            if colour
+            else ("float", raw(f[0] if isinstance(f, tuple) else f))
+        )
+    reader = Node(name, f"ND_image_{kind}", inputs, {"out": "color4f" if picked else slot_type})
+    space = mtlx_color_space(image.colorspace)
+    if space is not None:
+        reader.color_spaces["file"] = space
+    nodes.append(reader)
+    out = Connection(name, "out")
+    if picked:
+        index = ("int", "rgba".index(output))
+        extract = Node(
+            f"{name}_{output}",
+            "ND_extract_color4",
+            {"in": ("color4f", out), "index": index},
+            {"out": "float"},
+        )
+        nodes.append(extract)
+        out = Connection(extract.name, "out")
+    suffix = "color3FA" if colour else "float"
+    if scale != 1.0:
+        node = Node(
+            f"{name}_scale",
+            f"ND_multiply_{suffix}",
+            {"in1": (slot_type, out), "in2": ("float", float(scale))},
+            {"out": slot_type},
+        )
+        nodes.append(node)
+        out = Connection(node.name, "out")
+    if bias != 0.0:
+        node = Node(
+            f"{name}_bias",
+            f"ND_add_{suffix}",
+            {"in1": (slot_type, out), "in2": ("float", float(bias))},
+            {"out": slot_type},
+        )
+        nodes.append(node)
+        out = Connection(node.name, "out")
+    return slot_type, out
 
 
 def document(specs: list[MaterialSpec], relative_to: Path):
@@ -200,16 +307,22 @@ def _add_network(doc, material: str, net: Network, relative_to: Path) -> None:
         mx_node = doc.addNode(nodedef.getNodeString(), prefix + node.name, nodedef.getType())
         mx_node.setNodeDefString(node.id)
         for name, (kind, value) in node.inputs.items():
+            value = plain_value(value)
             inp = mx_node.addInput(name, MX_TYPES[kind])
             if isinstance(value, Connection):
                 inp.setNodeName(prefix + value.node)
             elif isinstance(value, Image):
                 inp.setValueString(_relative(value.path, relative_to))
+                if name in node.color_spaces:
+                    inp.setColorSpace(node.color_spaces[name])
             else:
                 inp.setValueString(_mx_value(value))
     mat = doc.addNode("surfacematerial", material, "material")
     shader = mat.addInput("surfaceshader", "surfaceshader")
     shader.setNodeName(prefix + net.terminal.node)
+    if net.displacement is not None:
+        disp = mat.addInput("displacementshader", "displacementshader")
+        disp.setNodeName(prefix + net.displacement.node)
 
 
 def _mx_value(value: Any) -> str:

@@ -29,6 +29,12 @@ CONTEXT_OUTPUT = {"universal": "surface", "mtlx": "mtlx:surface", "ri": "ri:surf
 """render context → the Material's terminal output name (UsdShade convention)."""
 
 CONTEXTS = tuple(CONTEXT_OUTPUT)
+DISPLACEMENT_OUTPUT = {
+    "universal": "displacement",
+    "mtlx": "mtlx:displacement",
+    "ri": "ri:displacement",
+}
+"""render context → the Material's displacement output name (UsdShade convention)."""
 
 F0_KEYS = frozenset(("specular", "ior", "eta"))
 """One quantity in several spellings (Burley's specular, an IOR): mapped when any is."""
@@ -64,6 +70,9 @@ class Node:
     inputs: dict[str, tuple[str, Any]] = field(default_factory=dict)
     outputs: dict[str, str] = field(default_factory=dict)
     custom: dict[str, str] = field(default_factory=dict)
+    color_spaces: dict[str, str] = field(default_factory=dict)
+    """Input name → colour space of the file it names (USD ``colorSpace`` metadata,
+    MaterialX ``colorspace``)."""
 
 
 @dataclass
@@ -73,6 +82,22 @@ class Network:
     context: str
     terminal: Connection
     nodes: list[Node]
+    displacement: Connection | None = None
+    """What the Material's displacement output of this context reads, if anything."""
+
+
+@dataclass(frozen=True)
+class Interface:
+    """A Material interface input (``inputs:NAME`` on the Material, holding ``value``)
+    that a shader input reads: one override there drives every render context."""
+
+    name: str
+    value: Any = None
+
+
+ST_PRIMVAR = Interface("frame:stPrimvarName", "st")
+"""The texture-coordinate primvar every texture reads, on the Material's interface
+(the UsdPreviewSurface spec's convention: an override there retargets every reader)."""
 
 
 @dataclass
@@ -83,19 +108,58 @@ class MaterialSpec:
     networks: list[Network]
     custom: dict[str, Any]
 
+    def interface(self) -> dict[str, tuple[str, Any]]:
+        """The Material's interface inputs the networks read: name → (type, value)."""
+        out: dict[str, tuple[str, Any]] = {}
+        for net in self.networks:
+            for node in net.nodes:
+                for kind, value in node.inputs.values():
+                    if isinstance(value, Interface):
+                        out.setdefault(value.name, (kind, value.value))
+        return out
+
+
+def plain_value(value: Any) -> Any:
+    """An input's value with an interface reference replaced by the interface's value
+    (for writers without interfaces: a standalone ``.mtlx``)."""
+    return value.value if isinstance(value, Interface) else value
+
 
 @dataclass(frozen=True)
 class Image:
     """A texture a network reads: a file, and optionally its pixels (for conversions).
 
     ``write`` marks an image the exporter must write itself (a converted map, a baked
-    procedural mask) before the stage that references it.
+    procedural mask) before the stage that references it. A *referenced* image (the
+    preset's own file, :attr:`reference`) is read as it is: ``colorspace`` names its
+    encoding (OCIO), ``channel`` the texture output that carries the parameter, and
+    ``scale``/``bias`` the affine map from the file's decoded value to the parameter
+    (:class:`~lookdev.materials.textures.TextureInput`'s scale, offset and range);
+    ``fallback`` is the parameter's mean, read where the file is missing.
     """
 
     path: Path
     pixels: np.ndarray | None = None
     write: bool = False
     origin: Path | None = None  # a file written elsewhere (a bake) to copy to ``path``
+    colorspace: str | None = None
+    """OCIO colour space of the file; None: written by lookdev (working space, or data)."""
+    channel: str = ""
+    """Output read: ``r``, ``g``, ``b``, ``a`` or ``rgb``; "" picks by the input's type."""
+    scale: float = 1.0
+    bias: float = 0.0
+    fallback: Any = None
+    wrap: str = "periodic"
+    flip_y: bool = False  # a DirectX normal map (green down)
+    derived_dir: Path | None = None  # where converted copies of a referenced file go
+    reference: bool = False
+    """The preset's own file, not a bake: the exporter points at it (or copies it with
+    ``--collect``) and converts nothing."""
+
+    @property
+    def udim(self) -> bool:
+        """True when ``path`` is a ``<UDIM>`` tile pattern."""
+        return "<UDIM>" in self.path.name
 
 
 @dataclass
@@ -118,6 +182,8 @@ class Source:
     notes: list[str] = field(default_factory=list)  # losses every context shares
     live: tuple[str, ...] | None = None
     """The model's live lobes (the blend's, maps included); None: judged from ``values``."""
+    height: Image | None = None
+    """Heights in scene units (value · scale + bias of the image), for displacement."""
 
     @cached_property
     def lobes(self) -> dict[str, bool]:
@@ -165,8 +231,19 @@ def surface_inputs(
         at_default = defaults is not None and same_or_eq(value, defaults.get(slot.input))
         if at_default and slot.param not in WEIGHTS:
             continue
-        inputs[slot.input] = (slot.type, value)
+        inputs[slot.input] = (slot.type, _interface(slot, value))
     return inputs
+
+
+def _interface(slot: Slot, value: Any) -> Any:
+    """A value taken as it is (no conversion) sits on the Material's interface under the
+    parameter's name, so one override drives every context; converted values stay on
+    the shader (the contexts would disagree on one interface value)."""
+    from .names import _same
+
+    if slot.to_target is _same and not isinstance(value, str):
+        return Interface(slot.param, value)
+    return value
 
 
 def same(a: Any, b: Any) -> bool:

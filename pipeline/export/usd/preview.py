@@ -13,8 +13,25 @@ from functools import cache
 from typing import Any
 
 from .names import Slot, mapped_params, table_for
-from .network import Connection, Image, Network, Node, Source, loss_note, surface_inputs
-from .textures import converted
+from .network import (
+    ST_PRIMVAR,
+    Connection,
+    Image,
+    Network,
+    Node,
+    Source,
+    loss_note,
+    surface_inputs,
+)
+from .textures import (
+    USD_WRAP,
+    affine,
+    converted,
+    fallback4,
+    output_of,
+    preview_color_space,
+    usd_color_space,
+)
 
 SURFACE = "preview_surface"
 SPECULAR_WORKFLOW = ("pixar_weights",)  # models whose highlight is a colour, not metallic
@@ -75,6 +92,11 @@ def build(source: Source, preview_opacity: str = "keep") -> Network:
         inputs["useSpecularWorkflow"] = ("int", 1)
     if source.normal_map is not None:
         inputs["normal"] = _normal(nodes, source.normal_map)
+    displacement = None
+    if source.height is not None:
+        # UsdPreviewSurface displaces along the normal by `displacement` scene units.
+        inputs["displacement"] = _height(nodes, source.height)
+        displacement = Connection(SURFACE, "displacement")
     lobes = source.lobes
     notes = SHAPE_NOTES[source.model]
     shapes = [text for lobe, text in notes.items() if lobes[lobe]]
@@ -82,53 +104,103 @@ def build(source: Source, preview_opacity: str = "keep") -> Network:
     if transmissive and preview_opacity == "keep":
         shapes.insert(0, KEPT_OPAQUE)
     mapped = mapped_params("universal", source.model, preview_opacity)
+    shapes += [n.custom.pop("space_note") for n in nodes if n.custom.get("space_note")]
     note = loss_note(source, "UsdPreviewSurface", mapped, "; ".join(shapes))
-    surface = Node(SURFACE, "UsdPreviewSurface", inputs, {"surface": "token"})
+    outputs = {"surface": "token"}
+    if displacement is not None:
+        outputs["displacement"] = "token"
+    surface = Node(SURFACE, "UsdPreviewSurface", inputs, outputs)
     surface.custom["loss"] = note
-    return Network("universal", Connection(SURFACE, "surface"), [surface, *nodes])
+    return Network("universal", Connection(SURFACE, "surface"), [surface, *nodes], displacement)
 
 
 def _st(nodes: list[Node]) -> Connection:
+    """The one ``st`` reader; its primvar name is the Material's interface input."""
     if not any(n.name == ST_READER for n in nodes):
-        reader = Node(ST_READER, "UsdPrimvarReader_float2", {"varname": ("string", "st")})
+        reader = Node(ST_READER, "UsdPrimvarReader_float2", {"varname": ("string", ST_PRIMVAR)})
         reader.outputs["result"] = "float2"
         nodes.append(reader)
     return Connection(ST_READER, "result")
 
 
-def _uv_texture(nodes: list[Node], name: str, image: Image, output: str, kind: str) -> Node:
+def _uv_texture(
+    nodes: list[Node],
+    name: str,
+    image: Image,
+    output: str,
+    kind: str,
+    scale_bias: tuple[tuple[float, ...], tuple[float, ...]] | None = None,
+    slot_type: str = "float",
+) -> Node:
+    """A ``UsdUVTexture`` reading ``image``: colour space, wrap, scale/bias, fallback."""
+    space, note = preview_color_space(image.colorspace)
+    wrap = USD_WRAP[image.wrap]
     node = Node(
         name,
         "UsdUVTexture",
         {
             "file": ("asset", image),
             "st": ("float2", _st(nodes)),
-            "sourceColorSpace": ("token", "raw"),
-            "wrapS": ("token", "repeat"),
-            "wrapT": ("token", "repeat"),
+            "sourceColorSpace": ("token", space),
+            "wrapS": ("token", wrap),
+            "wrapT": ("token", wrap),
         },
         {output: kind},
     )
+    metadata = usd_color_space(image, slot_type)
+    if metadata is not None:
+        node.color_spaces["file"] = metadata
+    if note:
+        node.custom["space_note"] = note
+    if scale_bias is not None:
+        scale, bias = scale_bias
+        if scale != (1.0, 1.0, 1.0, 1.0) or bias != (0.0, 0.0, 0.0, 0.0):
+            node.inputs["scale"] = ("float4", scale)
+            node.inputs["bias"] = ("float4", bias)
     nodes.append(node)
     return node
 
 
 def _texture(nodes: list[Node], slot: Slot, image: Image) -> tuple[str, Any]:
-    output = "rgb" if slot.type == "color3f" else "r"
-    kind = "float3" if output == "rgb" else "float"
-    if slot.texture_linear is None:
+    linear = affine(image, slot)
+    if linear is None:  # not affine: a converted copy, read as it is
         image = converted(image, slot)
-    node = _uv_texture(nodes, f"preview_{slot.param}", image, output, kind)
-    if slot.texture_linear not in (None, (1.0, 0.0)):
-        scale, bias = slot.texture_linear
-        node.inputs["scale"] = ("float4", (scale, scale, scale, 1.0))
-        node.inputs["bias"] = ("float4", (bias, bias, bias, 0.0))
+        linear = (1.0, 0.0)
+    output = output_of(image, slot.type)
+    kind = "float3" if output == "rgb" else "float"
+    scale, bias = linear
+    node = _uv_texture(
+        nodes,
+        f"preview_{slot.param}",
+        image,
+        output,
+        kind,
+        ((scale, scale, scale, 1.0), (bias, bias, bias, 0.0)),
+        slot.type,
+    )
+    fallback = fallback4(image, output, scale, bias)
+    if fallback is not None:
+        node.inputs["fallback"] = ("float4", fallback)
     return slot.type, Connection(node.name, output)
 
 
 def _normal(nodes: list[Node], image: Image) -> tuple[str, Any]:
-    """A tangent-space normal map: texel 0..1 ↦ -1..1 by scale 2, bias -1 (spec 5.4)."""
-    node = _uv_texture(nodes, "preview_normal_map", image, "rgb", "float3")
-    node.inputs["scale"] = ("float4", (2.0, 2.0, 2.0, 1.0))
-    node.inputs["bias"] = ("float4", (-1.0, -1.0, -1.0, 0.0))
+    """A tangent-space normal map: texel 0..1 ↦ -1..1 by scale 2, bias -1 (spec 5.4);
+    a DirectX map (green down) gets −2, +1 on green. A missing file reads as the
+    unperturbed normal (0, 0, 1)."""
+    g = (-2.0, 1.0) if image.flip_y else (2.0, -1.0)
+    scale_bias = ((2.0, g[0], 2.0, 1.0), (-1.0, g[1], -1.0, 0.0))
+    node = _uv_texture(nodes, "preview_normal_map", image, "rgb", "float3", scale_bias)
+    node.inputs["fallback"] = ("float4", (0.5, 0.5, 1.0, 1.0))
     return "normal3f", Connection(node.name, "rgb")
+
+
+def _height(nodes: list[Node], image: Image) -> tuple[str, Any]:
+    """Heights in scene units: the file's value times the height scale, plus offset; a
+    missing file reads as height 0 (no displacement)."""
+    s, b = image.scale, image.bias
+    node = _uv_texture(
+        nodes, "preview_height", image, "r", "float", ((s, s, s, 1.0), (b, b, b, 0.0))
+    )
+    node.inputs["fallback"] = ("float4", (0.0 if s == 0 else -b / s, 0.0, 0.0, 1.0))
+    return "float", Connection(node.name, "r")

@@ -121,7 +121,12 @@ def _collect(prim, nodes: dict[str, Node]) -> None:
     for inp in shader.GetInputs():
         kind = str(inp.GetTypeName())
         source = _source(inp)
-        if source is not None:
+        if source is not None and UsdShade.Material(prim.GetStage().GetPrimAtPath(source[0])):
+            # A Material interface input (lookdev's own, usdex, Houdini): its value.
+            attrs = inp.GetValueProducingAttributes()
+            if attrs and attrs[0].HasAuthoredValue():
+                node.inputs[inp.GetBaseName()] = (kind, _plain(attrs[0].Get()))
+        elif source is not None:
             node.inputs[inp.GetBaseName()] = (kind, Connection(source[0].name, source[1]))
             _collect(prim.GetStage().GetPrimAtPath(source[0]), nodes)
         elif inp.GetAttr().HasAuthoredValue():

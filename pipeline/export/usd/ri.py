@@ -29,7 +29,7 @@ from .network import (
     loss_note,
     surface_inputs,
 )
-from .textures import converted
+from .textures import affine, converted, output_of, preview_color_space
 
 INPUTS_FILE = Path(__file__).with_name("renderman_inputs.json")
 
@@ -84,13 +84,16 @@ def build(source: Source) -> Network:
         inputs["bumpNormal"] = ("normal3f", Connection("ri_normal_map", "resultN"))
     node_id = SURFACE_IDS[("ri", source.model)]
     extra = [EXTRA_LOSS[source.model]] if source.model in EXTRA_LOSS else []
+    displacement = None
+    if source.height is not None:
+        displacement = _displacement(nodes, source.height)
     if source.model in PXR_SURFACE_MODELS:
         inputs.update(_pixar_gains(source.lobes))
         if source.lobes["reflection_t"]:
             extra.append(GLASS_REFLECTION)
     note = loss_note(source, node_id, mapped_params("ri", source.model), "; ".join(extra))
     surface = Node(SURFACE, node_id, inputs, {"bxdf_out": "token"}, {"loss": note})
-    net = Network("ri", Connection(SURFACE, "bxdf_out"), [surface, *nodes])
+    net = Network("ri", Connection(SURFACE, "bxdf_out"), [surface, *nodes], displacement)
     check_network(net, source.name)
     return net
 
@@ -139,12 +142,62 @@ def _pixar_gains(lobes: dict[str, bool]) -> dict[str, tuple[str, Any]]:
     return out
 
 
+RESULTS = {"r": "resultR", "g": "resultG", "b": "resultB", "a": "resultA", "rgb": "resultRGB"}
+"""Texture output → PxrTexture's output (renderman_inputs.json, PxrTexture outputs)."""
+
+
 def _texture(nodes: list[Node], slot: Slot, image: Image) -> tuple[str, Any]:
-    if slot.texture_linear != (1.0, 0.0):
-        image = converted(image, slot)
-    output = "resultRGB" if slot.type == "color3f" else "resultR"
+    linear = affine(image, slot)
+    if linear is None:
+        image, linear = converted(image, slot), (1.0, 0.0)
+    output = RESULTS[output_of(image, slot.type)]
     name = f"ri_{slot.param}"
     if any(n.name == name for n in nodes):  # one map feeding two inputs (subsurfaceColor)
         return slot.type, Connection(name, output)
-    nodes.append(Node(name, "PxrTexture", {"filename": ("asset", image)}, {output: slot.type}))
+    nodes.append(_pxr_texture(name, image, output, slot.type, linear))
     return slot.type, Connection(name, output)
+
+
+def _pxr_texture(
+    name: str, image: Image, output: str, kind: str, linear: tuple[float, float]
+) -> Node:
+    """``PxrTexture``: ``linearize`` for an sRGB-encoded file, the affine value rule as
+    ``colorScale``/``colorOffset`` and the parameter's mean as ``missingColor`` (the
+    names hdPrman's and Gaffer's UsdUVTexture conversions write)."""
+    inputs: dict[str, tuple[str, Any]] = {"filename": ("asset", image)}
+    if preview_color_space(image.colorspace)[0] == "sRGB":
+        inputs["linearize"] = ("int", 1)
+    scale, bias = linear
+    if (scale, bias) != (1.0, 0.0):
+        inputs["colorScale"] = ("color3f", (scale,) * 3)
+        inputs["colorOffset"] = ("color3f", (bias,) * 3)
+    if image.fallback is not None:  # before colorScale/colorOffset, as UsdUVTexture's
+        f = image.fallback
+        raw = (lambda x: x) if scale == 0 else (lambda x: (x - bias) / scale)
+        inputs["missingColor"] = (
+            "color3f",
+            tuple(raw(x) for x in f) if isinstance(f, tuple) else (raw(f),) * 3,
+        )
+    # A UDIM set keeps USD's <UDIM> token in `filename`, as Foundry's Mari exporter for
+    # PxrTexture writes it (renderman_inputs.json names the source).
+    return Node(name, "PxrTexture", inputs, {output: kind})
+
+
+def _displacement(nodes: list[Node], image: Image) -> Connection:
+    """``PxrDisplace`` (hdPrman's conversion of UsdPreviewSurface displacement):
+    ``dispAmount`` 1 scene unit times ``dispScalar``, the height in scene units."""
+    texture = _pxr_texture("ri_height", image, "resultR", "float", (image.scale, image.bias))
+    if image.fallback is None:
+        texture.inputs["missingColor"] = ("color3f", (0.0, 0.0, 0.0))
+    nodes.append(texture)
+    node = Node(
+        "ri_displacement",
+        "PxrDisplace",
+        {
+            "dispAmount": ("float", 1.0),
+            "dispScalar": ("float", Connection(texture.name, "resultR")),
+        },
+        {"displacement": "token"},
+    )
+    nodes.append(node)
+    return Connection(node.name, "displacement")

@@ -10,6 +10,7 @@ blend's answer (:attr:`~lookdev.pipeline.blend.BlendedMaterial.live_lobes`).
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 from typing import Any
 
@@ -17,7 +18,6 @@ import numpy as np
 
 from lookdev.materials import registry
 from lookdev.materials.fresnel import specular_to_ior
-from lookdev.materials.params import DisneyParams
 from lookdev.pipeline.blend.result import LOBE_WEIGHTS, BlendedMaterial
 
 from .live import live_stack
@@ -40,7 +40,7 @@ def source_for(
     _check_model(hub.model, hub.name)
     if hub.representation == LOBE_WEIGHTS:
         return weights_source(hub, texture_dir)
-    if not hub.layered:
+    if not hub.layered and not hub.arrays:
         source = source_from_params(hub.name, hub.model, hub.params, hub.description)
         source.live = hub.live_lobes
         return source
@@ -61,19 +61,48 @@ def _check_model(model: str, name: str) -> None:
 
 
 def baked_source(hub: BlendedMaterial, texture_dir: Path, scratch: Path) -> Source:
-    """Bake the varying parameters of a Disney blend and read the maps from there."""
+    """The varying parameters of a Disney blend: the preset's own files referenced where
+    a parameter is read straight from one (``hub.textures``), the rest baked to maps."""
     from lookdev.pipeline.blend import bake
 
-    files = bake(hub, scratch)
+    referenced = {
+        name: referenced_image(hub, name, ti, texture_dir)
+        for name, ti in hub.textures.items()
+        if referable(ti)
+    }
+    to_bake = dataclasses.replace(
+        hub,
+        maps={k: v for k, v in hub.maps.items() if k not in referenced},
+        normal_map=None if "normal_map" in referenced else hub.normal_map,
+        height_map=None if "height" in referenced else hub.height_map,
+    )
+    files = bake(to_bake, scratch) if to_bake.arrays else {}
 
-    def image(name: str, array: np.ndarray) -> Image:
-        return Image(texture_dir / files[name].name, np.flipud(array), True, files[name])
+    def image(name: str, array: np.ndarray, colour: bool = False) -> Image:
+        space = colour_space_of_bake(colour)
+        return Image(
+            texture_dir / files[name].name,
+            np.flipud(array),
+            True,
+            files[name],
+            colorspace=space,
+            fallback=_mean(array),
+        )
 
-    maps = {name: image(name, array) for name, array in hub.maps.items()}
+    maps = {
+        name: referenced.get(name) or image(name, array, np.ndim(array) == 3)
+        for name, array in hub.maps.items()
+    }
     if "specular" in maps:  # the universal surface reads the same F0 as an IOR
-        ior = specular_to_ior(np.asarray(maps["specular"].pixels, np.float64)).astype(np.float32)
+        spec = np.asarray(hub.maps["specular"], np.float64)
+        ior = np.flipud(specular_to_ior(spec)).astype(np.float32)
         maps["ior"] = Image(texture_dir / f"{hub.name}_ior.exr", ior, write=True)
-    normal = None if hub.normal_map is None else image("normal_map", hub.normal_map)
+    normal = referenced.get("normal_map")
+    if normal is None and hub.normal_map is not None:
+        normal = image("normal_map", hub.normal_map)
+    height = referenced.get("height")
+    if height is None and hub.height_map is not None:
+        height = image("height_map", hub.height_map)
     return Source(
         hub.name,
         hub.model,
@@ -84,7 +113,90 @@ def baked_source(hub: BlendedMaterial, texture_dir: Path, scratch: Path) -> Sour
         description=hub.description,
         notes=_specular_normal_note(hub),
         live=hub.live_lobes,
+        height=height,
     )
+
+
+CHANNEL_OUTPUTS: dict[Any, str] = {
+    **{c: c for c in ("r", "g", "b", "a", "rgb")},
+    **{i: c for i, c in enumerate("rgba")},
+}
+"""TextureInput ``channel`` → the texture output that reads it (every target has these
+five: UsdUVTexture r/g/b/a/rgb, PxrTexture resultR…resultRGB, MaterialX via extract)."""
+
+
+def referable(ti: Any) -> bool:
+    """True when a texture node can read ``ti`` as it is: its channel is one of a
+    texture's five outputs (a named layer such as ``diffuse.R`` is baked instead)."""
+    channel = ti.channel.lower() if isinstance(ti.channel, str) else ti.channel
+    return channel is None or channel in CHANNEL_OUTPUTS
+
+
+def referenced_image(hub: BlendedMaterial, name: str, ti: Any, texture_dir: Path) -> Image:
+    """The preset's own file for parameter ``name``: its colour space, channel, the
+    affine part of its value rule, and the parameter's mean as the fallback."""
+    channel = ti.channel.lower() if isinstance(ti.channel, str) else ti.channel
+    scale, bias = ti.scale, ti.offset
+    if ti.range is not None:  # (x − lo)/(hi − lo)·s + o
+        lo, hi = ti.range
+        scale, bias = ti.scale / (hi - lo), ti.offset - lo * ti.scale / (hi - lo)
+    array = {"normal_map": hub.normal_map, "height": hub.height_map}.get(name)
+    if array is None:
+        array = hub.maps.get(name)
+    colour = array is not None and np.ndim(array) == 3 and name != "normal_map"
+    space = ti.colorspace or default_colorspace(Path(ti.texture), colour)
+    return Image(
+        Path(ti.texture),
+        None if array is None else np.flipud(array),
+        colorspace=space,
+        channel=CHANNEL_OUTPUTS.get(channel, "") if channel is not None else "",
+        scale=float(scale),
+        bias=float(bias),
+        # A missing normal or height map reads as no perturbation, not as the mean.
+        fallback=None if array is None or name in ("normal_map", "height") else _mean(array),
+        wrap=ti.wrap,
+        flip_y=bool(getattr(ti, "flip_y", False)),
+        derived_dir=texture_dir,
+        reference=True,
+    )
+
+
+def default_colorspace(path: Path, colour: bool) -> str:
+    """The colour space of a file its texture input does not name (DESIGN.md, Colour):
+    an 8-bit colour map is sRGB-encoded, a float colour map is in the working space,
+    everything else is data."""
+    from lookdev.materials import colour as cm
+
+    if not colour:
+        return cm.RAW
+    return cm.SRGB_TEXTURE if _bits(path) == 8 else cm.working_space()
+
+
+def _bits(path: Path) -> int:
+    import OpenImageIO as oiio
+
+    from lookdev.pipeline.blend.surface_maps import udim_tiles
+
+    first = next(iter(sorted(udim_tiles(path).values())))
+    image = oiio.ImageInput.open(str(first))
+    if image is None:
+        return 32
+    fmt = str(image.spec().format)
+    image.close()
+    return {"uint8": 8, "int8": 8, "uint16": 16, "half": 16}.get(fmt, 32)
+
+
+def colour_space_of_bake(colour: bool) -> str:
+    """Baked maps hold working-space values (colours) or data."""
+    from lookdev.materials import colour as cm
+
+    return cm.working_space() if colour else cm.RAW
+
+
+def _mean(array: np.ndarray) -> Any:
+    a = np.asarray(array, dtype=np.float64)
+    m = a.reshape(-1, *a.shape[2:]).mean(axis=0)
+    return tuple(float(x) for x in m) if np.ndim(m) else float(m)
 
 
 def _specular_normal_note(blended) -> list[str]:
@@ -98,10 +210,10 @@ def _constants(hub: BlendedMaterial) -> dict[str, Any]:
     """Canonical values: the constants, and for mapped parameters their mean (a fallback)."""
     data = dict(hub.constants)
     data.update({name: hub.mean(name) for name in hub.maps})
-    if "ior" in data and "specular" in data:
+    if "ior" in data and "specular" in data and hub.model == "disney":
         del data["specular"]
     # Means of valid maps and blended constants are valid: not validated again.
-    return canonical(DisneyParams.model_construct(**data))
+    return canonical(hub.bsdf_model.params_type.model_construct(**data))
 
 
 def weights_source(hub: BlendedMaterial, texture_dir: Path) -> Source:

@@ -9,7 +9,6 @@ succeeded, so a failure leaves no partial file (:class:`Staging`).
 from __future__ import annotations
 
 import os
-import shutil
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -19,22 +18,24 @@ from pxr import Gf, Sdf
 
 from lookdev.library import files
 
-from . import mtlx, preview, ri
+from . import mtlx, preview, publish, ri
 from .names import PREVIEW_OPACITY
 from .network import (
     CONTEXT_OUTPUT,
+    DISPLACEMENT_OUTPUT,
     Connection,
     ExportError,
     Image,
+    Interface,
     MaterialSpec,
     Source,
     prim_name,
 )
-from .textures import write_image
 
 BUILDERS = {"universal": preview.build, "mtlx": mtlx.build, "ri": ri.build}
 MTLX_CONFIG_API = "MaterialXConfigAPI"
 SWITCH = "Look"  # the prim whose variant set switches between the exported presets
+ROOT = "Materials"  # the default prim: every material, the switch, preview geometry
 USD_SUFFIXES = (".usda", ".usdc", ".usd")
 
 
@@ -74,6 +75,7 @@ def value_types() -> dict[str, Any]:
         "float2": t.Float2,
         "float3": t.Float3,
         "float4": t.Float4,
+        "color4f": t.Color4f,
         "color3f": t.Color3f,
         "normal3f": t.Normal3f,
         "vector3f": t.Vector3f,
@@ -94,7 +96,7 @@ def usd_value(kind: str, value: Any, base: Path) -> Any:
         return Gf.Vec3f(*value)
     if kind == "float2":
         return Gf.Vec2f(*value)
-    if kind == "float4":
+    if kind in ("float4", "color4f"):
         return Gf.Vec4f(*value)
     if kind == "float":
         return float(value)
@@ -147,11 +149,19 @@ def _author_material(layer, scope, spec: MaterialSpec, base: Path, types: dict[s
         _attribute(
             layer, version, types["string"], Sdf.VariabilityUniform
         ).default = mtlx.mtlx_version()
+    for name, (kind, value) in spec.interface().items():
+        attr = _attribute(layer, path.AppendProperty(f"inputs:{name}"), types[kind])
+        attr.default = usd_value(kind, value, base)
     for net in spec.networks:
         output = path.AppendProperty(f"outputs:{CONTEXT_OUTPUT[net.context]}")
         _attribute(layer, output, types["token"]).connectionPathList.explicitItems = [
             _output_path(path, net.terminal)
         ]
+        if net.displacement is not None:
+            output = path.AppendProperty(f"outputs:{DISPLACEMENT_OUTPUT[net.context]}")
+            _attribute(layer, output, types["token"]).connectionPathList.explicitItems = [
+                _output_path(path, net.displacement)
+            ]
         for node in net.nodes:
             shader = Sdf.PrimSpec(prim, node.name, Sdf.SpecifierDef, "Shader")
             if any(node.custom.values()):
@@ -163,8 +173,17 @@ def _author_material(layer, scope, spec: MaterialSpec, base: Path, types: dict[s
                 attr = _attribute(layer, at(f"inputs:{name}"), types[kind])
                 if isinstance(value, Connection):
                     attr.connectionPathList.explicitItems = [_output_path(path, value)]
+                elif isinstance(value, Interface):
+                    # Connected to the Material's interface (which wins); the value
+                    # stays here too for readers that do not follow connections.
+                    attr.connectionPathList.explicitItems = [
+                        path.AppendProperty(f"inputs:{value.name}")
+                    ]
+                    attr.default = usd_value(kind, value.value, base)
                 else:
                     attr.default = usd_value(kind, value, base)
+                if name in node.color_spaces:
+                    attr.SetInfo("colorSpace", node.color_spaces[name])
             for name, kind in node.outputs.items():
                 Sdf.JustCreatePrimAttributeInLayer(layer, at(f"outputs:{name}"), types[kind])
     return path
@@ -181,12 +200,14 @@ def _output_path(material_path, conn: Connection):
 
 
 def add_switch(layer, targets: dict[str, tuple[str, str]]) -> None:
-    """A ``/Look`` material whose variant set ``preset`` references each target.
+    """A ``/Materials/Look`` material (under the default prim, so a reference to the
+    file brings it) whose variant set ``preset`` references each target.
 
     ``targets`` maps a variant name to ``(asset path or "" for this layer, prim path)``.
     """
     with Sdf.ChangeBlock():
-        look = Sdf.PrimSpec(layer.pseudoRoot, SWITCH, Sdf.SpecifierDef, "Material")
+        root = layer.GetPrimAtPath(f"/{ROOT}")
+        look = Sdf.PrimSpec(root, SWITCH, Sdf.SpecifierDef, "Material")
         look.customData = {"lookdev": {"switch": True}}
         vset = Sdf.VariantSetSpec(look, "preset")
         for name, (asset, prim_path) in targets.items():
@@ -238,10 +259,16 @@ def images_of(specs: list[MaterialSpec]) -> list[Image]:
 
 
 def check_images(images: list[Image]) -> None:
-    """Every referenced image that the export does not write itself must exist."""
+    """Every image the export reads (a preset's own file, referenced or collected) must
+    exist (a UDIM set: at least one tile)."""
     for image in images:
-        if not image.write and not image.path.is_file():
-            raise ExportError("texture does not exist", where=str(image.path))
+        path = image.origin if image.reference and image.write else image.path
+        if image.write and not image.reference:
+            continue
+        if image.udim and not publish.tile_files(path):
+            raise ExportError("no UDIM tile of this texture exists", where=str(path))
+        if not image.udim and not path.is_file():
+            raise ExportError("texture does not exist", where=str(path))
 
 
 @dataclass
@@ -276,6 +303,8 @@ def export_usd(
     split_dir: Path | None = None,
     workdir: Path | None = None,
     preview_opacity: str = "keep",
+    collect: bool = False,
+    preview_geometry: bool = False,
 ) -> ExportResult:
     """Export ``sources`` to ``out`` (``.usda``/``.usdc``/``.usd``, or ``.usdz`` to package).
 
@@ -283,7 +312,9 @@ def export_usd(
     ``mtlx_path``: also a standalone MaterialX document. ``workdir`` (packages): where the
     stage is staged before packaging; textures below it keep their path relative to it
     inside the ``.usdz``. ``preview_opacity``: see :data:`.names.PREVIEW_OPACITY`.
-    Nothing is left behind on error.
+    ``collect``: copy the presets' own texture files into ``<out stem>_textures`` beside
+    ``out`` (a package always does). ``preview_geometry``: a sphere per material bound
+    to it. Nothing is left behind on error.
     """
     out = Path(out)
     package = package or out.suffix == ".usdz"
@@ -306,13 +337,21 @@ def export_usd(
         )
     specs = [material_spec(s, contexts, preview_opacity) for s in sources]
     _check_names(specs, out)
+    if package:
+        publish.collect(specs, Path(workdir or out.parent) / f"{out.stem}_textures")
+        publish.for_package(specs)
+    elif collect:
+        publish.collect(specs, out.parent / f"{out.stem}_textures")
     images = images_of(specs)
     check_images(images)
+    layout = {"name": out.name, "geometry": preview_geometry}
     with Staging() as staging:  # commits on success; removes every temporary otherwise
         if package:
-            written = _write_package(specs, images, out, Path(workdir or out.parent), staging)
+            written = _write_package(
+                specs, images, out, Path(workdir or out.parent), staging, layout
+            )
         else:
-            written = _write_all(specs, images, out, split_dir, staging)
+            written = _write_all(specs, images, out, split_dir, staging, layout)
         if mtlx_path is not None:
             mtlx.write_document(specs, staging.temp_for(Path(mtlx_path)), where=mtlx_path)
             written.append(Path(mtlx_path))
@@ -335,35 +374,35 @@ def _check_names(specs: list[MaterialSpec], out: Path) -> None:
         raise ExportError("no materials to export", where=str(out))
 
 
-def _write_all(specs, images, out, split_dir, staging) -> list[Path]:
+def _write_all(specs, images, out, split_dir, staging, layout) -> list[Path]:
+    files = [out]
     for image in images:
         if image.write:
             staging.folder(image.path.parent)
-            _write_image(image, staging.temp_for(image.path), image.path)
-    files = [out, *(i.path for i in images if i.write)]
+            files += publish.write_image(image, staging.temp_for, image.path)
     if split_dir is not None:
         staging.folder(Path(split_dir))
-        return files + _write_split(specs, out, Path(split_dir), staging)
-    layer = _one_layer(specs, out.parent)
+        return files + _write_split(specs, out, Path(split_dir), staging, layout)
+    layer = _one_layer(specs, out.parent, layout)
     _export_layer(layer, staging.temp_for(out), out)
     return files
 
 
-def _write_package(specs, images, out: Path, workdir: Path, staging: Staging) -> list[Path]:
+def _write_package(specs, images, out: Path, workdir: Path, staging: Staging, layout):
     """A ``.usdz`` holding the stage and every texture it references."""
     from pxr import UsdUtils
 
     for image in images:
         if image.write:
             image.path.parent.mkdir(parents=True, exist_ok=True)
-            _write_image(image, image.path)
+            publish.write_image(image, lambda p: p, image.path)
     root = workdir / f"{out.stem}.usdc"  # the package's root layer keeps the output's name
     if root.exists():  # not a private folder: never overwrite what is there
         fd, name = tempfile.mkstemp(prefix=f".{out.stem}.", suffix=".usdc", dir=workdir)
         os.close(fd)
         root = Path(name)
     try:
-        _export_layer(_one_layer(specs, workdir), root)
+        _export_layer(_one_layer(specs, workdir, layout), root)
         if not UsdUtils.CreateNewUsdzPackage(str(root), str(staging.temp_for(out))):
             raise ExportError("USD could not write the package", where=str(out))
     finally:
@@ -371,23 +410,24 @@ def _write_package(specs, images, out: Path, workdir: Path, staging: Staging) ->
     return [out]
 
 
-def _one_layer(specs: list[MaterialSpec], base: Path):
-    """Every material in one layer, with the ``/Look`` switch when there are several."""
+def _one_layer(specs: list[MaterialSpec], base: Path, layout: dict[str, Any]):
+    """Every material in one layer, with the ``Look`` switch when there are several, the
+    asset's metadata and, if asked, preview geometry."""
     layer = new_layer()
     paths = author(layer, specs, base)
     if len(specs) > 1:
         add_switch(layer, {prim_name(s.name): ("", p) for s, p in zip(specs, paths, strict=True)})
+    _finish(layer, paths, layout)
     return layer
 
 
-def _write_image(image: Image, target: Path, shown: Path | None = None) -> None:
-    if image.origin is not None:
-        shutil.copyfile(image.origin, target)
-    else:
-        write_image(target, image.pixels, shown)
+def _finish(layer, paths: list[str], layout: dict[str, Any]) -> None:
+    publish.asset_metadata(layer, ROOT, layout["name"], len(paths))
+    if layout["geometry"]:
+        publish.add_preview_geometry(layer, ROOT, paths)
 
 
-def _write_split(specs, out: Path, folder: Path, staging: Staging) -> list[Path]:
+def _write_split(specs, out: Path, folder: Path, staging: Staging, layout) -> list[Path]:
     files, targets = [], {}
     library = new_layer()
     scope = Sdf.CreatePrimInLayer(library, "/Materials")
@@ -397,6 +437,7 @@ def _write_split(specs, out: Path, folder: Path, staging: Staging) -> list[Path]
         path = folder / f"{name}.usda"
         layer = new_layer()
         (prim_path,) = author(layer, [spec], folder)
+        publish.asset_metadata(layer, ROOT, path.name, 1)
         _export_layer(layer, staging.temp_for(path), path)
         asset = relative_asset(path, out.parent)
         ref = Sdf.PrimSpec(scope, name, Sdf.SpecifierDef, "Material")
@@ -404,6 +445,7 @@ def _write_split(specs, out: Path, folder: Path, staging: Staging) -> list[Path]
         targets[name] = (asset, prim_path)
         files.append(path)
     add_switch(library, targets)
+    _finish(library, [f"/{ROOT}/{name}" for name in targets], layout)
     _export_layer(library, staging.temp_for(out), out)
     return files
 

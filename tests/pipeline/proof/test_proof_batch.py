@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from lookdev.materials.colour import luminance
-from lookdev.pipeline.proof import batch, ibl, shaderball, turntable
+from lookdev.pipeline.proof import batch, ibl, passes, shaderball, turntable
 
 pytestmark = pytest.mark.render
 
@@ -75,10 +75,10 @@ def test_frames_after_the_first_reuse_every_compiled_kernel(mitsuba):
     table = _table(mitsuba)
     dr.set_flag(dr.JitFlag.KernelHistory, True)
     try:
-        turntable.render_frame(table, turntable.Frame(0, "element", 0.0), 4)
+        passes.render_frame(table, turntable.Frame(0, "element", 0.0), spp=4)
         dr.kernel_history()  # drain the first frame's compilations
         for frame in turntable.frames(2, 2)[1:]:
-            turntable.render_frame(table, frame, 4)
+            passes.render_frame(table, frame, spp=4)
         jit = [k for k in dr.kernel_history() if str(k["type"]).endswith("JIT")]
     finally:
         dr.set_flag(dr.JitFlag.KernelHistory, False)
@@ -169,16 +169,16 @@ def test_half_sample_noise_estimate_matches_the_true_error(mitsuba):
     frame = turntable.Frame(0, "element", 0.0)
     table.set_frame(frame)
     reference = luminance(table.render(1024, seed=99))
-    r = turntable.render_frame(table, frame, 8)
+    r = passes.render_frame(table, frame, spp=8)
     true_rmse = float(np.sqrt(np.mean((luminance(r.image) - reference) ** 2)))
     assert 0.7 < r.noise_rmse / true_rmse < 1.4
-    assert r.seconds > 0 and r.noise_relative > 0
+    assert r.seconds > 0 and r.noise > 0
 
 
 def test_a_black_frame_has_no_relative_noise(mitsuba):
     table = turntable.Turntable(DIFFUSE, np.zeros((16, 32, 3), np.float32), (16, 8), 3)
-    r = turntable.render_frame(table, turntable.Frame(0, "element", 0.0), 2)
-    assert r.noise_rmse == 0.0 and r.noise_relative is None
+    r = passes.render_frame(table, turntable.Frame(0, "element", 0.0), spp=2)
+    assert r.noise_rmse == 0.0 and r.noise is None and r.firefly_share is None
 
 
 # -- jobs and resumption -------------------------------------------------------------------
@@ -196,8 +196,10 @@ def test_a_job_writes_frames_sheet_and_manifest(mitsuba, gold, tmp_path):
     assert manifest["ibl_orientation"] == ibl.ORIENTATION  # the convention, stated
     assert manifest["rig"]["rig"] == "full" and manifest["rig"]["grey_albedo"] == 0.18
     for f in manifest["frames"]:
-        assert f["seconds"] > 0 and f["noise_rmse"] > 0
-        assert (folder / f["exr"]["file"]).stat().st_size == f["exr"]["size"]
+        assert f["time_s"] > 0 and f["noise_rmse"] > 0
+        raw = f["files"]["raw"]
+        assert raw["file"] == f["images"]["raw"]
+        assert (folder / raw["file"]).stat().st_size == raw["size"]
     assert (folder / "contact.png").is_file()
     assert not [p for p in folder.iterdir() if p.name.startswith(".")], "temporaries left"
 

@@ -117,14 +117,18 @@ def test_plain_diffuse_has_no_clearcoat_sheen_or_transmission(tmp_path):
         "inputs:roughness",
         "outputs:bxdf_out",
     ]
-    # the Material: three outputs and MaterialXConfigAPI's config:mtlx:version
+    # the Material: its interface (the values every context reads, one override for
+    # all), three outputs and MaterialXConfigAPI's config:mtlx:version
     assert attrs["/Materials/plaster"] == [
         "config:mtlx:version",
+        "inputs:base_color",
+        "inputs:ior",
+        "inputs:roughness",
         "outputs:mtlx:surface",
         "outputs:ri:surface",
         "outputs:surface",
     ]
-    assert sum(len(v) for v in attrs.values()) == 4 + 4 + 4 + 5
+    assert sum(len(v) for v in attrs.values()) == 4 + 4 + 5 + 7
 
 
 @pytest.mark.parametrize("specular", [0.0, 0.3, 0.5, 2.0])
@@ -182,7 +186,7 @@ def test_variant_set_switches_presets_on_one_prim(tmp_path):
     out = tmp_path / "lib.usda"
     export_usd(sources, out, contexts=("universal",))
     stage = Usd.Stage.Open(str(out))
-    look = stage.GetPrimAtPath("/Look")
+    look = stage.GetPrimAtPath("/Materials/Look")
     vset = look.GetVariantSets().GetVariantSet("preset")
     assert sorted(vset.GetVariantNames()) == ["blue", "red"]
     for name, colour in (("red", (1, 0, 0)), ("blue", (0, 0, 1))):
@@ -253,7 +257,9 @@ def test_package_holds_stage_and_textures(tmp_path):
     with zipfile.ZipFile(tmp_path / "r.usdz") as z:
         names = z.namelist()
     assert names[0].endswith(".usdc")
-    assert sum(n.endswith(".exr") for n in names) == len(result.images)
+    # ARKit reads PNG and JPEG only: maps go in as PNG, none as EXR
+    assert sum(n.endswith(".png") for n in names) == len(result.images)
+    assert not any(n.endswith(".exr") for n in names)
     assert all(n.startswith("tex/") for n in names[1:])  # packaged by their path from the stage
     assert validate_usd(tmp_path / "r.usdz").ok
 
@@ -329,3 +335,10 @@ def test_texture_mask_and_normal_map_live(tmp_path):
     assert normal.GetAttribute("inputs:sourceColorSpace").Get() == "raw"
     loss = stage.GetPrimAtPath("/Materials/scuffed/mtlx_surface").GetCustomDataByKey("lookdev:loss")
     assert "no normal input" in loss
+    # --collect: the mask file is copied beside the export, referenced relatively
+    export_usd([source], out_dir / "c.usda", collect=True)
+    assert (out_dir / "c_textures" / "mask.exr").read_bytes() == (src / "mask.exr").read_bytes()
+    stage = Usd.Stage.Open(str(out_dir / "c.usda"))
+    mask = stage.GetPrimAtPath("/Materials/scuffed/mtlx_mask_1").GetAttribute("inputs:file")
+    assert mask.Get().path == "./c_textures/mask.exr"
+    assert validate_usd(out_dir / "c.usda").ok

@@ -1,0 +1,180 @@
+"""What every turntable of a proof batch shares, its defaults and their allowed ranges.
+
+The one home of the proof options: :class:`Settings` is what the batch hashes into each
+proof's key (so changing any of them re-renders), what the manifests record, and what
+``lookdev proof`` and :func:`lookdev.proof` fill in; :func:`check` holds every range.
+
+Sampling is either a fixed count (``spp``: one pass, the manifests' ``stop`` reads
+``"spp"``) or a noise target (``noise``: passes until the estimated relative noise of the
+frame is at most it, or ``max_spp`` / ``time_budget`` is reached; :mod:`.passes`).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass
+from typing import Any
+
+from lookdev.materials.errors import LookdevError, check_range
+
+from . import shaderball
+from .rig import DEFAULT_RIG, RIGS
+from .turntable import Frame, frames
+
+__all__ = [
+    "DEFAULT_MAX_SPP",
+    "DEFAULT_NOISE",
+    "DEFAULT_RESOLUTION",
+    "MAX_SAMPLES",
+    "MAX_SIDE",
+    "MIN_SIDE",
+    "ProofError",
+    "Settings",
+    "check",
+]
+
+DEFAULT_NOISE = 0.05
+"""The relative-noise target of a proof when no ``spp`` is given: 5 % RMS, clean grain."""
+DEFAULT_MAX_SPP = 8
+"""The sample cap of a frame rendered to a noise target, unless ``max_spp`` is given.
+Chosen by measurement (README, "Noise target"; ``lookdev bench noise``): at 480×240 a cap
+of 8 keeps the main job at ≈ 1.2× the old default's time (192×96, 32 spp, Gaussian);
+16 would be ≈ 2.3×. Few frames of the main job reach 5 % within 8 spp, and their
+manifests say so (``stop: "max_spp"``); ``--max-spp`` buys the rest."""
+DEFAULT_RESOLUTION = (480, 240)
+"""Frame width and height of a proof: big enough to judge a texture."""
+MIN_SIDE, MAX_SIDE = 8, 8192
+"""Frame width and height of a proof, in pixels (``--resolution W H``)."""
+MAX_SAMPLES = 2**32 - 1
+"""Most samples one render may take, width × height × spp: Dr.Jit indexes a render's
+wavefront with 32-bit integers (a noise-target pass is small; a fixed ``spp`` is one)."""
+MAX_SPP = 65536
+RANGES: dict[str, tuple[float, float]] = {
+    "--frames": (1, 360),
+    "--light-frames": (0, 360),
+    "--spp": (2, MAX_SPP),
+    "--noise": (1e-4, 10.0),
+    "--max-spp": (2, 2**20),
+    "--time-budget": (0.01, 86400.0),
+    "--clamp": (1e-3, 1e9),
+}
+"""Allowed ranges of the numeric proof options, inclusive (NaN and infinity never)."""
+
+
+class ProofError(LookdevError):
+    """A proof cannot run as asked (output folder, settings, scheduler)."""
+
+
+@dataclass(frozen=True)
+class Settings:
+    """What every turntable of a batch shares.
+
+    Give ``spp`` for a fixed count, or nothing / ``noise`` for a noise target (then
+    ``max_spp`` defaults to :data:`DEFAULT_MAX_SPP`); :meth:`__post_init__` fills the
+    defaults, so a manifest always spells out what ran.
+    """
+
+    element_frames: int = 8
+    light_frames: int = 8
+    spp: int | None = None
+    resolution: tuple[int, int] = DEFAULT_RESOLUTION
+    exposure: float = 0.0  # display only: applied by the view transform, not the render
+    noise: float | None = None
+    max_spp: int | None = None
+    time_budget: float | None = None  # seconds of rendering per frame
+    clamp: float | None = None  # None: unclamped (the default; see .clamp)
+    pixel_filter: str = "box"
+    geometry: str | None = None
+    """A mesh in the cup's place (the cached PLY of :func:`.geometry.proof_mesh`: its
+    name holds the hash of the user's file, so the proof key follows the mesh)."""
+    rig: str = DEFAULT_RIG  # the calibrated rig beside the material (.rig)
+
+    def __post_init__(self) -> None:
+        if self.spp is not None:
+            extra = [
+                name
+                for name, value in (
+                    ("--noise", self.noise),
+                    ("--max-spp", self.max_spp),
+                    ("--time-budget", self.time_budget),
+                )
+                if value is not None
+            ]
+            if extra:
+                raise ProofError(
+                    f"--spp is a fixed count; {', '.join(extra)} go with a noise target "
+                    "(drop --spp)",
+                    field="--spp",
+                )
+            return
+        if self.noise is None:
+            object.__setattr__(self, "noise", DEFAULT_NOISE)
+        if self.max_spp is None:
+            object.__setattr__(self, "max_spp", DEFAULT_MAX_SPP)
+
+    def frames(self) -> list[Frame]:
+        return frames(self.element_frames, self.light_frames)
+
+    def sampling(self) -> dict[str, Any]:
+        """The keyword arguments of :func:`.passes.render_frame` these settings ask for."""
+        if self.spp is not None:
+            return {"spp": self.spp}
+        return {"noise": self.noise, "max_spp": self.max_spp, "time_budget": self.time_budget}
+
+    def as_json(self) -> dict[str, Any]:
+        """The settings as they read back from a manifest (lists, not tuples)."""
+        return json.loads(json.dumps(asdict(self)))
+
+
+def check(settings: Settings, jobs: int | None = None) -> Settings:
+    """Every setting in its documented range, or one :class:`ProofError` line."""
+    from . import tonemap
+
+    s = settings
+    if len(tuple(s.resolution)) != 2:
+        raise ProofError(f"{tuple(s.resolution)} is not W H", field="--resolution")
+    for side in s.resolution:
+        check_range(side, MIN_SIDE, MAX_SIDE, field="--resolution", error=ProofError)
+    values = {
+        "--frames": s.element_frames,
+        "--light-frames": s.light_frames,
+        "--spp": s.spp,
+        "--noise": s.noise,
+        "--max-spp": s.max_spp,
+        "--time-budget": s.time_budget,
+        "--clamp": s.clamp,
+    }
+    for name, value in values.items():
+        if value is not None:
+            check_range(value, *RANGES[name], field=name, error=ProofError)
+    if jobs is not None:
+        check_range(jobs, 1, 1024, field="--workers", error=ProofError)
+    check_range(
+        s.exposure,
+        -tonemap.EXPOSURE_MAX,
+        tonemap.EXPOSURE_MAX,
+        field="--exposure",
+        error=ProofError,
+    )
+    if s.rig not in RIGS:
+        raise ProofError(f"unknown rig {s.rig!r}; use {', '.join(RIGS)}", field="--rig")
+    if s.pixel_filter not in shaderball.PIXEL_FILTERS:
+        raise ProofError(
+            f"{s.pixel_filter!r} is not one of {', '.join(shaderball.PIXEL_FILTERS)}",
+            field="--pixel-filter",
+        )
+    spp = s.spp if s.spp is not None else min(s.max_spp, _pass_spp())
+    samples = s.resolution[0] * s.resolution[1] * spp
+    if samples > MAX_SAMPLES:
+        raise ProofError(
+            f"{s.resolution[0]}×{s.resolution[1]} at {spp} spp is {samples:.3g} samples a "
+            f"frame; allowed ≤ {MAX_SAMPLES:.3g} (lower --spp or --resolution)",
+            field="--resolution",
+        )
+    return s
+
+
+def _pass_spp() -> int:
+    from .passes import PASS_SPP
+
+    return PASS_SPP
