@@ -55,8 +55,13 @@ def test_a_thick_slab_reflects_its_base_colour_within_the_documented_error():
 
 
 def test_subsurface_proofs_trace_the_measured_depth():
-    from lookdev.pipeline.export.mitsuba.depth import DEPTH_SUBSURFACE, max_depth_for
+    from lookdev.pipeline.export.mitsuba.depth import (
+        DEPTH_SUBSURFACE,
+        DEPTH_SUBSURFACE_BRIGHT,
+        max_depth_for,
+    )
 
     assert max_depth_for(lookdev.blend(lookdev.load("skin"), 16)) == DEPTH_SUBSURFACE
+    assert max_depth_for(lookdev.blend(lookdev.load("marble"), 16)) == DEPTH_SUBSURFACE_BRIGHT
     thin = DisneyParams(thin=True, scatter_distance=0.1, diff_trans=0.5)
     assert max_depth_for(thin) < DEPTH_SUBSURFACE  # thin sheets keep their class
