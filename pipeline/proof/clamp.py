@@ -29,8 +29,8 @@ def integrator(
     if clamp is None:
         return inner
     register()
-    return {"type": PLUGIN, "max_depth": int(max_depth), "clamp": float(clamp),
-            "inner": inner["type"]}  # fmt: skip
+    out = {"type": PLUGIN, "max_depth": int(max_depth), "clamp": float(clamp)}
+    return out if inner["type"] == "path" else out | {"inner": inner["type"]}
 
 
 def register() -> None:

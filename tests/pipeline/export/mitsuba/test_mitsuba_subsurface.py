@@ -34,6 +34,8 @@ def test_the_proof_puts_the_medium_in_ball_and_cup_at_its_scale():
     assert scene["cup_shape"]["shape"]["interior"] is inside
     plain = shaderball.scene_dict({"type": "diffuse"}, env, (8, 8), 4)
     assert plain["integrator"]["type"] == "path"
+    clamped = shaderball.scene_dict({"type": "diffuse"}, env, (8, 8), 4, clamp=4.0, interior=inside)
+    assert clamped["integrator"]["inner"] == "volpath"
     assert material_interior(lookdev.blend(lookdev.load("plaster"), 16)) is None
 
 
