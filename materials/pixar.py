@@ -51,6 +51,7 @@ from .pixar_scatter import (
     PIXAR_LOBES,
     PREFIX,
     at_view,
+    delta_lobes,
     prepared,
     scatter_eval,
     scatter_pdf,
@@ -267,7 +268,13 @@ def _prepare(xp: Any, params: PixarParams, **maps: Any) -> dict[str, Any]:
     p_r = lobes.power_reflection(xp, r, v["reflection_cone_scale"])
     powers = {"specular": p_s, "specular_t": p_s, "reflection": p_r, "reflection_t": p_r}
     eta = xp.scalar(maps.get("ior", params.eta))
-    return prepared(xp, ends(xp, view_independent(xp, v)), powers, eta)
+    c_s = specular_cone(r, v["specular_cone_scale"])
+    c_r = reflection_cone(r, v["reflection_cone_scale"])
+    cones = {"specular": c_s, "specular_t": c_s, "reflection": c_r, "reflection_t": c_r}
+    falls = {"specular": r * LN_10, "specular_t": r * LN_10}
+    falls.update(reflection=LN_10, reflection_t=LN_10)
+    delta = delta_lobes(cones, falls)
+    return prepared(xp, ends(xp, view_independent(xp, v)), powers, eta, delta)
 
 
 def _prepare_weights(xp: Any, params: Any, **maps: Any) -> dict[str, Any]:
@@ -286,11 +293,13 @@ def _prepare_weights(xp: Any, params: Any, **maps: Any) -> dict[str, Any]:
             g = getattr(params, name + GRAZING)
             g = None if g is None or (name not in maps and g == n) else xp.color(g)
         pairs[name] = (xp.color(n), g)
-    powers = {}
+    powers, cones, falls = {}, {}, {}
     for lobe in CONE_LOBES:
         falloff = _scalar(xp, params, maps, f"{lobe}_falloff") if lobe in FALLOFF_LOBES else LN_10
-        powers[lobe] = lobes.cone_power(xp, falloff, _scalar(xp, params, maps, f"{lobe}_cone"))
-    return prepared(xp, pairs, powers, _scalar(xp, params, maps, "ior"))
+        cones[lobe], falls[lobe] = _scalar(xp, params, maps, f"{lobe}_cone"), falloff
+        powers[lobe] = lobes.cone_power(xp, falloff, cones[lobe])
+    eta = _scalar(xp, params, maps, "ior")
+    return prepared(xp, pairs, powers, eta, delta_lobes(cones, falls))
 
 
 def _scalar(xp: Any, params: Any, maps: dict[str, Any], name: str) -> Any:
@@ -320,13 +329,38 @@ LAYERED_MODEL = Model(
 
 
 # -- public numpy API ----------------------------------------------------------------------
-def lobe_weights(params: PixarParams, cos_view: Any = 1.0) -> dict[str, np.ndarray]:
-    """Smits' twelve weights by his names, each an RGB colour (shape (3,) or (..., 3))."""
+def lobe_weights(
+    params: PixarParams, cos_view: Any = 1.0, maps: dict[str, Any] | None = None
+) -> dict[str, np.ndarray]:
+    """Smits' twelve weights by his names, each an RGB colour (shape (3,) or (..., 3)).
+
+    ``maps`` give parameters per texel (scalars (...), colours (..., 3), one leading shape);
+    the view is then one ``cos_view`` and the weights are (..., 3) over the texels.
+    """
     xp = NumpyOps()
     c = np.asarray(cos_view, dtype=np.float64)
+    if maps:
+        lead = next(np.shape(v)[: np.ndim(v) - (k in _COLORS)] for k, v in maps.items())
+        flat = {
+            k: np.reshape(v, (-1, 3)).T if k in _COLORS else np.reshape(v, -1)
+            for k, v in maps.items()
+        }
+        w = weights(xp, view_independent(xp, _values(xp, params, flat)), c.reshape(-1))
+        size = int(np.prod(lead))
+        return {k: np.broadcast_to(np.asarray(w[k]), (3, size)).T.reshape(*lead, 3) for k in w}
     w = weights(xp, view_independent(xp, _values(xp, params, {})), c.reshape(-1))
     shape = (*c.shape, 3)
     return {k: np.broadcast_to(np.asarray(w[k]).T, (c.size, 3)).reshape(shape) for k in w}
+
+
+def eta_of(params: PixarParams, maps: dict[str, Any] | None = None) -> Any:
+    """:attr:`PixarParams.eta` where ``ior`` or ``normal_fresnel`` may be per-texel maps."""
+    maps = maps or {}
+    if "ior" in maps:
+        return np.asarray(maps["ior"], dtype=np.float64)
+    if "normal_fresnel" in maps and params.ior is None:
+        return f0_to_ior(DIELECTRIC_REFL * np.asarray(maps["normal_fresnel"], dtype=np.float64))
+    return params.eta
 
 
 def as_lobe_weights(params: PixarParams) -> Any:

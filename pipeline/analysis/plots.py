@@ -200,7 +200,7 @@ def draw_albedo(ax: Any, hub: BlendedMaterial) -> None:
 def polar_curves(
     model: Model, params: Any, incidence_deg: Sequence[float] = (0, 30, 60, 80), n: int = 361
 ) -> tuple[np.ndarray, np.ndarray]:
-    """θo in (−90°, 90°) and the Rec.709 luminance of f for each incidence angle, (A, n).
+    """θo in (−90°, 90°) and the luminance (working space) of f for each incidence angle, (A, n).
 
     The light is at −θi in the x-z plane, so the mirror direction is θo = +θi.
     """
@@ -259,6 +259,15 @@ def draw_sphere(ax: Any, image: np.ndarray, exposure: float, title: str) -> None
 
 
 # -- figure --------------------------------------------------------------------------
+def at_uv(hub: BlendedMaterial, uv: tuple[float, float]) -> BlendedMaterial:
+    """``hub`` as the uniform material it is at ``uv`` (every plot then shows that texel);
+    a layered Pixar hub (lobe weights, not parameters) keeps its maps."""
+    if not hub.maps or hub.representation != "params":
+        return hub
+    u, v = uv
+    return BlendedMaterial.of_params(hub.params_at_uv(u, v), name=f"{hub.name} @ uv ({u:g}, {v:g})")
+
+
 def figure(
     hubs: Sequence[BlendedMaterial],
     view: str,

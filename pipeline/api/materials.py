@@ -159,7 +159,9 @@ def blend(
     material
         A preset name or path, or a :class:`~lookdev.library.Material`.
     resolution
-        Texels a side, or ``(width, height)``.
+        Texels a side, or ``(width, height)``, of each UV square: a material whose textures
+        are UDIM sets gets maps over every tile (a 2 × 2 set at 1024: 2048 × 2048), with
+        ``uv_extent`` and ``tiles`` saying which.
     layering
         Pixar stacks: ``"full"`` (light through a layer meets the ones below, Smits'
         table) or ``"simple"`` (A over B).
@@ -173,9 +175,11 @@ def blend(
     Returns
     -------
     lookdev.pipeline.blend.BlendedMaterial
-        ``maps[name][row, col]`` is the texel centred on ``((col + ½)/W, (row + ½)/H)``;
-        ``params_at(row, col)`` the parameters there. A layered Pixar material blends to
-        Smits' lobe weights (``representation == "lobe_weights"``).
+        ``maps[name][row, col]`` is the texel centred on ``((col + ½)/W, (row + ½)/H)``
+        (over ``uv_extent``); ``params_at(row, col)`` the parameters there,
+        ``params_at_uv(u, v)`` at a UV. Parameters read straight from one unchanged
+        image are also in ``textures`` (the file, for exporters). A layered Pixar
+        material blends to Smits' lobe weights (``representation == "lobe_weights"``).
 
     Examples
     --------
@@ -255,9 +259,7 @@ def _texels(blended: Any, uv: Any, lead: tuple[int, ...]) -> tuple[np.ndarray, n
     uv = np.broadcast_to(np.asarray(uv, dtype=np.float64), (*lead, 2))
     if not np.isfinite(uv).all():
         raise MaterialError("uv holds NaN or infinite values", where=blended.name, field="uv")
-    width, height = blended.resolution
-    cols = np.floor(uv[..., 0] * width).astype(np.intp) % width
-    rows = np.floor(uv[..., 1] * height).astype(np.intp) % height
+    rows, cols = blended.texel(uv)
     return rows, cols
 
 
@@ -348,13 +350,22 @@ def pdf(material: Any, wi: Any, wo: Any, uv: Any = None, *, dtype: Any = np.floa
 
 
 def sample(
-    material: Any, wo: Any, u: Any, uv: Any = None, *, dtype: Any = np.float64
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    material: Any,
+    wo: Any,
+    u: Any,
+    uv: Any = None,
+    *,
+    dtype: Any = np.float64,
+    delta: bool = False,
+) -> tuple[np.ndarray, ...]:
     """Draw a light direction for the view ``wo``: ``(wi, weight, pdf)``.
 
     ``u`` holds three uniforms in [0, 1) per element, ``(..., 3)``: the first picks the
     lobe, the other two the direction. ``weight`` is ``f · |cos θi| / pdf`` ``(..., 3)``;
     a failed sample has ``pdf`` 0 and ``weight`` 0. Other arguments as :func:`evaluate`.
+    A smooth lobe (roughness below √10⁻³: glass, water, a mirror) is a delta: its
+    samples have the probability of the lobe's choice as ``pdf``, and :func:`evaluate`
+    and :func:`pdf` leave it out; ``delta=True`` adds a fourth array marking them.
 
     >>> import numpy as np, lookdev
     >>> wi, weight, p = lookdev.sample("gold", [0, 0, 1.0], np.full((5, 3), 0.5))
@@ -365,4 +376,5 @@ def sample(
 
     lead = _lead(uv, wo=wo, u=u)
     model, params, maps = _bsdf(material, uv, lead)
-    return draw(model, params, _full(wo, lead, dtype), _full(u, lead, dtype), dtype=dtype, **maps)
+    wo, u = _full(wo, lead, dtype), _full(u, lead, dtype)
+    return draw(model, params, wo, u, dtype=dtype, delta=delta, **maps)

@@ -37,7 +37,8 @@ def plot(
             help="slice: f(θh, θd) at φd = 90° (left edge = specular peak, top = Fresnel "
             "peak). albedo: directional albedo per channel vs incidence angle. polar: f in "
             "the plane of incidence for θi = 0, 30, 60, 80°. sphere: a lit sphere under a "
-            "point light (and under --ibl).",
+            "point light (and under --ibl). (The OCIO display view is the global option: "
+            "`lookdev --view Un-tone-mapped plot …`.)",
         ),
     ] = View.slice,
     exposure: Annotated[
@@ -66,6 +67,12 @@ def plot(
         list[Path] | None,
         typer.Option("--library", "-L", help="Extra preset folders searched before the built-ins."),
     ] = None,
+    uv: Annotated[
+        tuple[float, float] | None,
+        typer.Option(
+            "--uv", help="Plot a texture-driven material as it is at this UV (default: centre)."
+        ),
+    ] = None,
     as_json: Annotated[
         bool, typer.Option("--json", help="Print one JSON object for scripts.")
     ] = False,
@@ -77,6 +84,8 @@ def plot(
       lookdev plot gold copper --view albedo -o metals.png
 
       lookdev plot velvet --view sphere --ibl studio -o velvet.png --exposure -1
+
+      lookdev --view Un-tone-mapped plot gold -o gold.png    # another OCIO view (global)
     """
     from lookdev.pipeline import api
 
@@ -89,6 +98,7 @@ def plot(
             ibl=ibl,
             resolution=resolution,
             library=library,
+            uv=uv,
         )
     if as_json:
         print_json(result.to_json())
