@@ -9,7 +9,10 @@ w_g = (1 − metallic)·spec_trans:
                 Schutte's f_lambert(1 − F_L/2)(1 − F_V/2) + f_retro; ``flatness`` (thin only)
                 blends f_lambert towards Hanrahan-Krueger; ``subsurface`` (2012) blends the
                 whole shape towards it as the BRDF Explorer does]
-``diff_trans``  w_d · diff_trans · T/π, Lambertian through the surface (T = base, or √base thin)
+``diff_trans``  w_d · diff_trans · T/π, Lambertian through the surface (T = base, or √base thin);
+                a solid with ``scatter_distance`` > 0 (Burley 2015) sends the whole w_d through
+                it, white and shaped (1 − F_L/2)(1 − F_V/2), into the interior medium of
+                :mod:`.subsurface`, keeping only the retro-reflection on the surface
 ``sheen``       w_d · sheen · mix(1, tint, sheen_tint) · (1 − cos θd)⁵ (2014 addendum), or the
                 Conty-Kulla lobe of :mod:`.sheen` with ``sheen_model = "conty_kulla"``
 ``specular``    F · D · G / (4 cos θl cos θv), anisotropic GGX (App. B eq. 13) with the
@@ -88,6 +91,8 @@ def _diffuse_shape(xp: Any, pr: dict[str, Any], ci: Any, co: Any, cos2_d: Any) -
     fl, fv = fr.schlick_weight(xp, ci), fr.schlick_weight(xp, co)
     rr = 2.0 * pr["roughness"] * cos2_d
     retro = rr * (fl + fv + fl * fv * (rr - 1.0))  # Schutte's split of (1 + (F_D90 − 1)F)²
+    if pr["volume"]:
+        return retro  # Burley 2015: the Lambertian part enters the medium (diff_trans)
     lambert = (1.0 - 0.5 * fl) * (1.0 - 0.5 * fv)
     flat, sss = pr["flatness"], pr["subsurface"]
     if xp.known_zero(flat) and xp.known_zero(sss):
@@ -203,6 +208,12 @@ def _eval_oriented(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) ->
     if "diff_trans" in lobes or glossy_t:
         down = (wi[2] < 0.0) & (wo[2] > 0.0)
         t = pr["diff_trans"] * INV_PI if "diff_trans" in lobes else 0.0
+        if pr["volume"] and "diff_trans" in lobes:
+            # The entry into (and exit from) the medium is the diffuse's Lambertian part,
+            # Schutte's f_lambert (1 − F_L/2)(1 − F_V/2): symmetric, and with no internal
+            # reflection it keeps the boundary's albedo below 1 from either side.
+            t = t * (1.0 - 0.5 * fr.schlick_weight(xp, -wi[2]))
+            t = t * (1.0 - 0.5 * fr.schlick_weight(xp, wo[2]))
         if glossy_t:
             t = t + pr["glass"] * transmission(xp, pr, wi, wo, front, pdf=False)
         terms.append((pr["trans_color"], xp.select(down, t, 0.0)))

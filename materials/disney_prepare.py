@@ -28,7 +28,14 @@ SHEEN_ALBEDO_GUESS = 0.1  # rough albedo of sheen 1, only used to weight samplin
 ETA_MIN = 1.001  # as Mitsuba: at η = 1 the rough BTDF becomes a delta
 DISNEY_LOBES = (
     Lobe("diffuse", "diffuse", params=("subsurface", "flatness")),
-    Lobe("diff_trans", "diffuse", True, params=("diff_trans",), switches=("diff_trans",)),
+    # A solid's scatter distance turns this lobe on too: it is the entry into the medium.
+    Lobe(
+        "diff_trans",
+        "diffuse",
+        True,
+        params=("diff_trans", "scatter_distance", "scatter_distance_scale"),
+        switches=("diff_trans", "scatter_distance"),
+    ),
     Lobe(
         "sheen",
         "glossy",
@@ -121,7 +128,14 @@ def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
     w_d = (1.0 - p["metallic"]) * (1.0 - p["spec_trans"])
     w_g = (1.0 - p["metallic"]) * p["spec_trans"]
     a, b, c = _fresnel_terms(xp, p, base, tint, w_d, w_g, eta)
-    trans_color = xp.sqrt(base) if thin else base
+    # Burley 2015: a solid with a scatter distance has an interior medium
+    # (:mod:`.subsurface`) that gives the colour; its diffuse's Lambertian part and its
+    # glass lead into it untinted, and only the retro-reflection stays on the surface.
+    volume = not thin and params.scatter_distance > 0.0
+    trans_color = xp.sqrt(base) if thin else (xp.color((1.0, 1.0, 1.0)) if volume else base)
+    diffuse, diff_trans = w_d * (1.0 - p["diff_trans"]), w_d * p["diff_trans"]
+    if volume:
+        diffuse, diff_trans = (w_d if _rough(p["roughness"]) else 0.0), w_d
     ax, ay = mf.anisotropic_alphas(xp, p["roughness"], p["anisotropic"])
     pr = {
         "thin": thin,
@@ -134,8 +148,9 @@ def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
         "spec_b": b,
         "spec_c": c,
         "glass": w_g,
-        "diffuse": w_d * (1.0 - p["diff_trans"]),
-        "diff_trans": w_d * p["diff_trans"],
+        "diffuse": diffuse,
+        "diff_trans": diff_trans,
+        "volume": volume,
         "trans_color": trans_color,
         "sheen": w_d * p["sheen"],
         "sheen_color": mix(1.0, tint, p["sheen_tint"]),
@@ -143,7 +158,7 @@ def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
         "sheen_r": p["sheen_roughness"],
         "clearcoat": 0.25 * p["clearcoat"],
         "clearcoat_a2": _sq(mix(0.1, 0.001, p["clearcoat_gloss"])),  # Burley §5.4 / App. B
-        "subsurface": p["subsurface"],
+        "subsurface": 0.0 if volume else p["subsurface"],
         "flatness": p["flatness"] if thin else 0.0,
     }
     pr["ax2"], pr["ay2"] = ax * ax, ay * ay
@@ -174,6 +189,11 @@ def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
     pr["lobes"] = tuple(k for k in LOBES if not xp.known_zero(weights[k]))
     pr["odds"], pr["odds_inside"] = lobe_odds(xp, pr)
     return pr
+
+
+def _rough(roughness: Any) -> bool:
+    """False where the retro-reflection is a known zero (roughness 0 exactly)."""
+    return not (isinstance(roughness, float) and roughness == 0.0)
 
 
 def _sq(x: Any) -> Any:

@@ -153,19 +153,27 @@ class DisneyParams(Params):
         0.0,
         ge=0.0,
         le=SCATTER_DISTANCE_MAX,
-        description="Mean free path inside solid transmissive materials (scene units); 0: no "
-        f"medium, else {SCATTER_DISTANCE_MIN:g} .. {SCATTER_DISTANCE_MAX:g}, so the medium's "
-        "σt = 1/(s·d), s in 1.04 .. 4.14, stays a finite float32 (beyond 10⁶ the interior is "
-        "clear at any scene scale).",
+        description="Solid (not thin) materials: how far light scatters under the surface, a "
+        "length in scene units (metres at metersPerUnit = 1; Burley 2015's scatter distance "
+        "d, the medium's σt = 1/(s·d), :mod:`lookdev.materials.subsurface`). 0: no interior "
+        f"medium (the 2012 ``subsurface`` blend applies), else {SCATTER_DISTANCE_MIN:g} .. "
+        f"{SCATTER_DISTANCE_MAX:g}, so σt, s in 1.04 .. 4.14, stays a finite float32.",
+    )
+    scatter_distance_scale: Color = Field(
+        (1.0, 1.0, 1.0),
+        description="Per-channel scale of ``scatter_distance`` (OpenPBR's "
+        "subsurface_radius_scale): 'red scatters further' for skin is (1, 0.4, 0.2).",
     )
     thin: bool = Field(False, description="Thin-walled surface (leaves, paper): no interior.")
 
     @model_validator(mode="after")
     def _scatter_distance_not_tiny(self) -> DisneyParams:
-        if 0.0 < self.scatter_distance < SCATTER_DISTANCE_MIN:
+        smallest = self.scatter_distance * min(self.scatter_distance_scale)
+        if self.scatter_distance > 0.0 and not smallest >= SCATTER_DISTANCE_MIN:
             raise ValueError(
-                f"scatter_distance {self.scatter_distance:g} is out of range; allowed 0 or "
-                f"[{SCATTER_DISTANCE_MIN:g}, {SCATTER_DISTANCE_MAX:g}]"
+                f"scatter_distance {self.scatter_distance:g} × scatter_distance_scale "
+                f"{min(self.scatter_distance_scale):g} is out of range; allowed 0 or "
+                f"[{SCATTER_DISTANCE_MIN:g}, {SCATTER_DISTANCE_MAX:g}] in every channel"
             )
         return self
 

@@ -348,9 +348,10 @@ REPRESENTATIVE = (
     "glass_clear",
     "rusty_car_paint",
     "pixar_paint_red",
+    "skin",
 )
 """The default subjects of :func:`proof`: a metal, a glossy plastic, cloth, glass, a
-layered material and a Pixar lobe-weight material."""
+layered material, a Pixar lobe-weight material and a path-traced subsurface one."""
 
 
 def representative_presets(library: Any) -> list[str]:

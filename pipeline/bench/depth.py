@@ -53,6 +53,7 @@ def measure(preset: str, s: Settings) -> dict[str, Any]:
     from lookdev.pipeline.blend import blend
     from lookdev.pipeline.export.mitsuba import bsdf_dict, max_depth_for
     from lookdev.pipeline.proof import batch, ibl, shaderball
+    from lookdev.pipeline.proof.turntable import material_interior
 
     hub = blend(load_material(preset), batch.MAP_RESOLUTION)
     depth = max_depth_for(hub)
@@ -64,8 +65,10 @@ def measure(preset: str, s: Settings) -> dict[str, Any]:
             field="--reference-depth",
         )
     depths = (depth, s.reference_depth)
+    inside = material_interior(hub)
     scenes = {
-        d: mi.load_dict(shaderball.scene_dict(bsdf, env.pixels, s.resolution, d)) for d in depths
+        d: mi.load_dict(shaderball.scene_dict(bsdf, env.pixels, s.resolution, d, interior=inside))
+        for d in depths
     }
     for scene in scenes.values():
         mi.render(scene, spp=s.spp, seed=0)

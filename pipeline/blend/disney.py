@@ -37,8 +37,11 @@ SCALARS = tuple(
     if info.annotation in (float, "float") and name != COLOR
 )
 """Continuous scalar parameters, blended linearly (``ior`` travels as ``specular``)."""
-DISCRETE = ("thin", "sheen_model")
-"""Parameters with no in-between: every layer that shows must agree."""
+DISCRETE = ("thin", "sheen_model", "scatter_distance_scale")
+"""Parameters with no in-between: every layer that shows must agree (the per-channel
+scale of the scatter distance shapes one homogeneous interior medium, so it is one value)."""
+VOTERS = {"sheen_model": "sheen", "scatter_distance_scale": "scatter_distance"}
+"""A layer votes on these only where the parameter they refine is non-zero."""
 
 
 def layer_values(params: DisneyParams) -> dict[str, Any]:
@@ -82,12 +85,15 @@ def stack_weights(masks: Sequence[Any], out: np.ndarray | None = None) -> Any:
 def check_discrete(stack: Sequence[tuple[str, DisneyParams]]) -> dict[str, Any]:
     """The one value of each discrete parameter, or a :class:`BlendError` naming the layer.
 
-    A layer without sheen does not vote on ``sheen_model`` (the choice changes nothing
-    there). ``stack`` is ``(label, params)`` bottom to top, of the layers that show.
+    A layer without sheen does not vote on ``sheen_model``, nor one without a scatter
+    distance on its scale (:data:`VOTERS`: the choice changes nothing there). ``stack``
+    is ``(label, params)`` bottom to top, of the layers that show.
     """
     out: dict[str, Any] = {}
     for name in DISCRETE:
-        voters = [(label, p) for label, p in stack if name != "sheen_model" or p.sheen > 0]
+        voters = [
+            (label, p) for label, p in stack if name not in VOTERS or getattr(p, VOTERS[name]) > 0
+        ]
         voters = voters or list(stack[-1:])
         first_label, first = voters[0]
         for label, p in voters[1:]:

@@ -15,7 +15,17 @@ from typing import Annotated, Any
 import typer
 from rich.progress import Progress
 
-from lookdev.pipeline.bench import blend, depth, error, glass, library, noise, proof, usd
+from lookdev.pipeline.bench import (
+    blend,
+    depth,
+    error,
+    glass,
+    library,
+    noise,
+    proof,
+    subsurface,
+    usd,
+)
 from lookdev.pipeline.bench import eval as eval_bench
 
 from .common import console, err_console, print_json, table
@@ -573,6 +583,30 @@ def usd_(
     )
 
 
+def subsurface_(
+    spp: Annotated[int, typer.Option("--spp", "-s", min=4, help="Samples per pixel.")] = 64,
+    as_json: JsonOut = False,
+) -> None:
+    """Path-traced subsurface: thick-slab reflectance against the base colour (three
+    colours), the white furnace, the cup rim's glow under back light, and the proof's
+    cost against the same preset without a scatter distance (equal spp, equal noise)."""
+    with console.status("rendering slabs, furnace, rims and proofs", spinner="dots"):
+        r = subsurface.run(spp=spp)
+    if as_json:
+        print_json(r)
+        return
+    rows = [[k, *v["base"], *v["error"], max(v["standard_error"])] for k, v in r["slab"].items()]
+    cols = ["slab", "R", "G", "B", "ΔR", "ΔG", "ΔB", "± (1σ)"]
+    console.print(table(f"thick slab ({r['mapping']})", cols, rows))
+    f = r["furnace"]
+    console.print(f"white furnace: {f['mean']:.4f} ± {f['standard_error']:.4f} (≤ 1)")
+    rows = [[k, v["with"], v["without"], v["ratio"]] for k, v in r["rim"].items()]
+    console.print(table("cup rim under back light", ["preset", "with", "without", "×"], rows))
+    rows = [[k, v["time_ratio"], v["equal_noise_ratio"]] for k, v in r["cost"].items()]
+    cols = ["preset", "× time, equal spp", "× time, equal noise"]
+    console.print(table("proof cost against no distance", cols, rows))
+
+
 app.command("blend")(blend_)
 app.command("depth")(depth_)
 app.command("error")(error_)
@@ -581,4 +615,5 @@ app.command("glass")(glass_)
 app.command("library")(library_)
 app.command("noise")(noise_)
 app.command("proof")(proof_)
+app.command("subsurface")(subsurface_)
 app.command("usd")(usd_)

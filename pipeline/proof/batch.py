@@ -200,7 +200,7 @@ def _run_job(job: Job, variant: str) -> dict[str, Any]:
 def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
     """Build the scene once, then render and write each frame; yields manifest entries."""
     from .passes import render_frame
-    from .turntable import Turntable, material_bsdf
+    from .turntable import Turntable, material_bsdf, material_interior
 
     s = job.settings
     bsdf, depth = material_bsdf(job.material)
@@ -213,6 +213,7 @@ def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
         rig=s.rig,
         pixel_filter=s.pixel_filter,
         clamp=s.clamp,
+        interior=material_interior(job.material),
     )
     guides = denoise.guide_renderer(table, s.spp) if s.denoise else None
     for frame in todo:

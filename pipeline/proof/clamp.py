@@ -18,12 +18,19 @@ __all__ = ["PLUGIN", "integrator", "register"]
 PLUGIN = "lookdev_clamped_path"
 
 
-def integrator(max_depth: int, clamp: float | None) -> dict[str, Any]:
-    """The scene's integrator dict: Mitsuba's ``path``, or it clamped at ``clamp``."""
+def integrator(
+    max_depth: int, clamp: float | None, interior: dict[str, Any] | None = None
+) -> dict[str, Any]:
+    """The scene's integrator dict: Mitsuba's ``path`` (``volpath`` for a scene with an
+    ``interior`` medium, :mod:`lookdev.pipeline.export.mitsuba.medium`), or it clamped."""
+    from lookdev.pipeline.export.mitsuba.medium import integrator as plain
+
+    inner = plain(max_depth, interior)
     if clamp is None:
-        return {"type": "path", "max_depth": int(max_depth)}
+        return inner
     register()
-    return {"type": PLUGIN, "max_depth": int(max_depth), "clamp": float(clamp)}
+    out = {"type": PLUGIN, "max_depth": int(max_depth), "clamp": float(clamp)}
+    return out if inner["type"] == "path" else out | {"inner": inner["type"]}
 
 
 def register() -> None:
@@ -45,7 +52,8 @@ def _register(variant: str) -> None:
             super().__init__(props)
             self.clamp = float(props.get("clamp"))
             depth = int(props.get("max_depth", 8))
-            self.inner = mi.load_dict({"type": "path", "max_depth": depth})
+            kind = str(props.get("inner", "path"))
+            self.inner = mi.load_dict({"type": kind, "max_depth": depth})
 
         def sample(self, scene, sampler, ray, medium=None, active=True):  # noqa: ANN001
             radiance, valid, aovs = self.inner.sample(scene, sampler, ray, medium, active)

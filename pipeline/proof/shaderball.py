@@ -33,6 +33,9 @@ BALL_CENTER = (-1.2, 1.0, 0.0)
 CUP_CENTER = (1.2, 1.0, 0.0)
 CUP_TILT_DEG = 40.0  # towards the camera, so the inside shows
 CUP_WALL = 0.18  # wall thickness, in units of the outer radius
+METERS_PER_UNIT = 0.05
+"""The proof's scale: the ball's radius (1 unit) is 5 cm, a 10 cm shader ball, so a
+preset's scatter distances (metres) show as they would on a hand-sized object."""
 
 
 @dataclass(frozen=True)
@@ -238,6 +241,7 @@ def scene_dict(
     rig: str = DEFAULT_RIG,
     pixel_filter: str = "box",
     clamp: float | None = None,
+    interior: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """The shader-ball scene; the same ``bsdf`` on the ball and the cup, the ``rig``
     (:mod:`.rig`: ``full``, ``balls`` or ``none``) beside them.
@@ -249,15 +253,19 @@ def scene_dict(
     already in its pixels, see :mod:`.ibl`) and oriented by :data:`.ibl.ORIENTATION`.
     ``clamp``: each camera sample's radiance is limited to that value (:mod:`.clamp`;
     biased, for previews); None renders unclamped.
+    ``interior`` (:func:`lookdev.pipeline.export.mitsuba.medium.interior_dict` at
+    :data:`METERS_PER_UNIT`) fills the ball and the cup of a solid subsurface material;
+    only then does the scene take ``volpath``.
     """
     import mitsuba as mi
 
     from .clamp import integrator
 
     width, height = resolution
+    inside = {} if interior is None else {"interior": interior}
     return {
         "type": "scene",
-        "integrator": integrator(max_depth, clamp),
+        "integrator": integrator(max_depth, clamp, interior),
         "sensor": camera(width, height, rig, pixel_filter),
         "environment": {
             "type": "envmap",
@@ -268,7 +276,10 @@ def scene_dict(
         # Each shape sits in a shapegroup placed by an instance: turning an instance
         # re-commits only the top-level acceleration structure (≈ 10 ms, not ≈ 80 ms
         # for moving the shapes themselves; measured in lookdev bench proof).
-        "ball_shape": {"type": "shapegroup", "shape": {"type": "sphere", "bsdf": _material}},
+        "ball_shape": {
+            "type": "shapegroup",
+            "shape": {"type": "sphere", "bsdf": _material, **inside},
+        },
         "cup_shape": {
             "type": "shapegroup",
             "shape": {
@@ -276,6 +287,7 @@ def scene_dict(
                 "filename": str(geometry or cup_ply()),
                 "face_normals": False,
                 "bsdf": _material,
+                **inside,
             },
         },
         "ball": _instance("ball_shape", ball_to_world(0.0)),

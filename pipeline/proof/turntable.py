@@ -55,6 +55,13 @@ def material_bsdf(hub: Any, *, force_all_lobes: bool = False) -> tuple[dict, int
     return bsdf_dict(hub, force_all_lobes=force_all_lobes), max_depth_for(hub)
 
 
+def material_interior(hub: Any) -> dict[str, Any] | None:
+    """The interior medium of a solid subsurface material at the proof's scale, or None."""
+    from lookdev.pipeline.export.mitsuba.medium import interior_dict
+
+    return interior_dict(hub, shaderball.METERS_PER_UNIT)
+
+
 class Turntable:
     """A loaded shader-ball scene whose rotations are set per frame, never reloaded.
 
@@ -73,6 +80,7 @@ class Turntable:
         rig: str = DEFAULT_RIG,
         pixel_filter: str = "box",
         clamp: float | None = None,
+        interior: dict[str, Any] | None = None,
     ):
         import mitsuba as mi
 
@@ -85,6 +93,7 @@ class Turntable:
             rig=rig,
             pixel_filter=pixel_filter,
             clamp=clamp,
+            interior=interior,
         )
         scene["sensor_pair"] = _sensor_pair(scene["sensor"])
         self.scene = mi.load_dict(scene)

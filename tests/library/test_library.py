@@ -113,7 +113,7 @@ def test_issue_looks_use_the_features_they_name():
     leaf = BUILTIN.load("leaf").params
     assert leaf.thin and leaf.diff_trans > 0
     assert BUILTIN.load("car_paint_red").params.clearcoat > 0
-    assert BUILTIN.load("marble").params.subsurface > 0
+    assert BUILTIN.load("marble").params.scatter_distance > 0
     plastic = BUILTIN.load("pixar_translucent_plastic").params
     assert plastic.clear > 0 and plastic.back > 0
     for name in ("pixar_painted_metal", "pixar_rusty_metal"):

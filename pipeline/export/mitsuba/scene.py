@@ -31,6 +31,7 @@ from lookdev.pipeline.blend.result import LOBE_WEIGHTS, BlendedMaterial, as_hub
 from lookdev.pipeline.exr import colour_space_of
 
 from .depth import max_depth_for
+from .medium import integrator, interior_dict
 from .normals import with_normals
 from .plugin import FORCE_ALL_LOBES, ONLY_LOBES, MitsubaExportError, register_model
 
@@ -286,6 +287,7 @@ def scene_dict(
     force_all_lobes: bool = False,
     max_depth: int | None = None,
     ibl_rotation: float = 0.0,
+    meters_per_unit: float = 1.0,
 ) -> dict[str, Any]:
     """A minimal scene: the material on a unit sphere, framed, under an environment.
 
@@ -293,7 +295,9 @@ def scene_dict(
     camera on +z, :data:`lookdev.pipeline.proof.ibl.ORIENTATION`) and turned by
     ``ibl_rotation`` degrees about +y; without one, a constant white sky (the
     white-furnace set-up). The integrator depth follows the material; the film
-    holds RGB only (no alpha, no AOVs).
+    holds RGB only (no alpha, no AOVs). A solid subsurface material fills the sphere
+    with its medium (:mod:`.medium`; the sphere's radius is 1 unit of ``meters_per_unit``
+    metres) and the scene takes ``volpath``; any other keeps ``path``.
     """
     import mitsuba as mi
 
@@ -302,6 +306,7 @@ def scene_dict(
     # The BSDF first: it refuses inputs the model does not take in one line, before the
     # depth rule runs the model's prepare on them.
     bsdf = bsdf_dict(hub, texture_dir, force_all_lobes=force_all_lobes)
+    medium = interior_dict(hub, meters_per_unit)
     width, height = resolution
     distance = 4.0
     fov = 2.0 * math.degrees(math.asin(1.0 / distance)) * 1.15  # the ball fills ~87%
@@ -318,7 +323,7 @@ def scene_dict(
         }
     return {
         "type": "scene",
-        "integrator": {"type": "path", "max_depth": max_depth or max_depth_for(hub)},
+        "integrator": integrator(max_depth or max_depth_for(hub), medium),
         "sensor": {
             "type": "perspective",
             "fov": fov,
@@ -335,7 +340,7 @@ def scene_dict(
             "sampler": {"type": "independent", "sample_count": int(spp)},
         },
         "environment": emitter,
-        "ball": {"type": "sphere", "bsdf": bsdf},
+        "ball": {"type": "sphere", "bsdf": bsdf} | ({"interior": medium} if medium else {}),
     }
 
 

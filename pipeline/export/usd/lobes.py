@@ -112,7 +112,11 @@ def active_lobes(
         "conty_kulla": on["sheen"] and v["sheen_model"] == "conty_kulla",
         "subsurface": subsurface,
         "flatness": on["diffuse"] and thin and v["flatness"] > 0.0,
-        "scatter": (on["spec_trans"] or subsurface) and not thin and v["scatter_distance"] > 0,
+        # Burley 2015: a solid's scatter distance fills its interior, entered by the
+        # diffuse (diff_trans) and the glass (lookdev.materials.subsurface).
+        "scatter": (on["spec_trans"] or on["diff_trans"] or subsurface)
+        and not thin
+        and v["scatter_distance"] > 0,
         "thin": thin,
     }
 

@@ -24,7 +24,9 @@ from lookdev.pipeline.export.usd.writer import export_usd  # noqa: E402
 
 PREVIEW_PARAMS = {s.param for s in PREVIEW_DISNEY} | {"specular"}
 """What UsdPreviewSurface expresses: its table, with both spellings of the F0."""
-UNEXPRESSIBLE = {"sheen_model", "sheen_roughness", "flatness"}
+# scatter_distance_scale: no single DCC input takes it (the per-channel distance is one
+# colour there); the loss notes name it.
+UNEXPRESSIBLE = {"sheen_model", "sheen_roughness", "flatness", "scatter_distance_scale"}
 
 PIXAR_PREVIEW = {"surface_color", "metallic", "roughness", "clear", "normal_fresnel", "ior"}
 """What a Pixar material is read back from: UsdPreviewSurface (the F0 as the surface's
