@@ -14,7 +14,9 @@ w_g = (1 − metallic)·spec_trans:
                 Conty-Kulla lobe of :mod:`.sheen` with ``sheen_model = "conty_kulla"``
 ``specular``    F · D · G / (4 cos θl cos θv), anisotropic GGX (App. B eq. 13) with the
                 un-remapped anisotropic Smith G (2014 addendum); F blends metal, dielectric
-                and the glass's reflection (see :func:`_fresnel_terms`)
+                and the glass's reflection (see :func:`_fresnel_terms`); the expert
+                ``specular_gamma`` ≠ 2 makes D the isotropic GTR of App. B eq. 1, sampled
+                by eqs. 2–3 (Chichi 2018's ``d_gamma``)
 ``clearcoat``   0.25 · clearcoat · D_GTR1 · F(0.04) · G(α = 0.25) / (4 cos θl cos θv)
 ``spec_trans``  w_g · T · Walter et al. 2007 rough dielectric BTDF (solid), or the
                 mirrored-reflection thin sheet with Burley 2015's roughness scale (thin)
@@ -165,11 +167,18 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
     scale = _base_scale(xp, pr, ci, co)
     terms = []
     if "specular" in lobes:
-        d = mf.ggx_d(xp, h, pr["ax"], pr["ay"], n2=h2)
-        g = mf.g1_over_cos(xp, ci, _q(pr, wi, zi2), zi2) * mf.g1_over_cos(
-            xp, co, _q(pr, wo, zo2), zo2
+        d = _specular_d(xp, pr, h, h2)
+        if pr["gamma"] == 2.0:
+            g = mf.g1_over_cos(xp, ci, _q(pr, wi, zi2), zi2) * mf.g1_over_cos(
+                xp, co, _q(pr, wo, zo2), zo2
+            )
+        else:
+            g = _v_cavity_over_cos(xp, h, h2, ci, co)
+        dg = (
+            _masked(xp, up, 0.25 * d * g)
+            if pr["gamma"] == 2.0
+            else xp.select(up, 0.25 * d * g, 0.0)
         )
-        dg = _masked(xp, up, 0.25 * d * g)
         a, b, c = pr["spec_a"], pr["spec_b"], pr["spec_c"]
         dg_out = _times(dg, front)
         terms += [(a * scale, dg_out), ((b - a) * scale, dg_out * w)]
@@ -203,6 +212,34 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
         k = _times((0.25 * pr["clearcoat"]) * f * d * g, front)
         terms.append((None, xp.select(up, k, 0.0)))  # D is 0/0 at wi = −wo: a true select
     return terms
+
+
+def _v_cavity_over_cos(xp: Any, h: Any, h2: Any, ci: Any, co: Any) -> Any:
+    """G/(cos θi cos θo) with the Cook–Torrance V-cavity G = min(1, 2 cos θh cos θ/(wo·h))
+    over both directions, written with the unnormalised h (2 cos θh/(wo·h) = 4 h_z/|h|²).
+
+    The shadowing of GTR at γ ≠ 2: Smith's Λ has no closed form for it (App. B closes
+    only GTR2), and GGX's Λ at the same α under GTR's heavier tail gains energy without
+    bound (measured, white metal at cos θo = 10⁻⁴: albedo 1.92 at γ = 1, roughness 0.5;
+    131 at roughness 0), while the V-cavity G is normalised for any D (Heitz 2014 §5.2:
+    ∫ G1 ⟨wo, h⟩ D dh = cos θo), so the lobe never reflects more than the light.
+    """
+    k = 4.0 * xp.maximum(h[2], 0.0) / xp.maximum(h2, xp.tiny)
+    inv = 1.0 / xp.maximum(ci * co, xp.tiny)
+    return xp.minimum(inv, k / xp.maximum(xp.maximum(ci, co), xp.tiny))
+
+
+def _specular_d(xp: Any, pr: dict[str, Any], h: Any, h2: Any) -> Any:
+    """D of the primary specular lobe at the unnormalised half vector h (|h|² = ``h2``):
+    the anisotropic GGX (eq. 13) at γ = 2, else the isotropic GTR of eq. 1 with α² = αx αy.
+
+    The GTR D is ∞ at h = 0 (wi = −wo, never a reflection pair): callers select, not mask.
+    """
+    if pr["gamma"] == 2.0:
+        return mf.ggx_d(xp, h, pr["ax"], pr["ay"], n2=h2)
+    inv_h2 = 1.0 / xp.maximum(h2, xp.tiny)
+    sin2_h = (h[0] * h[0] + h[1] * h[1]) * inv_h2  # not 1 − cos²: the α = 10⁻³ peak
+    return mf.gtr_d(xp, pr["gamma"], pr["a2"], h[2] * h[2] * inv_h2, sin2_h)
 
 
 def _transmission(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any, pdf: bool) -> Any:
@@ -259,7 +296,11 @@ def _pdf_oriented(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> 
     h = wi + wo
     h2 = xp.maximum(xp.dot(h, h), xp.tiny)  # 4 cos²θd, from h for float32 (see above)
     p_up = 0.0
-    if "specular" in odds:
+    if "specular" in odds and pr["gamma"] != 2.0:
+        # GTR sampling of App. B (eqs. 2–3): D(h) cos θh / (4 wo·h), as for the clearcoat.
+        d = _specular_d(xp, pr, h, h2)
+        p_up = odds["specular"] * xp.select(up, d * h[2] / (2.0 * h2), 0.0)
+    elif "specular" in odds:
         # Visible normals: D_wo(h)/(4 wo·h) = G1(wo) D(h) / (4 cos θo).
         zo2 = co * co
         g1 = mf.g1_over_cos(xp, co, _q(pr, wo, zo2), zo2)
@@ -316,7 +357,11 @@ def _candidates(xp: Any, pr: dict[str, Any], wo: Any, u1: Any, u2: Any, front: A
         out["diffuse"] = out["sheen"] = (xp.vec3(x, y, z), z > 0.0)
         out["diff_trans"] = (xp.vec3(x, y, -z), z > 0.0)
     if "specular" in lobes:
-        wi = mf.reflect(xp, wo, mf.sample_visible_ggx(xp, wo, pr["ax"], pr["ay"], u1, u2))
+        if pr["gamma"] == 2.0:
+            h = mf.sample_visible_ggx(xp, wo, pr["ax"], pr["ay"], u1, u2)
+        else:  # visible-normal sampling exists for GGX only: App. B's GTR sampling
+            h = mf.sample_gtr(xp, pr["gamma"], pr["a2"], u1, u2)
+        wi = mf.reflect(xp, wo, h)
         out["specular"] = (wi, wi[2] > 0.0)
     if "clearcoat" in lobes:
         wi = mf.reflect(xp, wo, mf.sample_gtr(xp, 1.0, pr["clearcoat_a2"], u1, u2))

@@ -34,7 +34,7 @@ DISNEY_LOBES = (
         params=("sheen", "sheen_tint", "sheen_model", "sheen_roughness"),
         switches=("sheen",),
     ),
-    Lobe("specular", "glossy", highlight=True),
+    Lobe("specular", "glossy", highlight=True, params=("specular_gamma",)),
     Lobe(
         "clearcoat",
         "glossy",
@@ -146,6 +146,10 @@ def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
         "flatness": p["flatness"] if thin else 0.0,
     }
     pr["ax2"], pr["ay2"] = ax * ax, ay * ay
+    # The GTR shape of the specular lobe: 2 keeps the anisotropic GGX and visible-normal
+    # sampling; any other γ is the isotropic GTR of App. B (eq. 1) with α² = αx αy.
+    pr["gamma"] = float(params.specular_gamma)
+    pr["a2"] = ax * ay
     if thin:
         # Burley 2015 Fig. 15 via Schutte: a thin sheet's transmission looks rougher.
         r_t = (0.65 * eta - 0.35) * p["roughness"]

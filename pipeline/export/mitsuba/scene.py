@@ -116,6 +116,8 @@ def principled_equivalent(hub: BlendedMaterial) -> dict[str, Any] | None:
         return None
     if c.get("clearcoat", 0.0) != 0.0:
         return None
+    if getattr(hub.params, "specular_gamma", 2.0) != 2.0:
+        return None  # ``principled`` is GGX only (γ = 2): the plugin renders any GTR γ
     out: dict[str, Any] = {"type": "principled", "metallic": 1.0}
     out["base_color"] = {"type": "rgb", "value": list(hub.params.base_color)}
     for key in ("roughness", "anisotropic"):

@@ -45,6 +45,10 @@ CASES = [
         "disney-ck-sheen",
         0.25,
     ),
+    # the GTR γ of the specular lobe (sampled by App. B eqs. 2–3 where γ ≠ 2)
+    ("disney", {"specular_gamma": 1.0, "roughness": 0.5}, "disney-gamma1", 0.25),
+    ("disney", {"specular_gamma": 1.5, "metallic": 1.0, "roughness": 0.5}, "disney-gamma1.5", 0.25),
+    ("disney", {"specular_gamma": 3.0, "metallic": 1.0, "roughness": 0.3}, "disney-gamma3", 0.09),
     # Pixar: "α" here is the reflection cone's half-angle in radians (10·r degrees).
     ("pixar", {"roughness": 0.0}, "pixar-r0", math.radians(0.5)),
     ("pixar", {"roughness": 0.3}, "pixar-r0.3", math.radians(3.0)),
