@@ -159,6 +159,34 @@ def sample_gtr(xp: Any, gamma: float, a2: Any, u1: Any, u2: Any) -> Any:
     return xp.vec3(sin_t * xp.cos(phi), sin_t * xp.sin(phi), xp.sqrt(cos2))
 
 
+def gtr_half_max_sin2(gamma: float, alpha: float) -> float:
+    """sin²θh where D_GTR(θh) falls to half its peak: the highlight's half width.
+
+    From eq. 1, D(θh)/D(0) = (α²/(α² + (1 − α²) sin²θh))^γ = ½ at
+    sin²θh = α² (2^{1/γ} − 1)/(1 − α²); infinite at α = 1 (D is flat there).
+    """
+    a2 = max(alpha, ALPHA_MIN) ** 2
+    return math.inf if a2 >= 1.0 else a2 * math.expm1(math.log(2.0) / gamma) / (1.0 - a2)
+
+
+def ggx_roughness_like_gtr(gamma: float, roughness: float) -> float:
+    """The roughness whose GGX (γ = 2) highlight is as wide as GTR γ's at ``roughness``.
+
+    Width = the half-maximum of D in θh (:func:`gtr_half_max_sin2`), the angular size
+    of the highlight seen at normal incidence (tests/materials/test_microfacet.py measures
+    it on the model's own BRDF slice). Solving GGX's half width x = α²(√2 − 1)/(1 − α²)
+    for α² gives α² = x/(√2 − 1 + x); roughness = √α. Identity at γ = 2.
+
+    >>> round(ggx_roughness_like_gtr(2.0, 0.5), 12), round(ggx_roughness_like_gtr(1.0, 0.5), 4)
+    (0.5, 0.6102)
+    """
+    if gamma == 2.0:
+        return roughness
+    x = gtr_half_max_sin2(gamma, roughness * roughness)
+    a2 = 1.0 if math.isinf(x) else x / (math.sqrt(2.0) - 1.0 + x)
+    return min(a2**0.25, 1.0)
+
+
 # -- anisotropic GTR2 = GGX (Burley App. B, eqs. 10–15; 2014 addendum) ------------------
 def anisotropic_alphas(xp: Any, roughness: Any, anisotropic: Any) -> tuple[Any, Any]:
     """α_x = r²/aspect, α_y = r²·aspect, aspect = √(1 − 0.9·anisotropic) (2014 addendum).

@@ -47,6 +47,7 @@ def material_spec(
         "preset": source.name,
         "model": source.model,
         "spelling": source.spelling,
+        **source.custom,
     }
     networks = [
         preview.build(source, preview_opacity) if c == "universal" else BUILDERS[c](source)
