@@ -21,7 +21,6 @@ import numpy as np
 
 from lookdev.materials import registry
 from lookdev.materials.errors import LookdevError
-from lookdev.materials.microfacet import ggx_roughness_like_gtr
 
 from .lobes import DEFAULTS, REGISTRY_MODEL, active_lobes, canonical, effective
 from .names import Slot
@@ -210,8 +209,8 @@ def source_from_params(name: str, model: str, params: Any, description: str = ""
 
 def gtr_as_ggx(source: Source) -> Source:
     """A Disney ``specular_gamma`` ≠ 2 (no DCC target has GTR's γ) written as the GGX
-    roughness whose highlight is as wide (half maximum of D,
-    :func:`lookdev.materials.microfacet.ggx_roughness_like_gtr`), with the loss named and
+    roughness whose highlight is as wide (half maximum of the measured slice,
+    :func:`lookdev.materials.highlight.ggx_roughness_like`), with the loss named and
     γ and the authored roughness kept in ``customData`` for the import.
     """
     gamma = source.values.get("specular_gamma", 2.0) if source.model == "disney" else 2.0
@@ -224,7 +223,13 @@ def gtr_as_ggx(source: Source) -> Source:
             "its roughness map is written as it is, for GGX (γ is kept in customData)"
         )
         return source
-    matched = ggx_roughness_like_gtr(float(gamma), float(rough))
+    from lookdev.materials.highlight import ggx_roughness_like
+    from lookdev.materials.params import DisneyParams
+
+    # The other parameters matter to the measured width only through F and G: the
+    # roughness and γ alone, with the Fresnel of a white metal, define the highlight.
+    lobe = DisneyParams(metallic=1.0, base_color=(1.0, 1.0, 1.0), roughness=float(rough))
+    matched = ggx_roughness_like(lobe.replace(specular_gamma=float(gamma)))
     source.custom["roughness"] = float(rough)
     source.values["roughness"] = matched
     source.notes.append(
