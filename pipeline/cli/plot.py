@@ -66,6 +66,15 @@ def plot(
         list[Path] | None,
         typer.Option("--library", "-L", help="Extra preset folders searched before the built-ins."),
     ] = None,
+    vary: Annotated[
+        str | None,
+        typer.Option(
+            "--vary",
+            metavar="PARAM=V1,V2,…",
+            help="Draw each preset once per value of one parameter, e.g. "
+            "specular_gamma=1,1.5,2,3 (uniform presets).",
+        ),
+    ] = None,
     as_json: Annotated[
         bool, typer.Option("--json", help="Print one JSON object for scripts.")
     ] = False,
@@ -77,6 +86,8 @@ def plot(
       lookdev plot gold copper --view albedo -o metals.png
 
       lookdev plot velvet --view sphere --ibl studio -o velvet.png --exposure -1
+
+      lookdev plot chrome --vary specular_gamma=1,1.5,2,3 -o gamma.png --exposure -4
     """
     from lookdev.pipeline import api
 
@@ -89,8 +100,25 @@ def plot(
             ibl=ibl,
             resolution=resolution,
             library=library,
+            vary=_vary(vary),
         )
     if as_json:
         print_json(result.to_json())
     else:
         console.print(f"wrote {output}")
+
+
+def _vary(text: str | None) -> tuple[str, list[float]] | None:
+    """``PARAM=V1,V2,…`` → (PARAM, [V1, V2, …]); a malformed one is one error line."""
+    if text is None:
+        return None
+    from lookdev.pipeline.analysis.plots import PlotError
+
+    name, _, values = text.partition("=")
+    try:
+        numbers = [float(v) for v in values.split(",") if v.strip()]
+    except ValueError:
+        numbers = []
+    if not name.strip() or not numbers:
+        raise PlotError(f"--vary {text!r}: expected PARAM=V1,V2,… with numbers", field="--vary")
+    return name.strip(), numbers
