@@ -30,3 +30,8 @@ def did_you_mean(name: str, candidates: Iterable[str]) -> str:
     if not close:
         return ""
     return "; did you mean " + " or ".join(repr(c) for c in close) + "?"
+
+
+class TextureError(LookdevError):
+    """A texture (mask, normal map or parameter map) is missing, unreadable, undecodable,
+    not finite, lacks the channel asked for, or holds values outside its parameter's range."""

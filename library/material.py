@@ -29,10 +29,11 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from lookdev.materials.layers import CombineMask, ConstantMask, Mask, TextureMask, map_textures
 from lookdev.materials.params import DisneyParams
 from lookdev.materials.pixar import PixarParams
-from lookdev.materials.textures import TextureInput
+from lookdev.materials.textures import UDIM_TOKEN, TextureInput, is_texture_input
 
-from .errors import PresetError, PresetNotFoundError
-from .preset import MODELS, PresetFile, check_params
+from .errors import PresetError, PresetNotFoundError, TextureError
+from .preset import MODELS, PresetFile, split_params
+from .textures import ParamTexture
 
 Lookup = Callable[[str], tuple[PresetFile, Path]]
 """Finds a preset by name: its parsed file and where it lives."""
@@ -48,6 +49,11 @@ class Material(BaseModel):
     description: str = ""
     tags: list[str] = Field(default_factory=list)
     params: DisneyParams | PixarParams | None = Field(None, description="None when layered.")
+    textures: dict[str, TextureInput] = Field(
+        default_factory=dict,
+        description="Parameters driven by textures (paths absolute), checked at load; "
+        "``params`` holds the schema default for them.",
+    )
     layers: list[Layer] = Field(default_factory=list)
     source: Path | None = None
     citation: str | None = Field(None, description="The preset's `source` note (measurements).")
@@ -107,9 +113,50 @@ def _resolve(name: str, lookup: Lookup, seen: tuple[str, ...]) -> Material:
     }
     common |= _surface_maps(preset, paths[0])
     if preset.model in MODELS:
-        params = check_params(preset.model, _with_set(preset, paths[0]), where=where)
-        return Material(params=params, **common)
-    return Material(layers=_layers(preset, paths[0], lookup, (*seen, name)), **common)
+        params, textures = _checked(preset.model, _with_set(preset, paths[0]), where=where)
+        return _tiles_agree(Material(params=params, textures=textures, **common))
+    material = Material(layers=_layers(preset, paths[0], lookup, (*seen, name)), **common)
+    return _tiles_agree(material)
+
+
+def _checked(model: str, params: dict[str, Any], *, where: str, prefix: str = "params"):
+    """(constants, textures) of ``params``, every texture opened and its values checked
+    (:mod:`.textures`: files, tiles, channels, colour space, range)."""
+    constants, textures = split_params(model, params, where=where, prefix=prefix)
+    for key, tex in textures.items():
+        label = f"{prefix}.{key}"
+        ParamTexture(tex, key, MODELS[model], where=where, label=label).check()
+    return constants, textures
+
+
+def _tiles_agree(material: Material) -> Material:
+    """Every UDIM texture of a material covers the same tiles: a tile one map lacks is a
+    hole in the asset (a missing file), not a region another map may cover alone."""
+    owners: dict[int, str] = {}
+    sets = []
+    for label, mat in [(None, material)] + [
+        (layer.name, layer.material) for layer in material.layers
+    ]:
+        for key, tex in mat.textures.items():
+            if tex.udim:
+                field = f"{label}: {key}" if label else key
+                tiles = set(ParamTexture(tex, key, MODELS[mat.model], where=None).tiles)
+                sets.append((field, tex, tiles))
+                for t in tiles:
+                    owners.setdefault(t, field)
+    every = set(owners)
+    for field, tex, tiles in sets:
+        missing = sorted(every - tiles)
+        if missing:
+            name = tex.texture.replace(UDIM_TOKEN, str(missing[0]))
+            raise TextureError(
+                f"missing UDIM tile {missing[0]} ({name} does not exist) of {tex.texture}; "
+                f"{owners[missing[0]]} has that tile, and every map of a material covers the "
+                "same tiles",
+                where=str(material.source) if material.source else None,
+                field=field,
+            )
+    return material
 
 
 def _merge_chain(name: str, lookup: Lookup, seen: tuple[str, ...]) -> tuple[PresetFile, list[Path]]:
@@ -125,7 +172,11 @@ def _merge_chain(name: str, lookup: Lookup, seen: tuple[str, ...]) -> tuple[Pres
             # A cycle that starts among the enclosing materials passes through a layer.
             field = "layers" if start < len(seen) else "extends"
             raise PresetError(f"cycle of presets: {cycle}", where=where, field=field)
-        chain.append(_find_parent(current, lookup, chain))
+        found, path = _find_parent(current, lookup, chain)
+        if found.params:  # texture paths are relative to the file that writes them
+            params = absolute_textures(found.params, Path(path).parent)
+            found = found.model_copy(update={"params": params})
+        chain.append((found, path))
         current = chain[-1][0].extends
     preset = chain[-1][0]
     for child, path in reversed(chain[:-1]):
@@ -159,7 +210,7 @@ def _override(parent: PresetFile, child: PresetFile, *, where: str) -> PresetFil
     update: dict[str, Any] = {k: getattr(child, k) for k in inherited if k in given}
     update["params"] = merge_params(parent.params, child.params)
     if parent.model in MODELS:
-        check_params(parent.model, update["params"], where=where)
+        split_params(parent.model, update["params"], where=where)
     return parent.model_copy(update={**update, "name": child.name, "extends": None})
 
 
@@ -187,10 +238,13 @@ def _layers(preset: PresetFile, path: Path, lookup: Lookup, seen: tuple[str, ...
             "normal_map": spec.normal_map and absolute(spec.normal_map),
             "specular_normal_map": spec.specular_normal_map and absolute(spec.specular_normal_map),
         }
+        given = absolute_textures(spec.params, path.parent)
         if spec.preset is None:
-            params = check_params(spec.model, spec.params, where=where, prefix=f"{field}.params")
+            params, textures = _checked(spec.model, given, where=where, prefix=f"{field}.params")
             name = spec.name or f"{preset.name}.{field}"
-            material = Material(name=name, model=spec.model, params=params, source=path)
+            material = Material(
+                name=name, model=spec.model, params=params, textures=textures, source=path
+            )
             out.append(Layer(material=material, name=name, **common))
             continue
         inner = _resolve_layer(spec.preset, lookup, seen, where=where, field=f"{field}.preset")
@@ -205,9 +259,10 @@ def _layers(preset: PresetFile, path: Path, lookup: Lookup, seen: tuple[str, ...
             out += [_nest(sub, spec.name or spec.preset, common) for sub in inner.layers]
             continue
         if spec.params:
-            merged = merge_params(inner.params.model_dump(exclude_unset=True), spec.params)
-            params = check_params(inner.model, merged, where=where, prefix=f"{field}.params")
-            inner = inner.model_copy(update={"params": params})
+            below = {**inner.params.model_dump(exclude_unset=True), **inner.textures}
+            merged = merge_params(below, given)
+            params, textures = _checked(inner.model, merged, where=where, prefix=f"{field}.params")
+            inner = inner.model_copy(update={"params": params, "textures": textures})
         out.append(Layer(material=inner, name=spec.name or spec.preset, **common))
     models = sorted({layer.material.model for layer in out})
     if len(models) > 1:
@@ -257,6 +312,24 @@ def multiply_masks(a: Mask, b: Mask) -> Mask:
 def _absolute_texture(texture: TextureMask, *, folder: Path) -> TextureMask:
     """Texture paths in a preset are relative to its file; consumers get absolute ones."""
     return texture.model_copy(update={"path": (folder / texture.path.expanduser()).resolve()})
+
+
+def absolute_textures(params: dict[str, Any], folder: Path) -> dict[str, Any]:
+    """``params`` with each texture's path made absolute against ``folder`` (the preset
+    file's), as mask textures are; ``<UDIM>`` is kept."""
+    out = dict(params)
+    for key, value in params.items():
+        if (
+            isinstance(value, dict)
+            and is_texture_input(value)
+            and isinstance(value["texture"], str)
+        ):
+            texture = str((folder / Path(value["texture"]).expanduser()).resolve())
+            out[key] = {**value, "texture": texture}
+        elif isinstance(value, TextureInput):
+            texture = str((folder / Path(value.texture).expanduser()).resolve())
+            out[key] = value.model_copy(update={"texture": texture})
+    return out
 
 
 def _with_set(preset: PresetFile, path: Path) -> dict[str, Any]:

@@ -30,7 +30,7 @@ from lookdev.materials import registry
 from lookdev.materials.errors import ParameterError, one_line, register_schema, short_repr
 from lookdev.materials.layers import ConstantMask, LayerSpec
 from lookdev.materials.params import Params
-from lookdev.materials.textures import TextureInput
+from lookdev.materials.textures import TextureInput, is_texture_input, texturable
 
 from .errors import PresetError
 
@@ -180,13 +180,59 @@ def check_params(model: str, params: dict[str, Any], *, where: str | None, prefi
 
     Strictly, as TOML is typed: ``roughness = "0.5"`` or ``roughness = true`` is a typo,
     not 0.5 or 1.0 (pydantic's lax mode would take both). TOML arrays become the tuples
-    that strict validation wants for colours.
+    that strict validation wants for colours. Parameters given as textures are checked as
+    :class:`~lookdev.materials.textures.TextureInput` (see :func:`split_params`).
     """
-    data = {k: tuple(v) if isinstance(v, list) else v for k, v in params.items()}
+    return split_params(model, params, where=where, prefix=prefix)[0]
+
+
+def split_params(
+    model: str, params: dict[str, Any], *, where: str | None, prefix: str = "params"
+) -> tuple[Params, dict[str, TextureInput]]:
+    """(the constants as ``model``'s parameters, the textures by parameter name).
+
+    A parameter written as a table with ``texture`` is a texture; it must be one the model
+    lets a texture drive (:func:`~lookdev.materials.textures.texturable`); the schema
+    checks the rest as constants, so a textured field is left at its default there.
+    Files are not opened here (see :mod:`lookdev.library.textures`).
+    """
+    params_type = MODELS[model]
+    allowed = texturable(params_type)
+    textures: dict[str, TextureInput] = {}
+    for key, value in params.items():
+        if not is_texture_input(value):
+            continue
+        if key not in allowed:
+            why = "no such parameter" if key not in params_type.model_fields else "not continuous"
+            raise ParameterError(
+                f"{key!r} cannot be a texture ({why}); textures drive {', '.join(allowed)}",
+                where=where,
+                field=f"{prefix}.{key}",
+            )
+        textures[key] = _texture_input(value, where=where, field=f"{prefix}.{key}")
+    if {"specular", "ior"} <= set(params) and "specular" in params_type.model_fields:
+        raise ParameterError(
+            "give either 'specular' or 'ior', not both: they are one parameter",
+            where=where,
+            field=prefix,
+        )
+    data = {
+        k: tuple(v) if isinstance(v, list) else v for k, v in params.items() if k not in textures
+    }
     try:
-        return MODELS[model].model_validate(data, strict=True)
+        return params_type.model_validate(data, strict=True), textures
     except ValidationError as exc:
         raise one_line(exc, ParameterError, where=where, prefix=prefix) from None
+
+
+def _texture_input(value: Any, *, where: str | None, field: str) -> TextureInput:
+    if isinstance(value, TextureInput):
+        return value
+    data = {k: tuple(v) if isinstance(v, list) else v for k, v in value.items()}
+    try:
+        return TextureInput.model_validate(data, strict=True)
+    except ValidationError as exc:
+        raise one_line(exc, ParameterError, where=where, prefix=field) from None
 
 
 def _validate(doc: dict[str, Any], *, where: str) -> PresetFile:
@@ -207,7 +253,39 @@ def dump_preset(preset: PresetFile) -> str:
     roughness = 0.3
     <BLANKLINE>
     """
-    return _compact_arrays(tomli_w.dumps(preset_document(preset)))
+    doc = preset_document(preset)
+    return _compact_arrays(_inline_textures(doc) or tomli_w.dumps(doc))
+
+
+def _inline_textures(doc: dict[str, Any]) -> str | None:
+    """The document with each texture of ``[params]`` as one inline table, as people write
+    it (``roughness = { texture = "r.png", channel = "r" }``; tomli_w would write a
+    ``[params.roughness]`` section; layers keep their sections); None when there is none,
+    or when the rewrite would not read back as the same document."""
+    tables: list[dict[str, Any]] = []
+
+    def mark(params: dict[str, Any]) -> dict[str, Any]:
+        out = {}
+        for key, value in params.items():
+            if isinstance(value, dict) and is_texture_input(value):
+                tables.append(value)
+                value = f"\x00texture{len(tables) - 1}\x00"
+            out[key] = value
+        return out
+
+    marked = dict(doc)
+    if "params" in doc:
+        marked["params"] = mark(doc["params"])
+    if not tables:
+        return None
+    text = tomli_w.dumps(marked)
+    for i, table in enumerate(tables):
+        items = [tomli_w.dumps({k: v}).strip() for k, v in table.items()]
+        text = text.replace(f'"\\u0000texture{i}\\u0000"', "{ " + ", ".join(items) + " }")
+    try:
+        return text if tomllib.loads(text) == doc else None
+    except tomllib.TOMLDecodeError:
+        return None
 
 
 def preset_document(preset: PresetFile) -> dict[str, Any]:

@@ -4,8 +4,9 @@ Editors that read JSON Schema for TOML (Taplo / Even Better TOML, via a
 ``#:schema ./preset.schema.json`` first line or their settings) then complete field
 names, show the descriptions and ranges, and flag mistakes while typing. The schema
 is the pydantic one plus what pydantic cannot see: ``[params]`` follows the preset's
-``model``, a colour may also be a ``"#rrggbb"`` string or one grey number, and a bare
-number is a mask.
+``model``, a colour may also be a ``"#rrggbb"`` string or one grey number, any continuous
+parameter may be a texture table (:class:`~lookdev.materials.textures.TextureInput`), and
+a bare number is a mask.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from typing import Any
 
 from lookdev.materials.layers import LayerSpec
 from lookdev.materials.params import Params, parse_color
+from lookdev.materials.textures import TextureInput, texturable
 
 from .preset import MODELS, NAME_RE, PresetFile
 
@@ -41,11 +43,17 @@ def params_schema(cls: type[Params], defs: dict[str, Any]) -> dict[str, Any]:
     """One model's parameter schema; its own ``$defs`` are hoisted into ``defs``."""
     schema = cls.model_json_schema()
     defs.update(schema.pop("$defs", {}))
+    texture = TextureInput.model_json_schema()
+    defs.update(texture.pop("$defs", {}))
+    defs[TextureInput.__name__] = texture
+    textured = {"$ref": f"#/$defs/{TextureInput.__name__}"}
     for name, field in cls.model_fields.items():
-        if any(getattr(m, "func", None) is parse_color for m in field.metadata):
-            prop = schema["properties"][name]
+        prop = schema["properties"][name]
+        colour = any(getattr(m, "func", None) is parse_color for m in field.metadata)
+        if colour or name in texturable(cls):
             meta = {k: prop.pop(k) for k in ("title", "description", "default") if k in prop}
-            schema["properties"][name] = {"anyOf": [prop, HEX_COLOR, GREY], **meta}
+            choices = [prop, HEX_COLOR, GREY] if colour else [prop]
+            schema["properties"][name] = {"anyOf": [*choices, textured], **meta}
     return schema
 
 

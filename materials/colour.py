@@ -11,6 +11,7 @@ curve or primaries matrix is written by hand anywhere in the program:
   or ``acescg``), named by the config's own colour-space names;
 * :func:`convert` moves pixels between any two of the config's spaces, by name or alias
   (``"sRGB - Texture"``, ``"ACEScg"``, ``"Raw"``); :func:`to_working` into the working space;
+* :func:`texture_space` names the colour space a texture is read in (the file rule);
 * :func:`decode_hex` reads a preset's ``"#rrggbb"`` as sRGB-encoded (``"sRGB - Texture"``);
 * :func:`luminance` weighs linear working-space RGB by the Y row of its RGB → CIE XYZ
   matrix, asked of the config (Rec.709: ITU-R BT.709-6 item 3.3).
@@ -53,11 +54,13 @@ __all__ = [
     "canonical",
     "working_space",
     "convert",
+    "convert_codes",
     "to_working",
     "decode_hex",
     "luminance",
     "luminance_weights",
     "is_data",
+    "texture_space",
 ]
 
 DEFAULT_CONFIG = "ocio://studio-config-v4.0.0_aces-v2.0_ocio-v2.5"
@@ -189,6 +192,69 @@ def convert(pixels: Any, src: str, dst: str | None = None) -> np.ndarray:
     return out
 
 
+def convert_codes(codes: np.ndarray, src: str, dst: str | None = None) -> np.ndarray:
+    """Integer-coded RGB ``codes`` (…, 3; uint8 or uint16, code/max is the encoded value)
+    from ``src`` to ``dst`` (default: the working space), float32: :func:`convert` of
+    ``codes / max``, to within 1e-6.
+
+    A texture of integers has at most 2⁸ or 2¹⁶ values per channel, so where the OCIO
+    transform is a per-channel curve followed by a matrix (every display-encoded texture
+    space into a scene-linear one: sRGB, gamma, Rec.709 curves; checked, not assumed)
+    the conversion is a table lookup per channel then a 3 × 3 matrix, both taken from
+    OCIO once per space pair; OCIO's lossless CPU path costs ~0.4 µs a pixel, which a 4K
+    UDIM set pays per tile. Where the check fails, it is :func:`convert`.
+    """
+    codes = np.asarray(codes)
+    src = canonical(src)
+    dst = working_space() if dst is None else canonical(dst)
+    split = _curves_and_matrix(settings().config_name, src, dst, np.iinfo(codes.dtype).max)
+    if split is None:
+        return convert(codes.astype(np.float32) / np.float32(np.iinfo(codes.dtype).max), src, dst)
+    curves, matrix = split
+    if curves[0] is curves[1] is curves[2]:  # one curve for all channels (sRGB, gamma)
+        out = curves[0][codes]
+    else:
+        out = np.empty(codes.shape, dtype=np.float32)
+        for k in range(3):
+            out[..., k] = curves[k][codes[..., k]]
+    if matrix is None:
+        return out
+    flat = out.reshape(-1, 3)
+    return (flat @ matrix.T).reshape(out.shape)
+
+
+@functools.cache
+def _curves_and_matrix(config_name: str, src: str, dst: str, top: int) -> tuple | None:
+    """(three per-channel curves over the codes 0..top, then a 3 × 3 matrix or None for the
+    identity) with ``convert(c / top) = M · (f_r(c_r), f_g(c_g), f_b(c_b))``; None when the
+    transform is not of that form (black must stay black, each channel's ramp must move
+    along one direction, and a random sample of codes must agree within 1e-6)."""
+    if np.abs(convert(np.zeros(3), src, dst)).max() > 0:
+        return None
+    levels = np.arange(top + 1, dtype=np.float64) / top
+    columns, curves = [], []
+    for k in range(3):
+        ramp = np.zeros((top + 1, 3), dtype=np.float32)
+        ramp[:, k] = levels
+        out = convert(ramp, src, dst).astype(np.float64)
+        column = out[-1]  # the curve is 1 at the top code
+        curve = out @ column / (column @ column)
+        if np.abs(np.outer(curve, column) - out).max() > 1e-6:
+            return None
+        columns.append(column)
+        curves.append(curve.astype(np.float32))
+    matrix = np.array(columns, dtype=np.float64).T
+    sample = np.random.default_rng(0).integers(0, top + 1, (4096, 3))
+    exact = convert(sample / top, src, dst)
+    linear = np.stack([curves[k][sample[:, k]] for k in range(3)], axis=-1)
+    if np.abs(linear @ matrix.T - exact).max() > 1e-6:
+        return None
+    identity = np.allclose(matrix, np.eye(3), rtol=0, atol=1e-7)
+    if all(np.array_equal(curves[0], c) for c in curves[1:]):
+        curves = [curves[0]] * 3
+    return tuple(curves), (None if identity else matrix.astype(np.float32))
+
+
 def to_working(pixels: Any, space: str) -> np.ndarray:
     """``pixels`` (…, 3) in ``space`` → the working space (float32)."""
     return convert(pixels, space)
@@ -228,3 +294,39 @@ def luminance(rgb: Any) -> Any:
     """
     out = np.asarray(rgb) @ luminance_weights()
     return float(out) if np.ndim(out) == 0 and not isinstance(rgb, np.ndarray) else out
+
+
+def texture_space(
+    bits_are_integer: bool, drives_colour: bool, declared: str | None, path: str | None = None
+) -> str:
+    """The colour space a texture file is read in, by the config's name.
+
+    The rule, first match wins:
+
+    1. ``declared`` (the texture's ``colorspace``) when given;
+    2. a data map (anything but a colour: roughness, metallic, masks, normals, heights)
+       is ``Raw``: it is never colour-converted by default;
+    3. the config's own file rules, when the config in force is not lookdev's default
+       (``$OCIO`` or ``--config`` named one) and ``path`` matches one of its rules other
+       than ``Default``: a studio that wrote rules for its texture names gets them. The
+       built-in studio config's rules are for plates (EXR → ACES2065-1), not textures,
+       so they are not consulted;
+    4. an integer colour map (8 or 16 bits) is ``sRGB - Texture`` (painted maps are
+       display-encoded), a float colour map (half, float EXR) is the working space
+       (scene-linear maps are written linear, in the space the look is built in).
+
+    >>> texture_space(True, True, None), texture_space(False, True, None)
+    ('sRGB Encoded Rec.709 (sRGB)', 'Linear Rec.709 (sRGB)')
+    >>> texture_space(True, False, None), texture_space(True, False, "ACEScg")
+    ('Raw', 'ACEScg')
+    """
+    if declared is not None:
+        return canonical(declared)
+    if not drives_colour:
+        return canonical(RAW)
+    if path is not None and settings().config_name != DEFAULT_CONFIG:
+        cfg = config()
+        if not cfg.filepathOnlyMatchesDefaultRule(path):
+            found = cfg.getColorSpaceFromFilepath(path)  # (name, rule index) in PyOpenColorIO
+            return canonical(found[0] if isinstance(found, tuple) else found)
+    return canonical(SRGB_TEXTURE) if bits_are_integer else working_space()

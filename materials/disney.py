@@ -168,17 +168,13 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
     terms = []
     if "specular" in lobes:
         d = _specular_d(xp, pr, h, h2)
-        if pr["gamma"] == 2.0:
+        if pr["ggx"]:
             g = mf.g1_over_cos(xp, ci, _q(pr, wi, zi2), zi2) * mf.g1_over_cos(
                 xp, co, _q(pr, wo, zo2), zo2
             )
         else:
             g = _v_cavity_over_cos(xp, h, h2, ci, co)
-        dg = (
-            _masked(xp, up, 0.25 * d * g)
-            if pr["gamma"] == 2.0
-            else xp.select(up, 0.25 * d * g, 0.0)
-        )
+        dg = _masked(xp, up, 0.25 * d * g) if pr["ggx"] else xp.select(up, 0.25 * d * g, 0.0)
         a, b, c = pr["spec_a"], pr["spec_b"], pr["spec_c"]
         dg_out = _times(dg, front)
         terms += [(a * scale, dg_out), ((b - a) * scale, dg_out * w)]
@@ -235,7 +231,7 @@ def _specular_d(xp: Any, pr: dict[str, Any], h: Any, h2: Any) -> Any:
 
     The GTR D is ∞ at h = 0 (wi = −wo, never a reflection pair): callers select, not mask.
     """
-    if pr["gamma"] == 2.0:
+    if pr["ggx"]:
         return mf.ggx_d(xp, h, pr["ax"], pr["ay"], n2=h2)
     inv_h2 = 1.0 / xp.maximum(h2, xp.tiny)
     sin2_h = (h[0] * h[0] + h[1] * h[1]) * inv_h2  # not 1 − cos²: the α = 10⁻³ peak
@@ -296,7 +292,7 @@ def _pdf_oriented(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> 
     h = wi + wo
     h2 = xp.maximum(xp.dot(h, h), xp.tiny)  # 4 cos²θd, from h for float32 (see above)
     p_up = 0.0
-    if "specular" in odds and pr["gamma"] != 2.0:
+    if "specular" in odds and not pr["ggx"]:
         # GTR sampling of App. B (eqs. 2–3): D(h) cos θh / (4 wo·h), as for the clearcoat.
         d = _specular_d(xp, pr, h, h2)
         p_up = odds["specular"] * xp.select(up, d * h[2] / (2.0 * h2), 0.0)
@@ -357,7 +353,7 @@ def _candidates(xp: Any, pr: dict[str, Any], wo: Any, u1: Any, u2: Any, front: A
         out["diffuse"] = out["sheen"] = (xp.vec3(x, y, z), z > 0.0)
         out["diff_trans"] = (xp.vec3(x, y, -z), z > 0.0)
     if "specular" in lobes:
-        if pr["gamma"] == 2.0:
+        if pr["ggx"]:
             h = mf.sample_visible_ggx(xp, wo, pr["ax"], pr["ay"], u1, u2)
         else:  # visible-normal sampling exists for GGX only: App. B's GTR sampling
             h = mf.sample_gtr(xp, pr["gamma"], pr["a2"], u1, u2)

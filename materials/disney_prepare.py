@@ -148,7 +148,10 @@ def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
     pr["ax2"], pr["ay2"] = ax * ax, ay * ay
     # The GTR shape of the specular lobe: 2 keeps the anisotropic GGX and visible-normal
     # sampling; any other γ is the isotropic GTR of App. B (eq. 1) with α² = αx αy.
-    pr["gamma"] = float(params.specular_gamma)
+    # A per-element γ (a blend of layers with different γ) takes the GTR path throughout.
+    gamma = maps.get("specular_gamma", params.specular_gamma)
+    pr["gamma"] = float(gamma) if isinstance(gamma, int | float) else xp.scalar(gamma)
+    pr["ggx"] = isinstance(gamma, int | float) and gamma == 2.0
     pr["a2"] = ax * ay
     if thin:
         # Burley 2015 Fig. 15 via Schutte: a thin sheet's transmission looks rougher.

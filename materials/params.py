@@ -111,6 +111,7 @@ class DisneyParams(Params):
         le=SPECULAR_GAMMA_MAX,
         description="Expert: GTR shape γ of the primary specular lobe (Burley 2012 App. B); 2 is "
         "Burley's GGX, lower gives a longer tail, higher a tighter one. Isotropic when not 2.",
+        json_schema_extra={"texturable": False},  # it picks the lobe's sampling technique
     )
     sheen: float = _unit(
         0.0,

@@ -320,13 +320,38 @@ LAYERED_MODEL = Model(
 
 
 # -- public numpy API ----------------------------------------------------------------------
-def lobe_weights(params: PixarParams, cos_view: Any = 1.0) -> dict[str, np.ndarray]:
-    """Smits' twelve weights by his names, each an RGB colour (shape (3,) or (..., 3))."""
+def lobe_weights(
+    params: PixarParams, cos_view: Any = 1.0, maps: dict[str, Any] | None = None
+) -> dict[str, np.ndarray]:
+    """Smits' twelve weights by his names, each an RGB colour (shape (3,) or (..., 3)).
+
+    ``maps`` give parameters per texel (scalars (...), colours (..., 3), one leading shape);
+    the view is then one ``cos_view`` and the weights are (..., 3) over the texels.
+    """
     xp = NumpyOps()
     c = np.asarray(cos_view, dtype=np.float64)
+    if maps:
+        lead = next(np.shape(v)[: np.ndim(v) - (k in _COLORS)] for k, v in maps.items())
+        flat = {
+            k: np.reshape(v, (-1, 3)).T if k in _COLORS else np.reshape(v, -1)
+            for k, v in maps.items()
+        }
+        w = weights(xp, view_independent(xp, _values(xp, params, flat)), c.reshape(-1))
+        size = int(np.prod(lead))
+        return {k: np.broadcast_to(np.asarray(w[k]), (3, size)).T.reshape(*lead, 3) for k in w}
     w = weights(xp, view_independent(xp, _values(xp, params, {})), c.reshape(-1))
     shape = (*c.shape, 3)
     return {k: np.broadcast_to(np.asarray(w[k]).T, (c.size, 3)).reshape(shape) for k in w}
+
+
+def eta_of(params: PixarParams, maps: dict[str, Any] | None = None) -> Any:
+    """:attr:`PixarParams.eta` where ``ior`` or ``normal_fresnel`` may be per-texel maps."""
+    maps = maps or {}
+    if "ior" in maps:
+        return np.asarray(maps["ior"], dtype=np.float64)
+    if "normal_fresnel" in maps and params.ior is None:
+        return f0_to_ior(DIELECTRIC_REFL * np.asarray(maps["normal_fresnel"], dtype=np.float64))
+    return params.eta
 
 
 def as_lobe_weights(params: PixarParams) -> Any:

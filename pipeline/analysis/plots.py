@@ -281,6 +281,15 @@ def varied(hubs: Sequence[BlendedMaterial], field: str, values: Sequence[float])
 
 
 # -- figure --------------------------------------------------------------------------
+def at_uv(hub: BlendedMaterial, uv: tuple[float, float]) -> BlendedMaterial:
+    """``hub`` as the uniform material it is at ``uv`` (every plot then shows that texel);
+    a layered Pixar hub (lobe weights, not parameters) keeps its maps."""
+    if not hub.maps or hub.representation != "params":
+        return hub
+    u, v = uv
+    return BlendedMaterial.of_params(hub.params_at_uv(u, v), name=f"{hub.name} @ uv ({u:g}, {v:g})")
+
+
 def figure(
     hubs: Sequence[BlendedMaterial],
     view: str,

@@ -159,7 +159,9 @@ def blend(
     material
         A preset name or path, or a :class:`~lookdev.library.Material`.
     resolution
-        Texels a side, or ``(width, height)``.
+        Texels a side, or ``(width, height)``, of each UV square: a material whose textures
+        are UDIM sets gets maps over every tile (a 2 × 2 set at 1024: 2048 × 2048), with
+        ``uv_extent`` and ``tiles`` saying which.
     layering
         Pixar stacks: ``"full"`` (light through a layer meets the ones below, Smits'
         table) or ``"simple"`` (A over B).
@@ -173,9 +175,11 @@ def blend(
     Returns
     -------
     lookdev.pipeline.blend.BlendedMaterial
-        ``maps[name][row, col]`` is the texel centred on ``((col + ½)/W, (row + ½)/H)``;
-        ``params_at(row, col)`` the parameters there. A layered Pixar material blends to
-        Smits' lobe weights (``representation == "lobe_weights"``).
+        ``maps[name][row, col]`` is the texel centred on ``((col + ½)/W, (row + ½)/H)``
+        (over ``uv_extent``); ``params_at(row, col)`` the parameters there,
+        ``params_at_uv(u, v)`` at a UV. Parameters read straight from one unchanged
+        image are also in ``textures`` (the file, for exporters). A layered Pixar
+        material blends to Smits' lobe weights (``representation == "lobe_weights"``).
 
     Examples
     --------
@@ -255,9 +259,7 @@ def _texels(blended: Any, uv: Any, lead: tuple[int, ...]) -> tuple[np.ndarray, n
     uv = np.broadcast_to(np.asarray(uv, dtype=np.float64), (*lead, 2))
     if not np.isfinite(uv).all():
         raise MaterialError("uv holds NaN or infinite values", where=blended.name, field="uv")
-    width, height = blended.resolution
-    cols = np.floor(uv[..., 0] * width).astype(np.intp) % width
-    rows = np.floor(uv[..., 1] * height).astype(np.intp) % height
+    rows, cols = blended.texel(uv)
     return rows, cols
 
 

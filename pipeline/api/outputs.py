@@ -475,8 +475,8 @@ def check_textures(material: Any) -> None:
     """Every texture a material names (masks and normal maps of every layer, nested
     layered presets included, pruned or not) exists, decodes and has its channels; else
     the one line of :class:`~lookdev.pipeline.blend.resample.TextureError`."""
+    from lookdev.library.images import TextureFile
     from lookdev.materials.layers import textures
-    from lookdev.pipeline.blend.resample import TextureFile
 
     for i, layer in enumerate(getattr(material, "layers", None) or []):
         if not hasattr(layer, "mask"):  # a blend's or a model's own: nothing to read
@@ -517,8 +517,12 @@ def plot(
     resolution: int = 128,
     library: Any = None,
     vary: tuple[str, Sequence[float]] | None = None,
+    uv: tuple[float, float] | None = None,
 ) -> Plot:
     """Draw materials side by side as one BRDF-explorer view (Burley §3.2) to an image.
+
+    ``uv``: draw a texture-driven material as it is at that UV (its parameters at the
+    texel there, as :func:`lookdev.evaluate` takes them); by default the centre texel.
 
     ``view``: ``slice`` (f(θh, θd) at φd = 90°), ``albedo`` (directional albedo per
     channel), ``polar`` (f in the plane of incidence) or ``sphere`` (a lit sphere, also
@@ -544,7 +548,9 @@ def plot(
     if isinstance(materials, str | os.PathLike):
         materials = [materials]
     hubs = [hub(m, plots.MAP_RESOLUTION, lib) for m in _materials(materials, lib)]
-    if vary is not None:
+    if uv is not None:
+        hubs = [plots.at_uv(h, uv) for h in hubs]
+    if vary is not None:  # after --uv, which makes a textured material uniform
         hubs = plots.varied(hubs, vary[0], [float(v) for v in vary[1]])
     environment = None
     if ibl is not None:

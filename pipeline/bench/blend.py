@@ -17,7 +17,9 @@ different per layer, so all parameter maps vary. Measured in one run:
   reset just before the blend) in a child process, so that everything counts, OpenImageIO
   and OpenEXR included; for this stack and for :func:`large_mask_material`, float EXR
   masks at twice the resolution driving a single map (where decoded masks, not maps,
-  would dominate), streamed and, as the baseline, ``_decoded`` whole;
+  would dominate), streamed and, as the baseline, ``_decoded`` whole; and for
+  :func:`udim_material`, a 2 × 2 UDIM set of N × N 8-bit roughness tiles on the base of a
+  two-layer stack (``-r 4096``: the 4-tile 4K set of issue 14), the map (2N)²;
 - ``targets_met``: each bounded figure against :data:`TARGETS` (the table's target column);
 - pruning: the same blend with ``prune=False`` on the built-in ``rusty_car_paint`` (maps
   that need not vary) and on this stack with a full-coverage layer and a zero layer added
@@ -52,6 +54,7 @@ TARGETS = {
     "peak_to_output": 2.0,
     "peak_rss_to_output_stack": 2.0,
     "peak_rss_to_output_large_masks": 2.0,
+    "peak_rss_to_output_udim": 2.0,
 }
 """Issue 5's bounds: time ≤ 4× the copy, peak memory < 2× the output."""
 
@@ -107,6 +110,7 @@ def run(resolution: int, folder: Path | None = None, *, repeat: int = 3) -> dict
         },
         **{f"peak_rss_mb_{case}": r["peak_bytes"] / 1e6 for case, r in rss.items()},
         "output_mb_large_masks": rss["large_masks"]["output_bytes"] / 1e6,
+        "output_mb_udim": rss["udim"]["output_bytes"] / 1e6,
         "pruning": {
             PRUNING_PRESET: pruning_saving(_library_material(PRUNING_PRESET), resolution, repeat),
             "hidden+zero layers": pruning_saving(
@@ -220,10 +224,39 @@ def _roughness(name: str, value: float):
     return Material(name=name, model="disney", params=DisneyParams(roughness=value))
 
 
+UDIM_TILES = (1001, 1002, 1011, 1012)
+"""The UDIM case's tiles: a 2 × 2 set."""
+
+
+def udim_material(folder: Path, resolution: int):
+    """A roughness texture set of four N × N 8-bit UDIM tiles on the base, under a noise-
+    masked constant layer: the blend writes one map over the 2 × 2 tile grid, (2N)²."""
+    from lookdev.library import Layer, Material
+    from lookdev.materials.layers import NoiseMask
+    from lookdev.materials.textures import TextureInput
+
+    rng = np.random.default_rng(5)
+    for tile in UDIM_TILES:
+        path = folder / f"rough.{tile}.png"
+        if not path.exists():
+            pixels = rng.integers(0, 256, (resolution, resolution), dtype=np.uint8)
+            write_mask(path, pixels, oiio.UINT8)
+    texture = TextureInput(texture=str(folder / "rough.<UDIM>.png"))
+    base = Material(
+        name="udim_base", model="disney", params=DisneyParams(), textures={"roughness": texture}
+    )
+    stack = [
+        Layer(material=base, name="base"),
+        Layer(material=_roughness("worn", 0.8), mask=NoiseMask(scale=8), name="worn"),
+    ]
+    return Material(name="bench_udim", model="layered", layers=stack)
+
+
 _CASES = {
     "stack": bench_material,
     "large_masks": large_mask_material,
     "large_masks_decoded": large_mask_material,
+    "udim": udim_material,
 }
 """Cases of :func:`peak_rss`; ``*_decoded`` blends with the masks decoded whole (a caller's
 image cache, as blend did before it streamed large masks): the baseline of the same run."""
@@ -281,11 +314,12 @@ def peak_bytes(fn) -> int:
         tracemalloc.stop()
 
 
-def write_mask(path: Path, values: np.ndarray) -> Path:
-    """A one-channel float EXR written with OpenImageIO."""
+def write_mask(path: Path, values: np.ndarray, fmt: Any = oiio.FLOAT) -> Path:
+    """A one-channel image written with OpenImageIO (float EXR by default)."""
     height, width = values.shape
-    buf = oiio.ImageBuf(oiio.ImageSpec(width, height, 1, oiio.FLOAT))
-    buf.set_pixels(oiio.ROI(0, width, 0, height, 0, 1, 0, 1), values.astype(np.float32))
+    buf = oiio.ImageBuf(oiio.ImageSpec(width, height, 1, fmt))
+    pixels = values.astype(np.float32) if values.dtype.kind == "f" else values
+    buf.set_pixels(oiio.ROI(0, width, 0, height, 0, 1, 0, 1), pixels)
     if not buf.write(str(path)):
         raise RuntimeError(f"cannot write {path}: {buf.geterror()}")
     return path

@@ -79,6 +79,9 @@ def sidecar_dict(blended: BlendedMaterial, files: dict[str, str]) -> dict[str, A
         "representation": blended.representation,
         "resolution": [width, height],
         "orientation": "top row of each file is v = 1; UV (0, 0) is the bottom-left texel",
+        "uv_extent": list(blended.uv_extent),
+        "udim_tiles": list(blended.tiles),
+        "textures": {k: t.model_dump(mode="json") for k, t in blended.textures.items()},
         "constants": {k: _plain(v) for k, v in blended.constants.items()},
         "maps": {
             name: {

@@ -35,6 +35,7 @@ from .errors import BlendError
 from .masks import MaskSampler
 from .result import TILE_TEXELS, BlendedMaterial
 from .stack import Decision, Entry, prune_stack, stack_of
+from .textures import extent_of, open_textures, sample
 
 Progress = Callable[[int, int], None]
 """Called as ``progress(rows_done, rows_total)`` after each tile."""
@@ -51,9 +52,11 @@ def blend(
 ) -> BlendedMaterial:
     """Blend a library :class:`~lookdev.library.Material` at ``resolution``.
 
-    ``resolution`` is ``N`` (N × N) or ``(width, height)``. A non-layered material blends
-    to constants and no maps. Disney stacks blend parameters (:mod:`.disney`); Pixar
-    stacks composite lobe weights (:mod:`.pixar`). ``prune=False`` turns off every
+    ``resolution`` is ``N`` (N × N) or ``(width, height)`` per UV square: UDIM textures
+    widen the maps to every square their tiles cover (:attr:`BlendedMaterial.uv_extent`).
+    A non-layered material blends to constants, and maps only for textured parameters.
+    Disney stacks blend parameters (:mod:`.disney`); Pixar stacks composite lobe weights
+    (:mod:`.pixar`). ``prune=False`` turns off every
     saving (all layers, all parameters as maps) and exists to measure them. ``images``
     caches decoded textures across calls (see :class:`.MaskSampler`). ``layering`` is
     Smits' ``"full"`` (transmitted light meets the layers below) or ``"simple"`` layering
@@ -65,7 +68,12 @@ def blend(
     if width < 1 or height < 1:
         raise BlendError(f"resolution {width}x{height} must be at least 1x1", where=material.name)
     entries = stack_of(material)
-    sampler = MaskSampler((height, width), images, output_channels=_channels_bound(entries))
+    folded = open_textures(entries)
+    extent = extent_of(entries, _surface_sets(material))
+    du, dv = extent[2] - extent[0], extent[3] - extent[1]
+    sampler = MaskSampler(
+        (height * dv, width * du), images, output_channels=_channels_bound(entries), extent=extent
+    )
     if entries[0].model == "pixar":
         result = pixar.blend_stack(
             material.name,
@@ -80,10 +88,22 @@ def blend(
         kept, decisions = prune_stack(entries, sampler, enabled=prune)
         result = _blend_disney(material.name, kept, sampler, progress, naive=not prune)
         result.decisions = decisions + result.decisions
+    result.decisions = folded + result.decisions
+    result.uv_extent = extent
+    result.tiles = tuple(
+        sorted({t for e in entries for x in e.decoded.values() for t in x.tiles} - {None})
+    )
     result.description = getattr(material, "description", "")
     result.origin = material
     result.layered = getattr(material, "model", None) == "layered"
     return result
+
+
+def _surface_sets(material: Any) -> list[str]:
+    """The texture-set height and normal maps of ``material`` (:mod:`.surface_maps` puts
+    them on the hub): their UDIM tiles widen the extent every map spans."""
+    height, normal = getattr(material, "height", None), getattr(material, "normal_map", None)
+    return [str(p) for p in (height and height.texture, normal and normal.path) if p]
 
 
 def _channels_bound(entries: list[Entry]) -> float:
@@ -93,20 +113,46 @@ def _channels_bound(entries: list[Entry]) -> float:
     texture budget."""
     if entries[0].model != "disney":
         return math.inf
-    values = [disney.layer_values(e.params) for e in entries]
+    values = [_values(e) for e in entries]
     differing = [k for k in values[0] if any(v[k] != values[0][k] for v in values)]
+    differing += [k for k in values[0] if k not in differing and isinstance(values[0][k], Textured)]
     normals = sum(
         any(getattr(e, which) is not None for e in entries)
         for which in ("normal_map", "specular_normal_map")
     )
-    return sum(np.size(values[0][k]) for k in differing) + 3 * normals
+    return sum(3 if k == disney.COLOR else 1 for k in differing) + 3 * normals
+
+
+class Textured:
+    """A layer's value of a parameter that a texture drives (``field``: the parameter the
+    texture was written for; ``ior`` for a ``specular`` spelled as a textured IOR)."""
+
+    def __init__(self, field: str, texture: Any):
+        self.field, self.texture = field, texture
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Textured) and (self.field, self.texture) == (
+            other.field,
+            other.texture,
+        )
+
+    def __hash__(self) -> int:
+        return hash((self.field, self.texture))
+
+
+def _values(entry: Entry) -> dict[str, Any]:
+    """A layer's values in blending space, :class:`Textured` where a texture drives them."""
+    values = disney.layer_values(entry.params)
+    for key, texture in entry.decoded.items():
+        values["specular" if key == "ior" else key] = Textured(key, texture.tex)
+    return values
 
 
 def _blend_disney(
     name: str, kept: list[Entry], sampler: MaskSampler, progress, *, naive: bool = False
 ) -> BlendedMaterial:
     """Parameter blending of the kept layers (bottom first) into constants and maps."""
-    values = [disney.layer_values(e.params) for e in kept]
+    values = [_values(e) for e in kept]
     if naive:
         constants, varying, inert = {}, set(values[0]), set()
     else:
@@ -121,6 +167,13 @@ def _blend_disney(
     out.layers = kept
     out.maps = _disney_maps(kept, values, varying, sampler, progress, out)
     out.constants = disney.assemble(constants, discrete, stack)
+    for key in _passed_through(values):
+        if values[0][key].field == key:  # the file as it is (a textured IOR becomes specular)
+            out.textures[key] = (
+                kept[0]
+                .decoded[key]
+                .tex.model_copy(update={"colorspace": kept[0].decoded[key].space})
+            )
     if "specular" in out.maps:
         out.maps.update(disney.spell_specular(stack, out.maps.pop("specular")))
     return out
@@ -133,8 +186,8 @@ def _plan(values: list[dict[str, Any]], kept: list[Entry]):
     A uniform mask lerps constants into constants; a varying mask makes a parameter vary
     unless the layer's value equals the constant below.
     """
-    constants: dict[str, Any] = dict(values[0])
-    varying: set[str] = set()
+    varying = {k for v in values for k, x in v.items() if isinstance(x, Textured)}
+    constants: dict[str, Any] = {k: x for k, x in values[0].items() if k not in varying}
     inert = []
     bumpy = False  # a normal map so far: any layer over it flattens it where it shows
     for i, (entry, layer) in enumerate(zip(kept[1:], values[1:], strict=True), start=1):
@@ -153,6 +206,16 @@ def _plan(values: list[dict[str, Any]], kept: list[Entry]):
         if not changes:
             inert.append(i)
     return constants, varying, set(inert)
+
+
+def _passed_through(values: list[dict[str, Any]]) -> list[str]:
+    """Parameters every kept layer takes from one and the same texture: their blend is the
+    texture itself (the weights sum to 1), read straight, and exporters may reference it."""
+    return [
+        k
+        for k, x in values[0].items()
+        if isinstance(x, Textured) and all(v[k] == x for v in values[1:])
+    ]
 
 
 def _has_normals(entry: Entry) -> bool:
@@ -188,8 +251,16 @@ def _disney_maps(kept, values, varying, sampler, progress, out: BlendedMaterial)
         return {}
     block = np.empty((len(scalars), height, width), dtype=np.float32)
     maps = {k: block[i] for i, k in enumerate(scalars)}
-    p_scalar = np.array([[v[k] for v in values] for k in scalars], dtype=np.float32)
-    p_color = np.array([v[disney.COLOR] for v in values], dtype=np.float32)
+    p_scalar = np.array([[_const(v[k]) for v in values] for k in scalars], dtype=np.float32)
+    p_color = np.array([_const(v[disney.COLOR], 3) for v in values], dtype=np.float32)
+    passed = set(_passed_through(values))
+    textured = [
+        (k, i, entry)
+        for k in [*scalars, disney.COLOR]
+        if k in varying
+        for i, (entry, v) in enumerate(zip(kept, values, strict=True))
+        if isinstance(v[k], Textured) and (k not in passed or i == 0)
+    ]
     if disney.COLOR in varying:
         maps[disney.COLOR] = np.empty((height, width, 3), dtype=np.float32)
     if normals:
@@ -208,12 +279,27 @@ def _disney_maps(kept, values, varying, sampler, progress, out: BlendedMaterial)
                 np.matmul(p_scalar, weights, out=block[:, rows].reshape(len(scalars), -1))
             if color is not None:
                 np.matmul(weights.T, p_color, out=color[rows].reshape(-1, 3))
+            for key, i, entry in textured:
+                values_here = sample(sampler, entry, key, rows)
+                target = maps[key][rows]
+                if key in passed:
+                    target[...] = values_here.reshape(target.shape)
+                else:
+                    w = weights[i].reshape(n, width, *([1] if target.ndim == 3 else []))
+                    target += w * values_here.reshape(target.shape)
             for which in ("normal_map", "specular_normal_map"):
                 if getattr(out, which) is not None:
                     getattr(out, which)[rows] = _tile_normals(kept, sampler, rows, weights, which)
             if progress is not None:
                 progress(rows.stop, height)
     return maps
+
+
+def _const(value: Any, count: int = 1) -> Any:
+    """A layer's constant for the matrix product; 0 where a texture adds its own share."""
+    if isinstance(value, Textured):
+        return 0.0 if count == 1 else (0.0, 0.0, 0.0)
+    return value
 
 
 def _tile_weights(kept: list[Entry], sampler: MaskSampler, rows: slice, out: np.ndarray):

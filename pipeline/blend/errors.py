@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
+from lookdev.library.errors import TextureError
 from lookdev.materials.errors import LookdevError
+
+__all__ = ["BlendError", "TextureError"]
 
 
 class BlendError(LookdevError):
     """A layer stack cannot be blended (mixed models, disagreeing discrete parameters …)."""
-
-
-class TextureError(BlendError):
-    """A mask or normal-map texture is missing, unreadable, undecodable or not finite."""

@@ -56,7 +56,9 @@ class MaskSampler:
     :data:`WHOLE_BUDGET` of the output, ``output_channels`` float32 channels at its
     resolution (the engine's bound on what a blend writes); larger ones stay in their
     files (:class:`.resample.TextureFile`) and each tile reads the rows it needs, so a
-    4096² float mask that varies one 2048² map costs rows, not 64 MB.
+    4096² float mask that varies one 2048² map costs rows, not 64 MB. A file whose format
+    cannot be read by rows (PNG, JPEG: :data:`lookdev.library.images.RANDOM_ACCESS`) is
+    held whole as stored, a byte per 8-bit channel, whatever its size.
     """
 
     def __init__(
@@ -64,67 +66,91 @@ class MaskSampler:
         resolution: tuple[int, int],
         images: dict | None = None,
         output_channels: float = math.inf,
+        extent: tuple[int, int, int, int] = (0, 0, 1, 1),
     ):
+        """``extent`` (u0, v0, u1, v1) is the UV region the output covers, in whole UV
+        squares (a UDIM set's tiles, see :class:`.result.BlendedMaterial`); texel centres
+        are ``u = u0 + (c + ½)/W · (u1 − u0)`` and likewise in v."""
         self.height, self.width = resolution
+        self.extent = extent
         output_bytes = output_channels * self.height * self.width * 4
         self._budget = math.inf if images is not None else WHOLE_BUDGET * output_bytes
-        self._images: dict[tuple, tuple[Any, tuple[float, float]]] = (
-            {} if images is None else images
-        )
+        self._images: dict[tuple, Any] = {} if images is None else images
         self._tap_cache: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
         self._mips: dict[tuple, np.ndarray] = {}
+        self._bounds: dict[tuple, tuple[float, float]] = {}
 
     def image(self, tex: TextureMask, count: int = 1, *, where: str | None = None) -> Any:
         """The source channels of ``tex``, as stored (see :func:`.read_channels`): an array
         when decoded whole, else a :class:`.TextureFile` indexed by rows the same way."""
         key = (str(tex.path), tex.channel, count)
+        return self.source(key, lambda: TextureFile(tex, count, where=where))
+
+    def source(self, key: tuple, opener: Any, *, lazy: bool = False) -> Any:
+        """The source cached under ``key`` (``opener()`` makes it: a :class:`.TextureFile`
+        or anything indexed by rows like one), decoded whole while it fits the budget;
+        ``lazy`` keeps it as it is (a view that decodes rows of a source held here)."""
         if key not in self._images:
-            source = TextureFile(tex, count, where=where)
-            if self._whole_bytes() + source.nbytes <= self._budget:
+            source = opener()
+            fits = self._whole_bytes() + source.nbytes <= self._budget
+            # A file that cannot be read rows at a time is held whole, as stored (a byte per
+            # 8-bit channel): streaming it would decode it again from the top for every tile.
+            if not lazy and (fits or not getattr(source, "random_access", True)):
                 source = source[np.arange(source.shape[0])]
-                chunks = [(0, source)]
-            else:
-                chunks = source.chunks()
-            lo, hi = _min_max(a for _, a in chunks)
-            self._images[key] = (source, (lo, hi))
-        return self._images[key][0]
+            self._images[key] = source
+        return self._images[key]
+
+    def extent_map(self, scale: tuple[float, float], offset: tuple[float, float]):
+        """A texture's UV scale and offset as seen from the output's 0..1 texel grid:
+        ``s = (e0 + t·Δe)·scale + offset`` = ``t·(scale·Δe) + (e0·scale + offset)``."""
+        u0, v0, u1, v1 = self.extent
+        (su, sv), (ou, ov) = scale, offset
+        return (su * (u1 - u0), sv * (v1 - v0)), (u0 * su + ou, v0 * sv + ov)
 
     def lookup(
         self, tex: TextureMask, count: int = 1, rows: slice | None = None, *, where=None
     ) -> np.ndarray:
-        """Filtered texture values at the output texels of ``rows``: (n, W, count).
+        """Filtered texture values at the output texels of ``rows``: (n, W, count)."""
+        key = (str(tex.path), tex.channel, count)
+        self.image(tex, count, where=where)
+        scale, offset = self.extent_map(tex.uv_scale, tex.uv_offset)
+        shape = (self.height, self.width)
+        return self.filtered(key, shape, scale, offset, tex.wrap, rows or slice(0, self.height))
+
+    def filtered(self, key, shape, scale, offset, wrap, rows: slice) -> np.ndarray:
+        """The source cached under ``key`` filtered onto a ``shape`` (h, w) grid covering the
+        source's UV square ``scale``·t + ``offset``, output rows ``rows``: (n, w, count).
 
         Where an output texel covers more than 4 source texels along an axis (strong
         minification, or many repeats), the source is first box-reduced along it by a
         power of two (a mip level) that leaves a footprint of 2 to 4 texels, so the cost
         does not grow with the footprint.
         """
-        src = self.image(tex, count, where=where)
-        (su, sv), (ou, ov) = tex.uv_scale, tex.uv_offset
-        kv = _mip_factor(src.shape[0], sv, self.height)
-        ku = _mip_factor(src.shape[1], su, self.width)
+        src = self._images[key]
+        (su, sv), (ou, ov) = scale, offset
+        kv = _mip_factor(src.shape[0], sv, shape[0])
+        ku = _mip_factor(src.shape[1], su, shape[1])
         if kv > 1 or ku > 1:
-            src = self._reduced(tex, count, kv, ku)
+            src = self._reduced(key, kv, ku)
         h, w = src.shape[:2]
-        v_idx, v_w = self._taps(self.height, h, sv, ov, tex.wrap)
-        rows = rows or slice(0, self.height)
-        u_taps = self._taps(self.width, w, su, ou, tex.wrap)
+        v_idx, v_w = self._taps(shape[0], h, sv, ov, wrap)
+        u_taps = self._taps(shape[1], w, su, ou, wrap)
         return resample(src, (v_idx[rows], v_w[rows]), u_taps)
 
-    def _reduced(self, tex: TextureMask, count: int, kv: int, ku: int) -> Any:
+    def _reduced(self, key: tuple, kv: int, ku: int) -> Any:
         """The source averaged over kv × ku blocks (float32, cached): whole while it fits
         the budget, else rows reduced when a tile asks for them."""
-        key = (str(tex.path), tex.channel, count, kv, ku)
-        if key not in self._mips:
-            reduced = BoxReduced(self.image(tex, count), kv, ku)
+        mip = (*key, kv, ku)
+        if mip not in self._mips:
+            reduced = BoxReduced(self._images[key], kv, ku)
             if self._whole_bytes() + reduced.nbytes <= self._budget:
                 reduced = reduced[np.arange(reduced.shape[0])]
-            self._mips[key] = reduced
-        return self._mips[key]
+            self._mips[mip] = reduced
+        return self._mips[mip]
 
     def _whole_bytes(self) -> int:
         """Bytes of the textures and reductions this sampler holds decoded whole."""
-        held = [a for a, _ in self._images.values()] + list(self._mips.values())
+        held = list(self._images.values()) + list(self._mips.values())
         return sum(a.nbytes for a in held if isinstance(a, np.ndarray))
 
     def _taps(self, *key) -> tuple[np.ndarray, np.ndarray]:
@@ -163,9 +189,10 @@ class MaskSampler:
         return combine(mask.kind, values)
 
     def _uv(self, rows: slice) -> tuple[np.ndarray, np.ndarray]:
-        """Texel-centre UVs of ``rows``: u as (1, W), v as (n, 1), float64."""
-        u = (np.arange(self.width) + 0.5) / self.width
-        v = (np.arange(self.height)[rows] + 0.5) / self.height
+        """Texel-centre UVs of ``rows`` over the extent: u as (1, W), v as (n, 1), float64."""
+        u0, v0, u1, v1 = self.extent
+        u = u0 + (np.arange(self.width) + 0.5) / self.width * (u1 - u0)
+        v = v0 + (np.arange(self.height)[rows] + 0.5) / self.height * (v1 - v0)
         return u[None, :], v[:, None]
 
     def bounds(self, mask: Mask, *, where=None) -> tuple[float, float]:
@@ -182,7 +209,8 @@ class MaskSampler:
         if isinstance(mask, NoiseMask):
             return 0.0, 1.0
         if isinstance(mask, RampMask):
-            return _ramp_bounds(mask, self.height, self.width)
+            u, v = self._uv(slice(0, self.height))
+            return _ramp_bounds(mask, u[0], v[:, 0])
         if isinstance(mask, InvertMask):
             lo, hi = self.bounds(mask.input, where=where)
             return 1.0 - hi, 1.0 - lo
@@ -194,15 +222,19 @@ class MaskSampler:
         return float(combine(mask.kind, list(lows))), float(combine(mask.kind, list(highs)))
 
     def _texture_bounds(self, tex: TextureMask, where) -> tuple[float, float]:
-        self.image(tex, 1, where=where)
-        lo, hi = (min(max(x, 0.0), 1.0) for x in self._images[(str(tex.path), tex.channel, 1)][1])
+        key = (str(tex.path), tex.channel, 1)
+        source = self.image(tex, 1, where=where)
+        if key not in self._bounds:
+            whole = isinstance(source, np.ndarray)
+            self._bounds[key] = _min_max([source] if whole else (a for _, a in source.chunks()))
+        lo, hi = (min(max(x, 0.0), 1.0) for x in self._bounds[key])
         if tex.wrap == "black" and self._reads_outside(tex):
             lo = 0.0
         return (1.0 - hi, 1.0 - lo) if tex.invert else (lo, hi)
 
     def _reads_outside(self, tex: TextureMask) -> bool:
         h, w = self.image(tex).shape[:2]
-        (su, sv), (ou, ov) = tex.uv_scale, tex.uv_offset
+        (su, sv), (ou, ov) = self.extent_map(tex.uv_scale, tex.uv_offset)
         v_w = taps(self.height, h, sv, ov, "black")[1].sum(axis=1)
         u_w = taps(self.width, w, su, ou, "black")[1].sum(axis=1)
         return bool((v_w < 1 - 1e-6).any() or (u_w < 1 - 1e-6).any())
@@ -295,16 +327,14 @@ def _ramp_profile(mask: RampMask, t: np.ndarray) -> np.ndarray:
     return t * t * (3.0 - 2.0 * t) if mask.interpolation == "smooth" else t
 
 
-def _ramp_bounds(mask: RampMask, height: int, width: int) -> tuple[float, float]:
-    """Exact range of a ramp over the texel centres (it is monotone in its coordinate)."""
-    u = (np.array([0, width - 1]) + 0.5) / width
-    v = (np.array([0, height - 1]) + 0.5) / height
+def _ramp_bounds(mask: RampMask, u: np.ndarray, v: np.ndarray) -> tuple[float, float]:
+    """Exact range of a ramp over the texel centres ``u`` and ``v`` (it is monotone in its
+    coordinate; radially, the nearest centre to (½, ½) and the farthest corner)."""
     if mask.axis == "radial":
-        du = 0.0 if width % 2 else 0.5 / width  # a texel centre sits on u = ½ when W is odd
-        dv = 0.0 if height % 2 else 0.5 / height
-        t = np.array([np.hypot(du, dv), np.hypot(u[0] - 0.5, v[0] - 0.5)])
+        du, dv = np.abs(u - 0.5), np.abs(v - 0.5)
+        t = np.array([np.hypot(du.min(), dv.min()), np.hypot(du.max(), dv.max())])
     else:
-        t = u if mask.axis == "u" else v
+        t = np.array([u.min(), u.max()] if mask.axis == "u" else [v.min(), v.max()])
     values = _ramp_profile(mask, t)
     return float(values.min()), float(values.max())
 

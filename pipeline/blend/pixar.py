@@ -14,12 +14,14 @@ from typing import Any
 
 import numpy as np
 
+from lookdev.materials.pixar import eta_of
 from lookdev.materials.pixar_scatter import LOBES, PREFIX
 
 from .masks import MaskSampler
 from .pixar_composite import GROUP, Lobes, Part, composite, layer_lobes, unit
 from .result import LOBE_WEIGHTS, TILE_TEXELS, BlendedMaterial
 from .stack import Entry, prune_stack
+from .textures import sample
 
 VIEWS = {"": 1.0, "_grazing": 0.0}
 """Map-name suffix → cos θ of the view the weights are composited for."""
@@ -28,7 +30,10 @@ FALLOFFS = ("specular", "specular_t")
 
 
 def opaque(entry: Entry) -> bool:
-    """True when the layer transmits nothing at any view (it hides what is below)."""
+    """True when the layer transmits nothing at any view (it hides what is below); a
+    textured layer is not taken to be (its transmission may vary from texel to texel)."""
+    if entry.decoded:
+        return False
     for cos_view in VIEWS.values():
         lobes = layer_lobes(entry.params, cos_view)
         if any(np.any(lobes[lobe].n > 0) or np.any(lobes[lobe].g > 0) for lobe in LOBES[3:]):
@@ -59,9 +64,7 @@ def blend_stack(
     """
     resolution = (sampler.width, sampler.height)
     if not layered:
-        params = entries[0].params
-        constants = {k: v for k, v in params.model_dump().items() if v is not None}
-        return BlendedMaterial(name, "pixar", resolution, constants, decisions=[])
+        return _plain(name, entries[0], sampler, resolution)
     kept, decisions = prune_stack(
         entries,
         sampler,
@@ -70,7 +73,8 @@ def blend_stack(
         enabled=prune,
     )
     constant = all(
-        e.uniform and e.normal_map is None and e.specular_normal_map is None for e in kept
+        e.uniform and e.normal_map is None and e.specular_normal_map is None and not e.decoded
+        for e in kept
     )
     if constant and prune:  # nothing varies: one texel says it all
         sampler = MaskSampler((1, 1))
@@ -89,21 +93,45 @@ def blend_stack(
     return out
 
 
+def _plain(name: str, entry: Entry, sampler: MaskSampler, resolution) -> BlendedMaterial:
+    """A plain Pixar material: its constants, and each textured parameter as a map read
+    straight from its texture (so also in :attr:`BlendedMaterial.textures`)."""
+    params = entry.params
+    constants = {
+        k: v for k, v in params.model_dump().items() if v is not None and k not in entry.decoded
+    }
+    out = BlendedMaterial(name, "pixar", resolution, constants, decisions=[])
+    every_row = slice(0, sampler.height)
+    for key, texture in entry.decoded.items():
+        values = sample(sampler, entry, key, every_row)
+        out.maps[key] = values[..., 0] if texture.count == 1 else values
+        out.textures[key] = texture.tex.model_copy(update={"colorspace": texture.space})
+    return out
+
+
 def _outputs(top_first: list[Entry], sampler: MaskSampler, progress, mode: str):
     """Every output array, (H, W[, 3]), composited tile by tile."""
     height, width = sampler.height, sampler.width
     rows_per_tile = max(1, TILE_TEXELS // width)
     out: dict[str, np.ndarray] = {}
-    per_layer = {
+    constant_layers = {
         (i, cos_view): layer_lobes(e.params, cos_view)
         for i, e in enumerate(top_first)
         for cos_view in VIEWS.values()
+        if not e.decoded
     }
     for r0 in range(0, height, rows_per_tile):
         rows = slice(r0, min(height, r0 + rows_per_tile))
         n = rows.stop - rows.start
         alphas = [e.coverage(sampler, rows) for e in top_first]  # scalars where uniform
         normals = [_entry_normals(e, sampler, rows) for e in top_first]
+        # A textured layer's lobes are Smits' weights of its parameters at each texel.
+        maps = [_texel_params(e, sampler, rows) for e in top_first]
+        per_layer = dict(constant_layers)
+        for i, e in enumerate(top_first):
+            if e.decoded:
+                for cos_view in VIEWS.values():
+                    per_layer[i, cos_view] = layer_lobes(e.params, cos_view, maps=maps[i])
         for suffix, cos_view in VIEWS.items():
             stack = [
                 (_with_normals(per_layer[i, cos_view], nm), a)
@@ -118,7 +146,7 @@ def _outputs(top_first: list[Entry], sampler: MaskSampler, progress, mode: str):
                 if suffix == "" and lobe in FALLOFFS:
                     _store(out, f"{lobe}_falloff", part.falloff, rows, n, width, height)
             if suffix == "":
-                _store(out, "ior", _ior(top_first, alphas), rows, n, width, height)
+                _store(out, "ior", _ior(top_first, alphas, maps), rows, n, width, height)
                 _store(out, "normal_map", group_normals["diffuse"], rows, n, width, height)
                 _store(
                     out, "specular_normal_map", group_normals["highlight"], rows, n, width, height
@@ -128,16 +156,25 @@ def _outputs(top_first: list[Entry], sampler: MaskSampler, progress, mode: str):
     return out
 
 
-def _ior(top_first: list[Entry], alphas: list[Any]) -> Any:
+def _ior(top_first: list[Entry], alphas: list[Any], maps: list[dict[str, Any]]) -> Any:
     """The IOR the view refracts by: the uppermost layer present at the texel, i.e. the
     A-over-B mean Σ cₖ ηₖ (cₖ = αₖ Π(1 − αⱼ above)), the bottom layer's where none is."""
     eta: Any = 0.0
     remaining: Any = 1.0
-    for entry, alpha in zip(top_first, alphas, strict=True):
+    for entry, alpha, texel in zip(top_first, alphas, maps, strict=True):
         alpha = np.asarray(alpha, dtype=np.float64)  # η ≈ 1 refracts by η − 1: keep digits
-        eta = eta + alpha * remaining * entry.params.eta
+        eta = eta + alpha * remaining * eta_of(entry.params, texel)
         remaining = remaining * (1.0 - alpha)
-    return eta + remaining * top_first[-1].params.eta
+    return eta + remaining * eta_of(top_first[-1].params, maps[-1])
+
+
+def _texel_params(entry: Entry, sampler: MaskSampler, rows: slice) -> dict[str, Any]:
+    """A textured layer's parameters on ``rows``: (n, W) scalars, (n, W, 3) colours."""
+    out = {}
+    for key, texture in entry.decoded.items():
+        values = sample(sampler, entry, key, rows).astype(np.float64)
+        out[key] = values[..., 0] if texture.count == 1 else values
+    return out
 
 
 def _with_normals(lobes: Lobes, normals: dict[str, Any]) -> Lobes:

@@ -93,16 +93,22 @@ Lobes = dict[str, Part]
 """Lobe name (:data:`LOBES`) → its light."""
 
 
-def layer_lobes(params: PixarParams, cos_view: float, normals: dict | None = None) -> Lobes:
+def layer_lobes(
+    params: PixarParams, cos_view: float, normals: dict | None = None, maps: dict | None = None
+) -> Lobes:
     """One layer's six lobes (Smits' weights, cones in degrees) for a view at ``cos_view``.
 
     Cones: specular (30 r + 5)°, reflection 10 r° (at least the model's floor), each times
-    its cone scale; transmitted lobes share their front twin's cone.
+    its cone scale; transmitted lobes share their front twin's cone. ``maps`` give
+    parameters per texel (a textured layer): weights (..., 3) and cones (...) per texel.
     """
-    w = lobe_weights(params, cos_view)
-    r = params.roughness
-    spec = specular_cone(r, params.specular_cone_scale)
-    refl = max(reflection_cone(r, params.reflection_cone_scale), CONE_MIN_DEG)
+    maps = maps or {}
+    w = lobe_weights(params, cos_view, maps)
+    r = maps.get("roughness", params.roughness)
+    spec = specular_cone(r, maps.get("specular_cone_scale", params.specular_cone_scale))
+    refl_scale = maps.get("reflection_cone_scale", params.reflection_cone_scale)
+    refl = np.maximum(reflection_cone(r, refl_scale), CONE_MIN_DEG)
+    refl = refl if np.ndim(refl) else float(refl)
     cone = {"diffuse": 0.0, "specular": spec, "reflection": refl}
     falloff = {"diffuse": LN_10, "specular": r * LN_10, "reflection": LN_10}
     normals = normals or {}

@@ -9,8 +9,12 @@ live), and asks the model registry (:mod:`lookdev.materials.registry`) which mod
 it and which of its lobes are live.
 
 Maps are float32 ``(H, W)`` scalars and ``(H, W, 3)`` colours and normals, in UV order:
-``map[r, c]`` is the texel centred on ``(u, v) = ((c + ½)/W, (r + ½)/H)``. Normal maps are
-unit tangent-space vectors (decoded, not 0..1 encoded).
+``map[r, c]`` is the texel centred on ``(u, v) = (u0 + (c + ½)/W · (u1 − u0),
+v0 + (r + ½)/H · (v1 − v0))`` over :attr:`BlendedMaterial.uv_extent` ``(u0, v0, u1, v1)``,
+which is the unit square ``(0, 0, 1, 1)`` unless the material's textures are UDIM tile
+sets: then the maps span every UV square the tiles cover (a 2 × 2 set: ``(0, 0, 2, 2)``,
+each tile's square ``W/2 × H/2`` texels, tile 1001 bottom-left). Normal maps are unit
+tangent-space vectors (decoded, not 0..1 encoded).
 """
 
 from __future__ import annotations
@@ -62,16 +66,31 @@ class BlendedMaterial:
     """What was blended (the resolved library material), for exporters that carry it."""
     textures: dict[str, Any] = field(default_factory=dict)
     """Parameters read straight from one image that blending did not change, by name →
-    :class:`lookdev.materials.textures.TextureInput` (path absolute): exporters reference
+    :class:`lookdev.materials.textures.TextureInput` (path absolute, ``<UDIM>`` kept, its
+    ``colorspace`` the one it was read in, by the config's name): exporters reference
     the original file (and its colour space) instead of baking :attr:`maps`, which still
     holds the decoded values for every other consumer."""
+    uv_extent: tuple[int, int, int, int] = (0, 0, 1, 1)
+    """(u0, v0, u1, v1), whole UV squares every map spans (see module doc): parameter maps,
+    :attr:`normal_map` and :attr:`height_map` alike."""
+    tiles: tuple[int, ...] = ()
+    """The UDIM tiles the material's textures cover (1001, 1002, …); empty when none is a
+    UDIM set. A square of :attr:`uv_extent` with no tile holds the layer constants."""
     height_map: np.ndarray | None = None
-    """Heights in scene units (float32 (H, W), UV order) for bump and displacement: the
-    preset's ``height`` texture after its scale/offset (:mod:`.surface_maps`)."""
-    map_tiles: tuple[int, int] = (1, 1)
-    """UDIM tiles ``(nu, nv)`` that :attr:`height_map` and a texture set's
-    :attr:`normal_map` span: their texel ``(r, c)`` sits at
-    ``(u, v) = (nu·(c + ½)/W, nv·(r + ½)/H)``."""
+    """Heights in scene units (float32 (H, W), UV order, over :attr:`uv_extent`) for bump
+    and displacement: the preset's ``height`` texture after its scale/offset
+    (:mod:`.surface_maps`)."""
+
+    @property
+    def map_tiles(self) -> tuple[int, int]:
+        """UV squares ``(nu, nv)`` the maps span, from tile 1001: :attr:`uv_extent`'s size
+        when it starts at (0, 0) (UDIM sets do)."""
+        u0, v0, u1, v1 = self.uv_extent
+        return (u1 - u0, v1 - v0)
+
+    @map_tiles.setter
+    def map_tiles(self, tiles: tuple[int, int]) -> None:
+        self.uv_extent = (0, 0, int(tiles[0]), int(tiles[1]))
 
     @classmethod
     def of_params(cls, params: Any, name: str | None = None) -> BlendedMaterial:
@@ -135,7 +154,7 @@ class BlendedMaterial:
     def digest(self) -> str:
         """A SHA-256 of everything that shapes the material's look (resumable proofs)."""
         h = hashlib.sha256()
-        head = [self.name, self.model, self.representation, self.resolution]
+        head = [self.name, self.model, self.representation, self.resolution, self.uv_extent]
         head.append(sorted((k, repr(_plain(v))) for k, v in self.constants.items()))
         h.update(json.dumps(head).encode())
         for name, array in sorted(self.arrays.items()):
@@ -157,6 +176,26 @@ class BlendedMaterial:
     def nbytes(self) -> int:
         """Bytes held by the maps (the size of the output)."""
         return sum(a.nbytes for a in self.arrays.values())
+
+    def texel(self, uv: Any) -> tuple[np.ndarray, np.ndarray]:
+        """(rows, cols) of the texels under ``uv`` (…, 2), nearest texel. Over the unit
+        square the maps repeat (a bitmap's ``repeat``); over a UDIM extent each (u, v)
+        picks its own tile's square and is clamped to the extent outside it."""
+        uv = np.asarray(uv, dtype=np.float64)
+        width, height = self.resolution
+        u0, v0, u1, v1 = self.uv_extent
+        cols = np.floor((uv[..., 0] - u0) / (u1 - u0) * width).astype(np.intp)
+        rows = np.floor((uv[..., 1] - v0) / (v1 - v0) * height).astype(np.intp)
+        if tuple(self.uv_extent) == (0, 0, 1, 1):
+            return rows % height, cols % width
+        return np.clip(rows, 0, height - 1), np.clip(cols, 0, width - 1)
+
+    def params_at_uv(self, u: float, v: float):
+        """The model's parameters at UV ``(u, v)`` (see :meth:`texel`, :meth:`params_at`)."""
+        if not self.maps:
+            return self.params if self.representation == PARAMS else dict(self.constants)
+        row, col = self.texel((u, v))
+        return self.params_at(int(row), int(col))
 
     def values_at(self, row: int, col: int) -> dict[str, Any]:
         """Every constant and map value at texel ``(row, col)``, by name (plain Python)."""

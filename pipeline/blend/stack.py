@@ -8,7 +8,7 @@ maps, and the coverage bounds known before any texel is evaluated.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -45,6 +45,11 @@ class Entry:
     high: float = 1.0
     per_texel: bool = False
     """Evaluate the mask per texel even when its bounds say it is uniform (no pruning)."""
+    textures: dict[str, Any] = field(default_factory=dict)
+    """Parameters driven by textures (:class:`~lookdev.materials.textures.TextureInput`)."""
+    decoded: dict[str, Any] = field(default_factory=dict)
+    """The non-uniform ones opened (:class:`~lookdev.library.textures.ParamTexture`), by
+    :func:`.textures.open_textures`; uniform ones are folded into ``params``."""
 
     @property
     def where(self) -> str:
@@ -81,8 +86,16 @@ def stack_of(material: Any) -> list[Entry]:
     """
     source = str(material.source) if getattr(material, "source", None) else None
     if material.model != "layered":
+        textures = dict(getattr(material, "textures", {}))
         return [
-            Entry(material.name, material.model, material.params, ConstantMask(), source=source)
+            Entry(
+                material.name,
+                material.model,
+                material.params,
+                ConstantMask(),
+                source=source,
+                textures=textures,
+            )
         ]
     if not material.layers:
         raise BlendError("a layered material needs at least one layer", where=source)
@@ -111,6 +124,7 @@ def _entry(index: int, layer: Any) -> Entry:
         normal_map=layer.normal_map,
         specular_normal_map=layer.specular_normal_map,
         source=str(mat.source) if getattr(mat, "source", None) else None,
+        textures=dict(getattr(mat, "textures", {})),
     )
 
 

@@ -16,14 +16,14 @@ the box reads as the set's mean.
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from lookdev.library.textures import udim_tiles as find_tiles
 from lookdev.materials.layers import TextureMask
-from lookdev.materials.textures import UDIM_TOKEN
+from lookdev.materials.textures import UDIM_TOKEN, tile_uv
 
 from .errors import TextureError
 from .resample import as_float, read_channels, resample, taps
@@ -33,19 +33,12 @@ __all__ = ["attach", "udim_tiles"]
 
 
 def udim_tiles(pattern: str | Path, *, where: str | None = None) -> dict[tuple[int, int], Path]:
-    """``{(u, v): file}`` of a ``<UDIM>`` pattern's tiles on disk (1001 + u + 10·v)."""
+    """``{(u, v): file}`` of a ``<UDIM>`` pattern's tiles on disk (1001 + u + 10·v), found
+    by the library's one tile lookup (:func:`lookdev.library.textures.udim_tiles`)."""
     pattern = Path(pattern)
     if UDIM_TOKEN not in pattern.name:
         return {(0, 0): pattern}
-    head, tail = pattern.name.split(UDIM_TOKEN, 1)
-    regex = re.compile(re.escape(head) + r"(1\d{3})" + re.escape(tail) + r"\Z")
-    found: dict[tuple[int, int], Path] = {}
-    if pattern.parent.is_dir():
-        for path in pattern.parent.iterdir():
-            m = regex.match(path.name)
-            if m:
-                n = int(m.group(1)) - 1001
-                found[(n % 10, n // 10)] = path
+    found = {tile_uv(t): path for t, path in find_tiles(pattern).items()}
     if not found:
         raise TextureError(f"no UDIM tiles match {pattern}", where=where)
     return found
@@ -62,11 +55,19 @@ def _read(path: Path, count: int, shape: tuple[int, int], where: str) -> np.ndar
     )
 
 
-def read_tiled(pattern: str | Path, count: int, shape: tuple[int, int], *, where: str):
-    """A (tile set of) image(s) at ``shape`` texels per tile: ((nv·h, nu·w, count), (nu, nv))."""
+def read_tiled(
+    pattern: str | Path,
+    count: int,
+    shape: tuple[int, int],
+    *,
+    where: str,
+    grid: tuple[int, int] | None = None,
+):
+    """A (tile set of) image(s) at ``shape`` texels per tile: ((nv·h, nu·w, count), (nu, nv));
+    ``grid`` (nu, nv) is the hub's when its other maps already span more tiles."""
     tiles = udim_tiles(pattern, where=where)
-    nu = max(u for u, _ in tiles) + 1
-    nv = max(v for _, v in tiles) + 1
+    nu = max(max(u for u, _ in tiles) + 1, grid[0] if grid else 1)
+    nv = max(max(v for _, v in tiles) + 1, grid[1] if grid else 1)
     h, w = shape
     out = np.empty((nv * h, nu * w, count), dtype=np.float32)
     filled = np.zeros((nv, nu), dtype=bool)
@@ -89,10 +90,12 @@ def attach(hub: BlendedMaterial, material: Any) -> BlendedMaterial:
     normal = getattr(material, "normal_map", None)
     if height is None and normal is None:
         return hub
-    width, h = hub.resolution
+    # hub.resolution spans its UDIM extent (the engine widened it to these sets' tiles too)
+    grid = hub.map_tiles
+    width, h = hub.resolution[0] // grid[0], hub.resolution[1] // grid[1]
     where = str(getattr(material, "source", None) or hub.name)
     if height is not None:
-        pixels, tiles = read_tiled(height.texture, 1, (h, width), where=where)
+        pixels, tiles = read_tiled(height.texture, 1, (h, width), where=where, grid=grid)
         value = pixels[..., 0]
         if height.range is not None:
             lo, hi = height.range
@@ -101,7 +104,7 @@ def attach(hub: BlendedMaterial, material: Any) -> BlendedMaterial:
         hub.map_tiles = tiles
         hub.textures["height"] = height
     if normal is not None and hub.normal_map is None:
-        pixels, tiles = read_tiled(normal.path, 3, (h, width), where=where)
+        pixels, tiles = read_tiled(normal.path, 3, (h, width), where=where, grid=grid)
         n = 2.0 * pixels - 1.0
         if any("DirectX" in note for note in getattr(material, "notes", [])):
             n[..., 1] = -n[..., 1]

@@ -75,6 +75,12 @@ def plot(
             "specular_gamma=1,1.5,2,3 (uniform presets).",
         ),
     ] = None,
+    uv: Annotated[
+        tuple[float, float] | None,
+        typer.Option(
+            "--uv", help="Plot a texture-driven material as it is at this UV (default: centre)."
+        ),
+    ] = None,
     as_json: Annotated[
         bool, typer.Option("--json", help="Print one JSON object for scripts.")
     ] = False,
@@ -87,7 +93,7 @@ def plot(
 
       lookdev plot velvet --view sphere --ibl studio -o velvet.png --exposure -1
 
-      lookdev plot chrome --vary specular_gamma=1,1.5,2,3 -o gamma.png --exposure -4
+      lookdev plot gold --vary specular_gamma=1,1.5,2,3 -o gamma.png --exposure -3
     """
     from lookdev.pipeline import api
 
@@ -101,6 +107,7 @@ def plot(
             resolution=resolution,
             library=library,
             vary=_vary(vary),
+            uv=uv,
         )
     if as_json:
         print_json(result.to_json())

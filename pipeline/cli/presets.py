@@ -11,9 +11,11 @@ import typer
 from rich.syntax import Syntax
 
 from lookdev.library import Library, PresetError, listing, read_preset
+from lookdev.library.errors import TextureError
 from lookdev.library.library import apply_changes
 from lookdev.library.preset import PresetFile, check_name, parse_value, preset_document
 from lookdev.library.schema import preset_schema
+from lookdev.materials.errors import LookdevError
 
 from .common import console, err_console, print_json
 from .presets_view import material_json, print_resolved, text_table
@@ -118,7 +120,7 @@ def show(
     preset = read_preset(path)
     explicit = name.endswith(".toml")
     others = [] if explicit else [p for p in lib.definitions(preset.name) if p != path]
-    material = lib.load_file(path) if resolved else None
+    material = lib.load_file(path) if resolved else _textures_checked(lib, path)
     links = lib.read_through(path)
     if as_json:
         doc: dict[str, Any] = {
@@ -152,6 +154,19 @@ def show(
         console.print(Syntax(text, "toml", theme="ansi_dark", word_wrap=True))
     else:
         print_resolved(material)
+
+
+def _textures_checked(lib: Library, path: Path) -> None:
+    """Check the textures a preset drives parameters with (files, tiles, channels, colour
+    spaces, ranges) even when it is shown as written: a bad map is one line and exit 2
+    here as in `proof` and `export`. Other problems of resolving (a missing parent) are
+    left to --resolved, so a preset can still be shown as written."""
+    try:
+        lib.load_file(path)
+    except TextureError:
+        raise
+    except LookdevError:
+        pass
 
 
 @app.command()

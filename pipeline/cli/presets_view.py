@@ -43,6 +43,7 @@ def print_resolved(m: Material) -> None:
         values = m.params.model_dump()
         if getattr(m.params, "uses_ior", False):  # Disney: one parameter, two spellings
             values["specular"], origin["specular"] = m.params.effective_specular, "(from ior)"
+        values |= {k: f"texture {t.texture}" for k, t in m.textures.items()}
         rows = [[k, value_text(v), origin.get(k, "default")] for k, v in values.items()]
         console.print(
             table(f"{m.name} ({m.model}, resolved)", ["parameter", "value", "set by"], rows)

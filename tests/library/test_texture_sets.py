@@ -145,7 +145,7 @@ def test_textures_key_fills_parameters_and_params_win(tmp_path):
     )
     material = Library([tmp_path], use_env=False).load("hero")
     assert material.params.roughness == 0.3
-    assert "hero_BaseColor" in str(material.params.base_color)
+    assert "hero_BaseColor" in material.textures["base_color"].texture  # Material.textures
 
 
 @needs_core

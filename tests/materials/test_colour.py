@@ -100,3 +100,36 @@ def test_hex_colours_decode_as_srgb_texture(code):
     text = f"#{code:06x}"
     expected = srgb_decode([int(text[i : i + 2], 16) / 255.0 for i in (1, 3, 5)])
     np.testing.assert_allclose(colour.decode_hex(text), expected, atol=1e-6)
+
+
+@pytest.mark.parametrize("working", ["lin_rec709", "acescg"])
+@pytest.mark.parametrize("dtype", [np.uint8, np.uint16])
+@pytest.mark.parametrize("space", ["sRGB - Texture", "ACEScct", "Raw"])
+def test_integer_codes_convert_as_their_normalised_values(working, dtype, space):
+    c = colour
+    top = np.iinfo(dtype).max
+    codes = np.random.default_rng(2).integers(0, top + 1, (64, 32, 3)).astype(dtype)
+    codes[0, :3] = [[0, 0, 0], [top, top, top], [top, 0, 0]]
+    with c.use(working_space=working):
+        exact = c.convert(codes.astype(np.float64) / top, space)
+        np.testing.assert_allclose(c.convert_codes(codes, space), exact, rtol=0, atol=1e-6)
+
+
+def test_a_user_config_s_file_rules_name_a_colour_map_s_space(tmp_path):
+    import PyOpenColorIO as ocio
+
+    cfg = ocio.Config.CreateFromFile(colour.DEFAULT_CONFIG)
+    rules = cfg.getFileRules()
+    rules.insertRule(0, "acescg_maps", "ACEScg", "*_acescg*", "exr")
+    cfg.setFileRules(rules)
+    path = tmp_path / "studio.ocio"
+    cfg.serialize(str(path))
+    with colour.use(config=str(path)):
+        assert colour.texture_space(False, True, None, "/a/wall_acescg.1001.exr") == "ACEScg"
+        # no rule of its own matches: the bit-depth rule; data is never colour-converted
+        assert colour.texture_space(True, True, None, "/a/wall.png") == colour.canonical(
+            colour.SRGB_TEXTURE
+        )
+        assert colour.texture_space(False, False, None, "/a/r_acescg.exr") == "Raw"
+    # lookdev's own default config: its plate rules (EXR → ACES2065-1) are not consulted
+    assert colour.texture_space(False, True, None, "/a/wall.exr") == colour.working_space()

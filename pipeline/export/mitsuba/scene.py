@@ -178,14 +178,17 @@ def with_bump(
 
 
 def _tiled(texture: dict[str, Any], hub: BlendedMaterial) -> dict[str, Any]:
-    """A map spanning UDIM tiles (``hub.map_tiles``) read at UV (u, v) ∈ [0, nu)×[0, nv)."""
-    nu, nv = hub.map_tiles
-    if (nu, nv) == (1, 1):
+    """A bitmap of a map spanning the hub's UDIM extent (``hub.uv_extent``, (u0, v0, u1, v1))
+    with the ``to_uv`` that brings the mesh's UVs onto it, ``(uv − (u0, v0)) / (Δu, Δv)``,
+    so each tile's square of the map lands on that tile's UV square of the mesh."""
+    if tuple(hub.uv_extent) == (0, 0, 1, 1):
         return texture
     import mitsuba as mi
 
-    texture["to_uv"] = mi.ScalarTransform4f().scale([1.0 / nu, 1.0 / nv, 1.0])
-    texture["wrap_mode"] = "clamp"
+    u0, v0, u1, v1 = hub.uv_extent
+    scale = mi.ScalarTransform4f().scale([1.0 / (u1 - u0), 1.0 / (v1 - v0), 1.0])
+    texture["to_uv"] = scale @ mi.ScalarTransform4f().translate([-u0, -v0, 0.0])
+    texture["wrap_mode"] = "clamp"  # outside the tiles: the edge texels, not another tile
     return texture
 
 
@@ -198,7 +201,7 @@ def _plugin_dict(hub: BlendedMaterial, texture_dir: str | Path | None) -> dict[s
         out[key] = _constant(value)
     for key, array in maps.items():
         colour = is_color_field(model.params_type, key)
-        out[key] = _bitmap(array, colour, hub.name, key, texture_dir)
+        out[key] = _tiled(_bitmap(array, colour, hub.name, key, texture_dir), hub)
     return out
 
 
@@ -216,8 +219,13 @@ def _encode_normals(normals: np.ndarray) -> np.ndarray:
 
 
 def _bitmap(
-    array: np.ndarray, color: bool, name: str, key: str, texture_dir: str | Path | None
+    array: np.ndarray,
+    color: bool,
+    name: str,
+    key: str,
+    texture_dir: str | Path | None,
 ) -> dict[str, Any]:
+    """A ``bitmap`` of a hub map (see :func:`_tiled` for maps over UDIM tiles)."""
     import mitsuba as mi
 
     data = np.asarray(array, dtype=np.float32)

@@ -10,6 +10,7 @@ import OpenImageIO as oiio
 import pytest
 from _blend_helpers import disney, layer, layered, write_image
 
+from lookdev.library import images
 from lookdev.materials.layers import TextureMask
 from lookdev.pipeline.blend import MaskSampler, TextureError, blend, resample
 from lookdev.pipeline.blend.masks import BoxReduced
@@ -46,7 +47,7 @@ def test_rows_read_in_chunks_equal_openimageio_whole_image(
 ):
     """Chunks of 32 rows (the smallest) across runs of every length: each chunk lands
     flipped in its place, as stored; the reference is ImageBuf's whole decode."""
-    monkeypatch.setattr(resample, "_CHUNK_BYTES", 1)
+    monkeypatch.setattr(images, "_CHUNK_BYTES", 1)
     rng = np.random.default_rng(11)
     pixels = rng.random((101, 19, 3), dtype=np.float32)
     pixels[:7] = 0.0  # exactly 0 and 1 survive every format
@@ -132,11 +133,12 @@ def test_bench_blend_reports_resident_peaks_of_both_cases(cli):
     r = cli("bench", "blend", "--resolution", "16", "--repeat", "1", "--json")
     assert r.code == 0, r.err
     doc = json.loads(r.out)
-    for case in ("stack", "large_masks", "large_masks_decoded"):
+    for case in ("stack", "large_masks", "large_masks_decoded", "udim"):
         assert doc[f"peak_rss_mb_{case}"] >= 0 and math.isfinite(doc[f"peak_rss_to_output_{case}"])
-    for case in ("stack", "large_masks"):
+    for case in ("stack", "large_masks", "udim"):
         assert doc["targets_met"][f"peak_rss_to_output_{case}"] in (True, False)
     assert doc["output_mb_large_masks"] == 16 * 16 * 4 / 1e6  # one float32 map: roughness
+    assert doc["output_mb_udim"] == 32 * 32 * 4 / 1e6  # roughness over the 2 x 2 tiles
     assert "peak_to_output" in doc  # tracemalloc's figure stays beside the resident one
 
 
