@@ -167,6 +167,7 @@ def test_drjit_eval_equals_numpy_eval(mi, model_name, values):
 FURNACE_CASES = [
     ("disney", {"roughness": 0.5, "base_color": [0.8, 0.4, 0.2]}, "disney-plastic"),
     ("disney", {"metallic": 1.0, "roughness": 0.2}, "disney-metal"),
+    ("disney", {"metallic": 1.0, "roughness": 0.4, "specular_gamma": 1.5}, "disney-gamma1.5"),
     ("disney", {"clearcoat": 1.0, "roughness": 0.7, "base_color": [0.2, 0.3, 0.8]}, "disney-coat"),
     ("disney", {"spec_trans": 1.0, "roughness": 0.0, "ior": 1.5}, "disney-glass"),
     ("sheen", {"roughness": 0.3, "color": [0.9, 0.5, 0.3]}, "sheen"),
