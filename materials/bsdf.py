@@ -16,9 +16,13 @@ as a :class:`Model`:
     both pointing away from the surface in the local frame (normal +z).
 ``pdf(xp, prepared, wi, wo) -> scalar``
     Solid-angle density with which ``sample`` produces ``wi`` given ``wo``.
-``sample(xp, prepared, wo, u) -> (wi, weight, pdf)``
+``sample(xp, prepared, wo, u) -> (wi, weight, pdf, delta)``
     ``u`` is a vector of three uniforms (``u[0]`` picks the lobe, ``u[1], u[2]`` the
     direction); ``weight = f·|cos θi| / pdf``; a failed sample has pdf 0 and weight 0.
+    ``delta`` (a mask, or ``False`` for a model without delta lobes) marks samples of a
+    delta lobe (a smooth mirror or refraction, :mod:`.disney_interface`): ``eval`` and
+    ``pdf`` leave such lobes out, and their sample's ``pdf`` is the probability with
+    which the lobe was chosen (Mitsuba's convention), its weight the lobe's exact value.
 
 Vectors and colours are channel-first inside core functions (see :mod:`.arrays`). The
 functions below are the public numpy API: they take ``(..., 3)`` arrays, broadcast, and
@@ -158,8 +162,24 @@ def density(
 
 
 def draw(
-    model: Model, params: Any, wo: Any, u: Any, *, dtype: Any = np.float64, **maps: Any
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Sample wi given wo and uniforms u of shape (..., 3): (wi, weight, pdf)."""
-    (wi, weight, pdf), n, lead = _call(model.sample, model, params, wo, u, dtype, maps)
-    return _out(wi, n, lead, True), _out(weight, n, lead, True), _out(pdf, n, lead, False)
+    model: Model,
+    params: Any,
+    wo: Any,
+    u: Any,
+    *,
+    dtype: Any = np.float64,
+    delta: bool = False,
+    **maps: Any,
+) -> tuple[np.ndarray, ...]:
+    """Sample wi given wo and uniforms u of shape (..., 3): (wi, weight, pdf).
+
+    With ``delta=True`` a fourth boolean array (...) marks the samples of delta lobes,
+    whose pdf is the probability of the lobe's choice rather than a density (MIS with
+    another strategy must give them weight 1, a histogram must leave them out).
+    """
+    (wi, weight, pdf, is_delta), n, lead = _call(model.sample, model, params, wo, u, dtype, maps)
+    out = _out(wi, n, lead, True), _out(weight, n, lead, True), _out(pdf, n, lead, False)
+    if not delta:
+        return out
+    flags = np.broadcast_to(np.asarray(is_delta, dtype=bool), (n,))
+    return (*out, from_channel_first(flags, lead))

@@ -14,7 +14,22 @@ curve or primaries matrix is written by hand anywhere in the program:
 * :func:`texture_space` names the colour space a texture is read in (the file rule);
 * :func:`decode_hex` reads a preset's ``"#rrggbb"`` as sRGB-encoded (``"sRGB - Texture"``);
 * :func:`luminance` weighs linear working-space RGB by the Y row of its RGB → CIE XYZ
-  matrix, asked of the config (Rec.709: ITU-R BT.709-6 item 3.3).
+  matrix, asked of the config (Rec.709: ITU-R BT.709-6 item 3.3);
+* :func:`to_display` is the one view transform (an OCIO ``DisplayViewTransform`` from the
+  working space to a display and view of the config, looks optional): proofs, contact
+  sheets, plots and the review page all show pixels through it;
+* :func:`chromaticities` and :func:`interop_id` name a space the way EXR headers and USD
+  (``colorSpace:name``) spell it (MaterialX's names are the exporter's:
+  :func:`lookdev.pipeline.export.usd.mtlx.mtlx_color_space`).
+
+The default view is the config's own (the studio config: ``sRGB - Display`` /
+``ACES 2.0 - SDR 100 nits (Rec.709)``): proofs judge materials under IBLs with a sun, and
+their speculars and glass caustics run to hundreds of times diffuse white. Through
+``Un-tone-mapped`` (the sRGB curve alone) every such highlight clips, and clipping one
+channel before the others turns a hot red into orange and then white (Burley 2012 §6.2);
+the ACES 2.0 view rolls highlights off with their hue kept and reaches white only at the
+very top. It costs mid-tone brightness (18 % grey shows at code 0.35, not 0.46): a look
+judged against albedo values uses ``--view Un-tone-mapped`` or ``--exposure``.
 
 Burley's tint weights ``(0.3, 0.6, 0.1)`` (:data:`lookdev.materials.disney_prepare.
 TINT_WEIGHTS`) are not luminance: they are a hue normaliser inside the Disney BRDF, part of
@@ -49,6 +64,7 @@ __all__ = [
     "ColourError",
     "Settings",
     "settings",
+    "pinned",
     "use",
     "config",
     "canonical",
@@ -60,6 +76,17 @@ __all__ = [
     "luminance",
     "luminance_weights",
     "is_data",
+    "spaces",
+    "displays",
+    "views",
+    "looks",
+    "display",
+    "view",
+    "look",
+    "to_display",
+    "chromaticities",
+    "interop_id",
+    "PRESET_LINEAR",
     "texture_space",
 ]
 
@@ -74,6 +101,10 @@ SRGB_TEXTURE = "sRGB - Texture"
 """How a preset's ``"#rrggbb"`` and an 8-bit colour map are encoded by default."""
 RAW = "Raw"
 """Data: no conversion (roughness, masks, normals, heights)."""
+PRESET_LINEAR = "Linear Rec.709 (sRGB)"
+"""The space of a preset's linear ``[r, g, b]`` (and grey scalar) colours: lookdev's
+presets were written in linear Rec.709, so an ACEScg working space converts them rather
+than reading Rec.709 numbers as AP1 ones (which would shift every hue)."""
 
 
 class ColourError(LookdevError):
@@ -88,6 +119,12 @@ class Settings:
     """Path or ``ocio://`` name; empty means ``$OCIO``, else :data:`DEFAULT_CONFIG`."""
     working_space: str = "lin_rec709"
     """A key of :data:`WORKING_SPACES`, or any colour-space name of the config."""
+    display: str = ""
+    """The display of the view transform; empty: the config's default display."""
+    view: str = ""
+    """The view of :attr:`display`; empty: that display's default view."""
+    look: str = ""
+    """OCIO looks applied before the view (comma-separated); empty: none."""
 
     @property
     def config_name(self) -> str:
@@ -102,9 +139,28 @@ def settings() -> Settings:
     return _current[-1]
 
 
+def pinned() -> Settings:
+    """The settings in force with every default spelled out (the config's name, the
+    working space, display, view and look as the config names them), for another
+    process, whose ``$OCIO`` may differ: ``use(**dataclasses.asdict(pinned()))``."""
+    disp, v, names = _view_names()
+    return Settings(settings().config_name, working_space(), disp, v, ", ".join(names))
+
+
 @contextlib.contextmanager
-def use(config: str | None = None, working_space: str | None = None) -> Iterator[Settings]:
-    """Use another OCIO config and/or working space inside a ``with`` block.
+def use(
+    config: str | None = None,
+    working_space: str | None = None,
+    *,
+    display: str | None = None,
+    view: str | None = None,
+    look: str | None = None,
+) -> Iterator[Settings]:
+    """Use another OCIO config, working space and/or view inside a ``with`` block.
+
+    ``None`` keeps what is in force; every name is checked here, so a typo fails at once
+    with one line. Another config resets the display, view and look to its defaults
+    unless they are given too.
 
     >>> with use(working_space="acescg"):
     ...     working_space()
@@ -113,14 +169,28 @@ def use(config: str | None = None, working_space: str | None = None) -> Iterator
     'Linear Rec.709 (sRGB)'
     """
     old = settings()
-    new = Settings(config if config is not None else old.config, working_space or old.working_space)
+    same = config is None or config == old.config
+    new = Settings(
+        old.config if config is None else config,
+        working_space or old.working_space,
+        _pick(display, old.display, same),
+        _pick(view, old.view, same),
+        _pick(look, old.look, same),
+    )
     _load(new.config_name)  # fail here, with the name, not at the first conversion
     _current.append(new)
     try:
         canonical(WORKING_SPACES.get(new.working_space, new.working_space))
+        _view_names()
         yield new
     finally:
         _current.pop()
+
+
+def _pick(given: str | None, old: str, same_config: bool) -> str:
+    if given is not None:
+        return given
+    return old if same_config else ""
 
 
 @functools.cache
@@ -143,14 +213,22 @@ def canonical(space: str) -> str:
     >>> canonical("srgb_tx"), canonical("lin_ap1")
     ('sRGB Encoded Rec.709 (sRGB)', 'ACEScg')
     """
-    found = config().getColorSpace(space)
+    found = _lookup(settings().config_name, space)
     if found is None:
         known = ", ".join(sorted(config().getColorSpaceNames())[:6])
         raise ColourError(
             f"unknown colour space {space!r} in the OCIO config {settings().config_name!r} "
             f"(e.g. {known}, …; `lookdev colour spaces` lists them)"
         )
-    return found.getName()
+    return found[0]
+
+
+@functools.cache
+def _lookup(config_name: str, space: str) -> tuple[str, bool] | None:
+    # OCIO's look-up by name or alias costs ≈ 0.1 ms (it scans the config); a preset's
+    # colours ask it several times each, so the answer (name, is data) is kept
+    cs = _load(config_name).getColorSpace(space)
+    return None if cs is None else (cs.getName(), bool(cs.isData()))
 
 
 def working_space() -> str:
@@ -161,8 +239,8 @@ def working_space() -> str:
 
 def is_data(space: str) -> bool:
     """True for a data space (``Raw``): values pass through every conversion unchanged."""
-    cs = config().getColorSpace(space)
-    return bool(cs is not None and cs.isData())
+    found = _lookup(settings().config_name, space)
+    return bool(found is not None and found[1])
 
 
 @functools.cache
@@ -294,6 +372,145 @@ def luminance(rgb: Any) -> Any:
     """
     out = np.asarray(rgb) @ luminance_weights()
     return float(out) if np.ndim(out) == 0 and not isinstance(rgb, np.ndarray) else out
+
+
+# -- what the config offers ------------------------------------------------------------------
+def spaces() -> list[str]:
+    """Every colour-space name of the config, in its order."""
+    return list(config().getColorSpaceNames())
+
+
+def displays() -> list[str]:
+    """The config's displays, its default first."""
+    return list(config().getDisplays())
+
+
+def views(display_name: str | None = None) -> list[str]:
+    """The views of ``display_name`` (default: the display in force), its default first."""
+    return list(config().getViews(display_name or display()))
+
+
+def looks() -> list[str]:
+    """The config's look names."""
+    return list(config().getLookNames())
+
+
+def _one_of(kind: str, name: str, known: list[str], command: str, of: str = "") -> str:
+    if name in known:
+        return name
+    folded = {k.casefold(): k for k in known}
+    if name.casefold() in folded:  # "un-tone-mapped" is what a user types
+        return folded[name.casefold()]
+    shown = "; ".join(known[:5]) + ("; …" if len(known) > 5 else "")
+    raise ColourError(
+        f"unknown {kind} {name!r}{of} in the OCIO config {settings().config_name!r} "
+        f"(known: {shown}; `lookdev colour {command}` lists them)"
+    )
+
+
+def _view_names() -> tuple[str, str, tuple[str, ...]]:
+    s = settings()
+    disp = _one_of("display", s.display, displays(), "views") if s.display else displays()[0]
+    known = list(config().getViews(disp))
+    v = _one_of("view", s.view, known, "views", f" of {disp!r}") if s.view else known[0]
+    names = tuple(n.strip() for n in s.look.split(",") if n.strip())
+    return disp, v, tuple(_one_of("look", n, looks(), "views") for n in names)
+
+
+def display() -> str:
+    """The display of the view transform in force (the config's name)."""
+    return _view_names()[0]
+
+
+def view() -> str:
+    """The view in force (the config's name)."""
+    return _view_names()[1]
+
+
+def look() -> str:
+    """The looks in force, comma-separated (empty: none)."""
+    return ", ".join(_view_names()[2])
+
+
+@functools.cache
+def _display_cpu(config_name: str, src: str, disp: str, v: str, look_names: str) -> Any:
+    cfg = _load(config_name)
+    transform = ocio.GroupTransform()
+    if look_names:  # looks grade scene-linear pixels, in the look's process space and back
+        transform.appendTransform(ocio.LookTransform(src=src, dst=src, looks=look_names))
+    transform.appendTransform(ocio.DisplayViewTransform(src=src, display=disp, view=v))
+    return cfg.getProcessor(transform).getOptimizedCPUProcessor(ocio.OPTIMIZATION_LOSSLESS)
+
+
+def to_display(pixels: Any, exposure: float = 0.0) -> np.ndarray:
+    """Scene-linear working-space ``pixels`` (…, 3) → display code values in [0, 1].
+
+    The one view transform: ``2**exposure`` (stops) scales the scene-linear values, then
+    the config's ``DisplayViewTransform`` (with the looks in force) to :func:`display` /
+    :func:`view` encodes them for the display. NaN, infinite and negative channels show
+    black (a renderer's bug, not light); the output is clipped to the display range.
+
+    >>> grey = np.array([[0.0], [0.18], [1e30]]).repeat(3, axis=1)
+    >>> [round(float(v), 4) for v in to_display(grey)[:, 0]]
+    [0.0, 0.3492, 1.0]
+    """
+    rgb = np.asarray(pixels, dtype=np.float32)[..., :3]
+    if rgb.shape[-1:] != (3,):
+        raise ColourError(f"a view transform needs (…, 3) RGB, not shape {rgb.shape}")
+    finite = np.where(np.isfinite(rgb), rgb, np.float32(0.0))
+    scaled = np.maximum(finite, 0.0, dtype=np.float64) * 2.0**exposure  # no float32 overflow
+    out = np.ascontiguousarray(np.minimum(scaled, np.finfo(np.float32).max), dtype=np.float32)
+    disp, v, names = _view_names()
+    cpu = _display_cpu(settings().config_name, working_space(), disp, v, ", ".join(names))
+    cpu.applyRGB(out.reshape(-1))
+    return np.clip(out, 0.0, 1.0)
+
+
+# -- naming a space in files ------------------------------------------------------------------
+def interop_id(space: str | None = None) -> str:
+    """USD's canonical name of ``space`` (default: the working space), e.g.
+    ``lin_rec709_scene``: OCIO 2.5's interop ID, else an alias of that form.
+
+    >>> interop_id(), interop_id("ACEScg"), interop_id(RAW)
+    ('lin_rec709_scene', 'lin_ap1_scene', 'data')
+    """
+    cs = config().getColorSpace(canonical(space) if space else working_space())
+    if cs.isData():
+        return "data"
+    found = cs.getInteropID() if hasattr(cs, "getInteropID") else ""
+    if found:
+        return found
+    canon = [a for a in cs.getAliases() if a.endswith("_scene")]  # USD's canonical form
+    return canon[0] if canon else cs.getName()
+
+
+@functools.cache
+def _chromaticities(config_name: str, space: str, interop: str) -> tuple[float, ...]:
+    import colour as colour_science  # a maintained table of primaries and white points
+
+    known = colour_science.RGB_COLOURSPACES
+    named = known.get(space) or known.get(interop)
+    if named is not None:
+        xy = np.vstack([named.primaries, named.whitepoint])
+    else:  # a space colour-science does not know: its primaries as the config maps them
+        basis = np.vstack([np.eye(3), np.ones((1, 3))]).astype(np.float32)
+        _cpu(config_name, space, "CIE XYZ-D65 - Display-referred").applyRGB(basis.reshape(-1))
+        xy = basis[:, :2] / basis.sum(axis=1, keepdims=True)
+    return tuple(round(float(v), 6) for v in xy.reshape(-1))
+
+
+def chromaticities(space: str | None = None) -> tuple[float, ...]:
+    """The EXR ``chromaticities`` of ``space`` (default: the working space): red, green,
+    blue and white (x, y), from colour-science's table of the space (the config's own
+    mapping to CIE XYZ for a space it does not know).
+
+    >>> chromaticities("ACEScg")
+    (0.713, 0.293, 0.165, 0.83, 0.128, 0.044, 0.32168, 0.33767)
+    """
+    name = canonical(space) if space else working_space()
+    if is_data(name):
+        raise ColourError(f"{name!r} is data: it has no chromaticities")
+    return _chromaticities(settings().config_name, name, interop_id(name))
 
 
 def texture_space(

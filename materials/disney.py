@@ -28,8 +28,10 @@ roughness² (BRDF Explorer; Schutte squares it). Transmission uses the radiance-
 1/η² (pbrt-v4, Mitsuba; Schutte omits it for his VCM).
 
 Thin surfaces look the same from both sides; a solid one shows only its glass from inside.
-Sampling picks a lobe with probability proportional to its estimated albedo; a lobe whose
-weight is a known zero is neither evaluated nor sampled.
+Sampling picks a lobe with probability proportional to its estimated albedo; the
+specular reflection and the glass transmission are one choice, split by the Fresnel term,
+and below the glossy minimum α they are delta lobes (:mod:`.disney_interface`). A lobe
+whose weight is a known zero is neither evaluated nor sampled.
 
 >>> import numpy as np
 >>> from .params import DisneyParams
@@ -49,6 +51,17 @@ from . import fresnel as fr
 from . import microfacet as mf
 from .arrays import NumpyOps
 from .bsdf import Model, density, draw, evaluate
+from .disney_interface import (
+    INTERFACE,
+    interface_pdf,
+    pick,
+    projected,
+    sample_interface,
+    specular_d,
+    times,
+    transmission,
+    v_cavity_over_cos,
+)
 from .disney_prepare import (
     CLEARCOAT_F0,
     DISNEY_LOBES,
@@ -71,11 +84,6 @@ def _orient(xp: Any, wi: Any, wo: Any) -> tuple[Any, Any, Any]:
 def _front(pr: dict[str, Any], s: Any) -> Any:
     """1 where the outside's lobes exist, 0 inside a solid; None on a (two-sided) thin sheet."""
     return None if pr["thin"] else 0.5 + 0.5 * s
-
-
-def _pick(xp: Any, front: Any, outside: Any, inside: Any) -> Any:
-    """``outside`` where front is 1, ``inside`` where it is 0 (exactly: x·1 + y·0)."""
-    return outside if front is None else outside * front + inside * (1.0 - front)
 
 
 # -- lobes, in the oriented frame (wo.z ≥ 0) -------------------------------------------------
@@ -120,18 +128,6 @@ def _base_scale(xp: Any, pr: dict[str, Any], ci: Any, co: Any) -> Any:
     return xp.maximum(_conty_kulla().base_scale(xp, ci, co, r, color), 0.0)
 
 
-def _q(pr: dict[str, Any], w: Any, z2: Any, prefix: str = "") -> Any:
-    """αx² x² + αy² y², the projected roughness of Smith's Λ (Heitz 2014 eq. 86).
-
-    Isotropic constants use x² + y² = 1 − z² (only its absolute error matters: q is
-    added to z²), which saves two products per direction.
-    """
-    ax2, ay2 = pr[prefix + "ax2"], pr[prefix + "ay2"]
-    if isinstance(ax2, float) and ax2 == ay2:
-        return ax2 * (1.0 - z2)
-    return ax2 * (w[0] * w[0]) + ay2 * (w[1] * w[1])
-
-
 def _masked(xp: Any, cond: Any, x: Any) -> Any:
     """x where cond, else 0, for an ``x`` that is finite everywhere.
 
@@ -139,10 +135,6 @@ def _masked(xp: Any, cond: Any, x: Any) -> Any:
     the random masks of a BSDF (measured: 0.5 ms against 0.023 ms for 125k float32).
     """
     return x * cond if isinstance(xp, NumpyOps) else xp.select(cond, x, 0.0)
-
-
-def _times(x: Any, front: Any) -> Any:
-    return x if front is None else x * front
 
 
 def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> list:
@@ -166,26 +158,26 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
     zi2, zo2 = ci * ci, co * co
     scale = _base_scale(xp, pr, ci, co)
     terms = []
-    if "specular" in lobes:
-        d = _specular_d(xp, pr, h, h2)
+    if "specular" in lobes and "specular" not in pr["delta"]:
+        d = specular_d(xp, pr, h, h2)
         if pr["ggx"]:
-            g = mf.g1_over_cos(xp, ci, _q(pr, wi, zi2), zi2) * mf.g1_over_cos(
-                xp, co, _q(pr, wo, zo2), zo2
+            g = mf.g1_over_cos(xp, ci, projected(pr, wi, zi2), zi2) * mf.g1_over_cos(
+                xp, co, projected(pr, wo, zo2), zo2
             )
         else:
-            g = _v_cavity_over_cos(xp, h, h2, ci, co)
+            g = v_cavity_over_cos(xp, h, h2, ci, co)
         dg = _masked(xp, up, 0.25 * d * g) if pr["ggx"] else xp.select(up, 0.25 * d * g, 0.0)
         a, b, c = pr["spec_a"], pr["spec_b"], pr["spec_c"]
-        dg_out = _times(dg, front)
+        dg_out = times(dg, front)
         terms += [(a * scale, dg_out), ((b - a) * scale, dg_out * w)]
         if not xp.known_zero(c):
             # The glass reflects the exact Fresnel on either side; inside, nothing else does.
-            f_exact = fr.dielectric(xp, cos_d, _pick(xp, front, pr["eta"], 1.0 / pr["eta"]))
-            k = f_exact * dg * _pick(xp, front, c, pr["glass"])
+            f_exact = fr.dielectric(xp, cos_d, pick(xp, front, pr["eta"], 1.0 / pr["eta"]))
+            k = f_exact * dg * pick(xp, front, c, pr["glass"])
             terms.append((None if isinstance(scale, float) else scale, k))
     if "diffuse" in lobes:
         shape = _diffuse_shape(xp, pr, ci, co, cos2_d)
-        k = _times(pr["diffuse"] * INV_PI * shape, front)
+        k = times(pr["diffuse"] * INV_PI * shape, front)
         terms.append((pr["base"] * scale, _masked(xp, up, k)))
     if "sheen" in lobes:
         if pr["sheen_model"] == "conty_kulla":
@@ -194,7 +186,7 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
         else:
             lobe = w * pr["sheen"]  # 2014 addendum: sheen · (1 − cos θd)⁵, no 1/π (Explorer)
             color = pr["sheen_color"]
-        terms.append((color, _masked(xp, up, _times(lobe, front))))
+        terms.append((color, _masked(xp, up, times(lobe, front))))
     if "clearcoat" in lobes:
         inv_h2 = 1.0 / xp.maximum(h2, xp.tiny)
         sin2_h = (h[0] * h[0] + h[1] * h[1]) * inv_h2  # not 1 − cos²: the α = 10⁻³ peak
@@ -205,68 +197,21 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
         )
         f = fr.schlick(xp, CLEARCOAT_F0, cos_d)
         # Burley's clearcoat keeps the 1/(4 cos cos) that Schutte and Mitsuba leave out.
-        k = _times((0.25 * pr["clearcoat"]) * f * d * g, front)
+        k = times((0.25 * pr["clearcoat"]) * f * d * g, front)
         terms.append((None, xp.select(up, k, 0.0)))  # D is 0/0 at wi = −wo: a true select
     return terms
-
-
-def _v_cavity_over_cos(xp: Any, h: Any, h2: Any, ci: Any, co: Any) -> Any:
-    """G/(cos θi cos θo) with the Cook–Torrance V-cavity G = min(1, 2 cos θh cos θ/(wo·h))
-    over both directions, written with the unnormalised h (2 cos θh/(wo·h) = 4 h_z/|h|²).
-
-    The shadowing of GTR at γ ≠ 2: Smith's Λ has no closed form for it (App. B closes
-    only GTR2), and GGX's Λ at the same α under GTR's heavier tail gains energy without
-    bound (measured, white metal at cos θo = 10⁻⁴: albedo 1.92 at γ = 1, roughness 0.5;
-    131 at roughness 0), while the V-cavity G is normalised for any D (Heitz 2014 §5.2:
-    ∫ G1 ⟨wo, h⟩ D dh = cos θo), so the lobe never reflects more than the light.
-    """
-    k = 4.0 * xp.maximum(h[2], 0.0) / xp.maximum(h2, xp.tiny)
-    inv = 1.0 / xp.maximum(ci * co, xp.tiny)
-    return xp.minimum(inv, k / xp.maximum(xp.maximum(ci, co), xp.tiny))
-
-
-def _specular_d(xp: Any, pr: dict[str, Any], h: Any, h2: Any) -> Any:
-    """D of the primary specular lobe at the unnormalised half vector h (|h|² = ``h2``):
-    the anisotropic GGX (eq. 13) at γ = 2, else the isotropic GTR of eq. 1 with α² = αx αy.
-
-    The GTR D is ∞ at h = 0 (wi = −wo, never a reflection pair): callers select, not mask.
-    """
-    if pr["ggx"]:
-        return mf.ggx_d(xp, h, pr["ax"], pr["ay"], n2=h2)
-    inv_h2 = 1.0 / xp.maximum(h2, xp.tiny)
-    sin2_h = (h[0] * h[0] + h[1] * h[1]) * inv_h2  # not 1 − cos²: the α = 10⁻³ peak
-    return mf.gtr_d(xp, pr["gamma"], pr["a2"], h[2] * h[2] * inv_h2, sin2_h)
-
-
-def _transmission(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any, pdf: bool) -> Any:
-    """f (without weight and colour) of the specular transmission, or its pdf; wi below."""
-    ax, ay = pr["tax"], pr["tay"]
-    if pr["thin"]:
-        # Schutte: reflection about the rougher thin α, mirrored through the sheet.
-        wm = xp.vec3(wi[0], wi[1], -wi[2])
-        h = xp.normalize(wm + wo)
-        oh = xp.dot(wo, h)
-        if pdf:
-            return mf.visible_ggx_pdf(xp, wo, h, ax, ay) / xp.maximum(4.0 * oh, xp.tiny)
-        g = mf.g1_over_cos(xp, wm[2], _qt(pr, wm)) * mf.g1_over_cos(xp, wo[2], _qt(pr, wo))
-        return (1.0 - fr.dielectric(xp, oh, pr["eta"])) * mf.ggx_d(xp, h, ax, ay) * g * 0.25
-    etap = _pick(xp, front, pr["eta"], 1.0 / pr["eta"])
-    return mf.dielectric_btdf(xp, wi, wo, etap, ax, ay, pdf)
-
-
-def _qt(pr: dict[str, Any], w: Any) -> Any:
-    return _q(pr, w, w[2] * w[2], "t")
 
 
 # -- the model's four core functions -------------------------------------------------------
 def _eval_oriented(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> Any:
     terms = _reflection_terms(xp, pr, wi, wo, front)
     lobes = pr["lobes"]
-    if "diff_trans" in lobes or "spec_trans" in lobes:
+    glossy_t = "spec_trans" in lobes and "spec_trans" not in pr["delta"]
+    if "diff_trans" in lobes or glossy_t:
         down = (wi[2] < 0.0) & (wo[2] > 0.0)
         t = pr["diff_trans"] * INV_PI if "diff_trans" in lobes else 0.0
-        if "spec_trans" in lobes:
-            t = t + pr["glass"] * _transmission(xp, pr, wi, wo, front, pdf=False)
+        if glossy_t:
+            t = t + pr["glass"] * transmission(xp, pr, wi, wo, front, pdf=False)
         terms.append((pr["trans_color"], xp.select(down, t, 0.0)))
     grey = [s for c, s in terms if c is None]
     f = xp.zeros(wi[2]) * pr["base"] if not grey else None
@@ -282,27 +227,19 @@ def _add(total: Any, term: Any) -> Any:
 
 
 def _odds(xp: Any, pr: dict[str, Any], front: Any) -> dict[str, Any]:
-    return {k: _pick(xp, front, v, pr["odds_inside"][k]) for k, v in pr["odds"].items()}
+    return {k: pick(xp, front, v, pr["odds_inside"][k]) for k, v in pr["odds"].items()}
 
 
 def _pdf_oriented(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> Any:
     odds = _odds(xp, pr, front)
     ci, co = wi[2], wo[2]
     up = (ci > 0.0) & (co > 0.0)
+    down = (ci < 0.0) & (co > 0.0)
     h = wi + wo
     h2 = xp.maximum(xp.dot(h, h), xp.tiny)  # 4 cos²θd, from h for float32 (see above)
-    p_up = 0.0
-    if "specular" in odds and not pr["ggx"]:
-        # GTR sampling of App. B (eqs. 2–3): D(h) cos θh / (4 wo·h), as for the clearcoat.
-        d = _specular_d(xp, pr, h, h2)
-        p_up = odds["specular"] * xp.select(up, d * h[2] / (2.0 * h2), 0.0)
-    elif "specular" in odds:
-        # Visible normals: D_wo(h)/(4 wo·h) = G1(wo) D(h) / (4 cos θo).
-        zo2 = co * co
-        g1 = mf.g1_over_cos(xp, co, _q(pr, wo, zo2), zo2)
-        p_up = odds["specular"] * 0.25 * mf.ggx_d(xp, h, pr["ax"], pr["ay"], n2=h2) * g1
+    p_up = xp.zeros(ci)
     if "diffuse" in odds or "sheen" in odds:
-        p_up = p_up + (odds.get("diffuse", 0.0) + odds.get("sheen", 0.0)) * INV_PI * ci
+        p_up = (odds.get("diffuse", 0.0) + odds.get("sheen", 0.0)) * INV_PI * ci
     if "clearcoat" in odds:
         # D(h) cos θh / (4 wo·h) with cos θh = h_z/|h| and wo·h = |h|/2.
         d = mf.gtr_d(
@@ -310,12 +247,12 @@ def _pdf_oriented(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> 
         )
         p_up = p_up + odds["clearcoat"] * d * h[2] / (2.0 * h2)
     p = xp.select(up, p_up, 0.0)
-    if "diff_trans" in odds or "spec_trans" in odds:
-        down = (ci < 0.0) & (co > 0.0)
-        p_down = odds["diff_trans"] * -ci * INV_PI if "diff_trans" in odds else 0.0
-        if "spec_trans" in odds:
-            p_down = p_down + odds["spec_trans"] * _transmission(xp, pr, wi, wo, front, pdf=True)
-        p = p + xp.select(down, p_down, 0.0)
+    if "diff_trans" in odds:
+        p = p + xp.select(down, odds["diff_trans"] * -ci * INV_PI, 0.0)
+    glossy = [k for k in INTERFACE if k in odds and k not in pr["delta"]]
+    if glossy:
+        o_d = sum(odds[k] for k in INTERFACE if k in odds)
+        p = p + o_d * interface_pdf(xp, pr, wi, wo, front, h2, up, down)
     return p
 
 
@@ -343,8 +280,8 @@ def pdf_core(xp: Any, pr: dict[str, Any], wi: Any, wo: Any) -> Any:
     return _pdf_oriented(xp, pr, wi_, wo_, front)
 
 
-def _candidates(xp: Any, pr: dict[str, Any], wo: Any, u1: Any, u2: Any, front: Any) -> dict:
-    """One direction per present lobe from (u1, u2), and whether it is a valid output."""
+def _candidates(xp: Any, pr: dict[str, Any], wo: Any, u1: Any, u2: Any) -> dict:
+    """One direction per present lobe outside the interface, and whether it is valid."""
     lobes = pr["lobes"]
     out = {}
     if {"diffuse", "sheen", "diff_trans"} & set(lobes):
@@ -352,57 +289,72 @@ def _candidates(xp: Any, pr: dict[str, Any], wo: Any, u1: Any, u2: Any, front: A
         x, y, z = r * xp.cos(phi), r * xp.sin(phi), xp.safe_sqrt(1.0 - u1)
         out["diffuse"] = out["sheen"] = (xp.vec3(x, y, z), z > 0.0)
         out["diff_trans"] = (xp.vec3(x, y, -z), z > 0.0)
-    if "specular" in lobes:
-        if pr["ggx"]:
-            h = mf.sample_visible_ggx(xp, wo, pr["ax"], pr["ay"], u1, u2)
-        else:  # visible-normal sampling exists for GGX only: App. B's GTR sampling
-            h = mf.sample_gtr(xp, pr["gamma"], pr["a2"], u1, u2)
-        wi = mf.reflect(xp, wo, h)
-        out["specular"] = (wi, wi[2] > 0.0)
     if "clearcoat" in lobes:
         wi = mf.reflect(xp, wo, mf.sample_gtr(xp, 1.0, pr["clearcoat_a2"], u1, u2))
         out["clearcoat"] = (wi, wi[2] > 0.0)
-    if "spec_trans" in lobes:
-        h = mf.sample_visible_ggx(xp, wo, pr["tax"], pr["tay"], u1, u2)
-        if pr["thin"]:
-            wi = mf.reflect(xp, wo, h)
-            out["spec_trans"] = (xp.vec3(wi[0], wi[1], -wi[2]), wi[2] > 0.0)
-        else:
-            etap = _pick(xp, front, pr["eta"], 1.0 / pr["eta"])
-            wi, ok = mf.refract(xp, wo, h, etap)
-            out["spec_trans"] = (wi, ok & (wi[2] < 0.0))
     return out
 
 
-def sample_core(xp: Any, pr: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any, Any]:
-    """(wi, f·|cos θi|/pdf, pdf): u[0] picks a lobe by its odds, u[1], u[2] its direction."""
+def sample_core(xp: Any, pr: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any, Any, Any]:
+    """(wi, f·|cos θi|/pdf, pdf, delta): u[0] picks a lobe by its odds, u[1], u[2] its
+    direction. The specular interface (reflection and glass) is one choice, taking the
+    last share of u[0], and splits by the Fresnel term (:mod:`.disney_interface`); a delta
+    lobe's sample has the probability of its choice as ``pdf`` and ``delta`` True."""
     _, wo_, front, s = _oriented(xp, pr, wo, wo)
     odds = _odds(xp, pr, front)
-    cands = _candidates(xp, pr, wo_, u[1], u[2], front)
-    order = [k for k in LOBES if k in odds]
-    if not order:  # nothing to sample (an opaque solid seen from inside)
-        zero = xp.zeros(wo_[2])
-        return xp.vec3(zero, zero, zero), zero * pr["base"], zero
-    wi, valid = cands[order[-1]]
+    zero = xp.zeros(wo_[2])
+    if not odds:  # nothing to sample (an opaque solid seen from inside)
+        return xp.vec3(zero, zero, zero), zero * pr["base"], zero, False
+    interface = [k for k in INTERFACE if k in odds]
+    others = [k for k in LOBES if k in odds and k not in INTERFACE]
+    cands = _candidates(xp, pr, wo_, u[1], u[2])
+    delta, value, o_d, p_choice, start = False, None, 0.0, 1.0, 0.0
+    if interface:
+        o_d = sum(odds[k] for k in interface)
+        start = sum((odds[k] for k in others), 0.0)
+        v = (u[0] - start) / xp.select(o_d > 0.0, o_d, 1.0) if others else u[0]
+        scale = _base_scale(xp, pr, wo_[2], wo_[2])
+        wi, valid, delta, value, p_choice = sample_interface(
+            xp, pr, wo_, xp.clip(v, 0.0, 1.0), u[1], u[2], front, scale
+        )
+        if others and delta is not False:
+            is_interface = u[0] >= start
+            delta = is_interface if delta is True else is_interface & delta
+        listed = others
+    else:
+        wi, valid = cands[others[-1]]
+        listed = others[:-1]
     cum = 0.0
     chosen = []
-    for k in order[:-1]:
+    for k in listed:
         cum = cum + odds[k]
         chosen.append((u[0] < cum, k))
     for cond, k in reversed(chosen):
-        wi = xp.select(cond, cands[k][0], wi)
+        wi = xp.vec3(*(xp.select(cond, cands[k][0][i], wi[i]) for i in range(3)))
         valid = xp.select(cond, cands[k][1], valid)
     valid = valid & (wo_[2] > 0.0)
     # A failed candidate may be NaN; evaluate at a harmless finite direction instead.
     wi = xp.vec3(*(xp.select(valid, wi[k], wo_[k]) for k in range(3)))
-    pdf = xp.select(valid, _pdf_oriented(xp, pr, wi, wo_, front), 0.0)
-    f = _eval_oriented(xp, pr, wi, wo_, front)
+    if any(k not in pr["delta"] for k in odds):
+        pdf = xp.select(valid, _pdf_oriented(xp, pr, wi, wo_, front), 0.0)
+        f = _eval_oriented(xp, pr, wi, wo_, front)
+        ok = pdf > 0.0
+        weight = f * xp.select(ok, xp.abs(wi[2]) / xp.select(ok, pdf, 1.0), 0.0)
+    else:  # only delta lobes: nothing has a density
+        pdf, weight = zero, zero * pr["base"]
+    if delta is not False:
+        p_delta = o_d * p_choice
+        ok_d = valid & (p_delta > 0.0)
+        w_delta = value * xp.select(ok_d, 1.0 / xp.select(ok_d, p_delta, 1.0), 0.0)
+        weight = xp.select(delta, w_delta, weight)
+        pdf = xp.select(delta, xp.select(ok_d, p_delta, 0.0), pdf)
     ok = pdf > 0.0
-    weight = f * xp.select(ok, xp.abs(wi[2]) / xp.select(ok, pdf, 1.0), 0.0)
     z = wi[2] if s is None else wi[2] * s
     # A failed sample is the zero vector with pdf 0 and weight 0, never NaN.
     wi = xp.vec3(xp.select(ok, wi[0], 0.0), xp.select(ok, wi[1], 0.0), xp.select(ok, z, 0.0))
-    return wi, weight, pdf
+    if delta is not False:
+        delta = ok if delta is True else delta & ok
+    return wi, weight, pdf, delta
 
 
 def restrict(xp: Any, prepared: dict[str, Any], names: Any) -> dict[str, Any]:
@@ -482,6 +434,7 @@ def pdf(params: DisneyParams, wi: Any, wo: Any, **kw: Any) -> Any:
     return density(MODEL, params, wi, wo, **kw)
 
 
-def sample(params: DisneyParams, wo: Any, u: Any, **kw: Any) -> tuple[Any, Any, Any]:
-    """(wi, weight = f·|cos θi|/pdf, pdf) from uniforms u of shape (..., 3)."""
+def sample(params: DisneyParams, wo: Any, u: Any, **kw: Any) -> tuple[Any, ...]:
+    """(wi, weight = f·|cos θi|/pdf, pdf) from uniforms u of shape (..., 3); with
+    ``delta=True`` a fourth array marks delta-lobe samples (their pdf is a probability)."""
     return draw(MODEL, params, wo, u, **kw)

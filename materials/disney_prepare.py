@@ -20,7 +20,8 @@ TINT_WEIGHTS = (0.3, 0.6, 0.1)
 """Burley's tint luminance, from the Disney BRDF Explorer's ``disney.brdf``:
 ``float Cdlum = .3*Cdlin[0] + .6*Cdlin[1] + .1*Cdlin[2]; // luminance approx.``
 (Schutte's seed prints (0.3, 0.6, 1.0): a typo). Part of the model, a rough hue normaliser;
-not Rec.709 Y (:data:`lookdev.materials.colour.REC709_LUMINANCE`), which measures pixels."""
+not luminance Y (:func:`lookdev.materials.colour.luminance`, the working space's XYZ row), which
+measures pixels."""
 CLEARCOAT_F0 = 0.04  # IOR 1.5 polyurethane (Burley §5.4)
 SCHLICK_MEAN = 1.0 / 21.0  # ∫ (1 − μ)⁵ 2μ dμ: hemispherical mean of the Schlick weight
 SHEEN_ALBEDO_GUESS = 0.1  # rough albedo of sheen 1, only used to weight sampling
@@ -153,6 +154,8 @@ def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
     pr["gamma"] = float(gamma) if isinstance(gamma, int | float) else xp.scalar(gamma)
     pr["ggx"] = isinstance(gamma, int | float) and gamma == 2.0
     pr["a2"] = ax * ay
+    pr["spec_lum_a"] = luminance(a)
+    r_t = p["roughness"]
     if thin:
         # Burley 2015 Fig. 15 via Schutte: a thin sheet's transmission looks rougher.
         r_t = (0.65 * eta - 0.35) * p["roughness"]
@@ -160,6 +163,12 @@ def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
         pr["tax"], pr["tay"] = mf.anisotropic_alphas(xp, r_t, p["anisotropic"])
     else:
         pr["tax"], pr["tay"] = ax, ay
+    # Lobes whose α is below ALPHA_MIN are deltas (microfacet.is_delta, disney_interface).
+    pr["delta"] = tuple(
+        k
+        for k, r in (("specular", p["roughness"]), ("spec_trans", r_t))
+        if mf.is_delta(r, p["anisotropic"]) and (k != "specular" or pr["ggx"])
+    )  # GTR's tails (γ < 2) carry visible energy at any α: γ ≠ 2 stays glossy, as the coat
     pr["tax2"], pr["tay2"] = pr["tax"] * pr["tax"], pr["tay"] * pr["tay"]
     weights = {
         "diffuse": pr["diffuse"],

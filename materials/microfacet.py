@@ -9,10 +9,19 @@ the shading frame (normal +z, tangent +x). References:
   GGX Λ), as the 2014 addendum adopts it.
 * Heitz 2018, "Sampling the GGX Distribution of Visible Normals" (JCGT 7(4)), listing 1.
 
-**Minimum α.** ``ALPHA_MIN`` = 10⁻³, the value of the Disney BRDF Explorer (and
-Schutte's and Mitsuba's ``principled``): roughness 0 gives this α, not a delta. At it the
-GGX peak D(n) = 1/(π α²) ≈ 3·10⁵ is still finite in float32, and ``sample``, ``pdf`` and
-``eval`` all see the same α, so they agree at roughness 0 exactly.
+**Minimum α, and below it a delta.** ``ALPHA_MIN`` = 10⁻³, the value of the Disney BRDF
+Explorer (and Schutte's and Mitsuba's ``principled``), is the smallest α a *glossy* GGX
+lobe takes: at it the peak D(n) = 1/(π α²) ≈ 3·10⁵ is still finite in float32, and
+``sample``, ``pdf`` and ``eval`` all see the same α. Roughness used to be clamped up to it,
+so every roughness below √10⁻³ ≈ 0.0316 already rendered alike, as a lobe 0.06° wide that
+a renderer had to treat as glossy (sample lights at every vertex for nothing, issue 16).
+The rule now (:func:`is_delta`): a GGX lobe whose larger α (roughness²/aspect, computed
+from the float32 roughness and anisotropy every consumer stores) is below ``ALPHA_MIN``
+is the α → 0 limit itself, a Dirac delta (mirror reflection, Snell refraction), sampled
+exactly and left out of ``eval``/``pdf`` (:mod:`.disney_interface`). Only constants
+decide: a roughness that varies per element (a texture) stays glossy with the clamp,
+since the kernel's lobe kinds are fixed when it is traced. An anisotropic lobe with one
+α above the minimum stays glossy and its other α is clamped.
 
 **Stability of the GTR normalisation** (eq. 1) at γ → 1 and α → 1: with L = log α² and
 t = (1 − γ) L the constant is
@@ -36,6 +45,8 @@ from __future__ import annotations
 
 import math
 from typing import Any
+
+import numpy as np
 
 from . import fresnel as fr
 
@@ -205,6 +216,22 @@ def anisotropic_alphas(xp: Any, roughness: Any, anisotropic: Any) -> tuple[Any, 
     return xp.maximum(a / aspect, ALPHA_MIN), xp.maximum(a * aspect, ALPHA_MIN)
 
 
+def is_delta(roughness: Any, anisotropic: Any = 0.0) -> bool:
+    """True when a GGX lobe of this roughness is a delta (see the module docstring).
+
+    Decided on constants only (Python floats, rounded to float32 as stored in a scene),
+    so the numpy backend and the Mitsuba plugin agree; per-element values give False.
+
+    >>> is_delta(0.0), is_delta(0.02), is_delta(0.05), is_delta(0.03, 1.0)
+    (True, True, False, False)
+    """
+    if not (isinstance(roughness, float) and isinstance(anisotropic, float)):
+        return False
+    r = float(np.float32(roughness))
+    aspect = math.sqrt(1.0 - 0.9 * float(np.float32(anisotropic)))
+    return r * r / aspect < ALPHA_MIN
+
+
 def ggx_d(xp: Any, h: Any, ax: Any, ay: Any, n2: Any = None) -> Any:
     """D_GTR2aniso(h) = 1/(π αx αy ((h·x)²/αx² + (h·y)²/αy² + (h·n)²)²) (eq. 13).
 
@@ -292,15 +319,18 @@ def transmission_half(xp: Any, wi: Any, wo: Any, eta: Any) -> Any:
     return h * xp.select(h[2] < 0.0, -one, one)
 
 
-def dielectric_btdf(xp: Any, wi: Any, wo: Any, eta: Any, ax: Any, ay: Any, pdf: bool) -> Any:
+def dielectric_btdf(
+    xp: Any, wi: Any, wo: Any, eta: Any, ax: Any, ay: Any, pdf: bool, h: Any = None
+) -> Any:
     """Rough dielectric transmission (Walter et al. 2007 eq. 21; pbrt-v4 DielectricBxDF).
 
     f = (1 − F) D G1(wi) G1(wo) |wi·h| |wo·h| / (|cos θi| cos θo (wi·h + wo·h/η)² η²),
     the last 1/η² for radiance transport. ``wo`` is up (relative IOR 1), ``wi`` below,
     ``eta`` = η_wi/η_wo. With ``pdf``: the density of refracting ``wo`` about a visible
     normal, D_wo(h) |wi·h| / (wi·h + wo·h/η)². Zero where no microfacet connects them.
+    ``h``: :func:`transmission_half` of (wi, wo), when the caller has it already.
     """
-    h = transmission_half(xp, wi, wo, eta)
+    h = transmission_half(xp, wi, wo, eta) if h is None else h
     ih, oh = xp.dot(wi, h), xp.dot(wo, h)
     ok = (ih < 0.0) & (oh > 0.0)
     denom = ih + oh / eta

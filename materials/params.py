@@ -4,7 +4,9 @@ Ranges follow Burley's principles (§5.1): parameters are 0..1 over their plausi
 may be pushed beyond it where that makes sense, and are rejected where meaningless
 (NaN, infinity, negative roughness …) with a one-line :class:`ParameterError` naming the
 field and the allowed range. Colours are scene-linear in the working space
-(:mod:`.colour`); a ``"#rrggbb"`` string is taken as sRGB-encoded and decoded once, here.
+(:mod:`.colour`), converted once, here, from the space a preset writes them in: a
+``"#rrggbb"`` string is sRGB-encoded (``sRGB - Texture``), a ``[r, g, b]`` triple or a grey
+scalar is linear Rec.709 (:data:`~.colour.PRESET_LINEAR`).
 
 >>> DisneyParams(base_color="#ffffff", metallic=1.0).base_color
 (1.0, 1.0, 1.0)
@@ -14,9 +16,11 @@ field and the allowed range. Colours are scene-linear in the working space
 
 from __future__ import annotations
 
+import math
 import re
 from typing import Annotated, Any, Literal
 
+import numpy as np
 from pydantic import (
     BaseModel,
     BeforeValidator,
@@ -26,7 +30,7 @@ from pydantic import (
     model_validator,
 )
 
-from .colour import decode_hex
+from .colour import PRESET_LINEAR, canonical, convert, decode_hex, settings, working_space
 from .errors import ParameterError as ParameterError  # re-exported
 from .errors import one_line, register_schema
 from .fresnel import SPECULAR_F0_SCALE, ior_to_specular, specular_to_ior
@@ -35,15 +39,33 @@ _HEX = re.compile(r"^#?([0-9a-fA-F]{6})$")
 
 
 def parse_color(value: Any) -> Any:
-    """``"#rrggbb"`` (sRGB) → linear triple; ``[r, g, b]`` and a grey scalar pass through."""
+    """``"#rrggbb"`` (sRGB) or linear Rec.709 ``[r, g, b]`` / grey → the working space."""
     if isinstance(value, str):
         m = _HEX.match(value.strip())
         if not m:
             raise ValueError(f"colour {value!r} is neither '#rrggbb' nor [r, g, b]")
         return decode_hex(m.group(1))
     if isinstance(value, int | float) and not isinstance(value, bool):
-        return (float(value),) * 3
-    return value
+        value = (float(value),) * 3
+    return _from_preset_linear(value)
+
+
+def _from_preset_linear(value: Any) -> Any:
+    """A finite numeric triple converted into the working space; anything else as given,
+    for the schema to reject with its own message (NaN, a pair, a string in a list)."""
+    try:
+        rgb = tuple(float(v) for v in value)
+    except (TypeError, ValueError):
+        return value
+    if len(rgb) != 3 or not all(math.isfinite(v) for v in rgb):
+        return value
+    ws = settings().working_space  # the default: no look-up (this runs for every colour)
+    if ws in ("lin_rec709", PRESET_LINEAR) or canonical(PRESET_LINEAR) == working_space():
+        return value  # as written: no float32 round trip
+    out = convert(rgb, PRESET_LINEAR).astype(np.float64)
+    # a colour on a range edge stays on it: OCIO's float32 matrix may land an ulp outside
+    edge = np.clip(out, 0.0, 1.0)
+    return tuple(float(v) for v in np.where(np.abs(out - edge) < 1e-6, edge, out))
 
 
 def _unit(default: float, description: str, *, le: float | None = 1.0, ge: float = 0.0):
@@ -67,7 +89,11 @@ Color = Annotated[tuple[Channel, Channel, Channel], BeforeValidator(parse_color)
 class Params(BaseModel):
     """Base of every parameter schema: strict about unknown names, NaN and infinity."""
 
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+    # defaults are validated too: a default colour is linear Rec.709 like a written one,
+    # and must reach an ACEScg working space converted
+    model_config = ConfigDict(
+        extra="forbid", allow_inf_nan=False, frozen=True, validate_default=True
+    )
 
     @classmethod
     def parse(cls, data: dict[str, Any], *, where: str | None = None):

@@ -51,6 +51,7 @@ from .pixar_scatter import (
     PIXAR_LOBES,
     PREFIX,
     at_view,
+    delta_lobes,
     prepared,
     scatter_eval,
     scatter_pdf,
@@ -267,7 +268,13 @@ def _prepare(xp: Any, params: PixarParams, **maps: Any) -> dict[str, Any]:
     p_r = lobes.power_reflection(xp, r, v["reflection_cone_scale"])
     powers = {"specular": p_s, "specular_t": p_s, "reflection": p_r, "reflection_t": p_r}
     eta = xp.scalar(maps.get("ior", params.eta))
-    return prepared(xp, ends(xp, view_independent(xp, v)), powers, eta)
+    c_s = specular_cone(r, v["specular_cone_scale"])
+    c_r = reflection_cone(r, v["reflection_cone_scale"])
+    cones = {"specular": c_s, "specular_t": c_s, "reflection": c_r, "reflection_t": c_r}
+    falls = {"specular": r * LN_10, "specular_t": r * LN_10}
+    falls.update(reflection=LN_10, reflection_t=LN_10)
+    delta = delta_lobes(cones, falls)
+    return prepared(xp, ends(xp, view_independent(xp, v)), powers, eta, delta)
 
 
 def _prepare_weights(xp: Any, params: Any, **maps: Any) -> dict[str, Any]:
@@ -286,11 +293,13 @@ def _prepare_weights(xp: Any, params: Any, **maps: Any) -> dict[str, Any]:
             g = getattr(params, name + GRAZING)
             g = None if g is None or (name not in maps and g == n) else xp.color(g)
         pairs[name] = (xp.color(n), g)
-    powers = {}
+    powers, cones, falls = {}, {}, {}
     for lobe in CONE_LOBES:
         falloff = _scalar(xp, params, maps, f"{lobe}_falloff") if lobe in FALLOFF_LOBES else LN_10
-        powers[lobe] = lobes.cone_power(xp, falloff, _scalar(xp, params, maps, f"{lobe}_cone"))
-    return prepared(xp, pairs, powers, _scalar(xp, params, maps, "ior"))
+        cones[lobe], falls[lobe] = _scalar(xp, params, maps, f"{lobe}_cone"), falloff
+        powers[lobe] = lobes.cone_power(xp, falloff, cones[lobe])
+    eta = _scalar(xp, params, maps, "ior")
+    return prepared(xp, pairs, powers, eta, delta_lobes(cones, falls))
 
 
 def _scalar(xp: Any, params: Any, maps: dict[str, Any], name: str) -> Any:

@@ -82,10 +82,43 @@ def kept_lobes(xp: Any, pairs: dict[str, tuple[Any, Any]]) -> tuple[str, ...]:
     return tuple(kept)
 
 
-def prepared(xp: Any, pairs: dict, powers: dict[str, Any], eta: Any) -> dict[str, Any]:
+def delta_lobes(cones: dict[str, Any], falloffs: dict[str, Any]) -> tuple[str, ...]:
+    """Highlight lobes that are deltas: a constant cone at most
+    :data:`~.pixar_lobes.CONE_MIN_DEG`, with a positive falloff.
+
+    Smits' reflection cone "goes between 0 (or epsilon in practice) and 10 degrees": the
+    cone used to be floored at 0.5° (the blend still floors it, for its energy-weighted
+    means, :mod:`lookdev.pipeline.blend.pixar_composite`, hence "at most" here, so a lone
+    layer stays its preset), and every narrower cone rendered alike as a glossy
+    lobe the renderer sampled lights for at every vertex (issue 16, as the Disney glass).
+    Below the floor the lobe is now its p → ∞ limit, a mirror (or, for a transmitted
+    lobe, the view refracted by the IOR), whose weight is FrnBlend[N, G, cos θo]: the
+    lobe's albedo in that limit. A cone or falloff that varies per element stays glossy
+    (the kernel's lobe kinds are fixed when it is traced); a falloff of 0 is a flat lobe.
+    """
+    out = []
+    for lobe, cone in cones.items():
+        fall = falloffs.get(lobe)
+        if isinstance(cone, float) and isinstance(fall, float):
+            if cone <= lobes.CONE_MIN_DEG and fall > 0.0:
+                out.append(lobe)
+    return tuple(out)
+
+
+def prepared(
+    xp: Any, pairs: dict, powers: dict[str, Any], eta: Any, delta: tuple[str, ...] = ()
+) -> dict[str, Any]:
     """What eval/pdf/sample consume, from the weights' two ends, each highlight lobe's
-    exponent and the IOR: the one path for plain and composited materials."""
-    return {"ends": pairs, "power": powers, "eta": eta, "lobes": kept_lobes(xp, pairs)}
+    exponent, the IOR and the delta lobes (:func:`delta_lobes`): the one path for plain
+    and composited materials."""
+    kept = kept_lobes(xp, pairs)
+    return {
+        "ends": pairs,
+        "power": powers,
+        "eta": eta,
+        "lobes": kept,
+        "delta": tuple(k for k in delta if k in kept),
+    }
 
 
 def _upper(xp: Any, wi: Any, wo: Any) -> tuple[Any, Any]:
@@ -125,7 +158,8 @@ def scatter_eval(xp: Any, prep: dict[str, Any], wi: Any, wo: Any) -> Any:
     w = at_view(xp, prep["ends"], wo[2])
     f = xp.zeros(wi[2]) * w["specN"]
     for lobe in prep["lobes"]:
-        f = f + _lobe_value(xp, prep, w, lobe, wi, wo)
+        if lobe not in prep["delta"]:  # a delta has no value at any given direction
+            f = f + _lobe_value(xp, prep, w, lobe, wi, wo)
     return f
 
 
@@ -165,7 +199,8 @@ def _mixture_pdf(xp: Any, prep: dict[str, Any], wi: Any, wo: Any) -> Any:
     probs = _selection(xp, prep, wo)
     pdf = xp.zeros(wi[2])
     for lobe, prob in probs.items():
-        pdf = pdf + prob * _lobe_pdf(xp, prep, lobe, wi, wo)
+        if lobe not in prep["delta"]:
+            pdf = pdf + prob * _lobe_pdf(xp, prep, lobe, wi, wo)
     return xp.select(wo[2] > 0.0, pdf, 0.0)
 
 
@@ -180,6 +215,10 @@ def _candidate(xp: Any, prep: dict[str, Any], lobe: str, wo: Any, u1: Any, u2: A
         return lobes.cosine_hemisphere(xp, u1, u2)
     if lobe == "diffuse_t":
         return lobes.to_back(xp, lobes.cosine_hemisphere(xp, u1, u2))
+    if lobe in prep["delta"]:  # the lobe's axis itself: the mirror, or the refracted view
+        view = lobes.back_view(xp, wo, prep["eta"]) if lobe.endswith("_t") else wo
+        mirror = xp.vec3(-view[0], -view[1], view[2])
+        return lobes.to_back(xp, mirror) if lobe.endswith("_t") else mirror
     h = lobes.sample_half_vector(xp, _power(prep, lobe), u1, u2)
     if lobe.endswith("_t"):
         view = lobes.back_view(xp, wo, prep["eta"])
@@ -187,11 +226,21 @@ def _candidate(xp: Any, prep: dict[str, Any], lobe: str, wo: Any, u1: Any, u2: A
     return lobes.reflect(xp, wo, h)
 
 
-def scatter_sample(xp: Any, prep: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any, Any]:
+def _delta_weight(xp: Any, prep: dict[str, Any], lobe: str, wo: Any) -> Any:
+    """A delta lobe's weight: FrnBlend[N, G, cos θo], its albedo as the cone closes."""
+    w = at_view(xp, prep["ends"], wo[2])
+    p = PREFIX[lobe]
+    return lobes.frn_blend(xp, w[p + "N"], w[p + "G"], wo[2])
+
+
+def scatter_sample(xp: Any, prep: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any, Any, Any]:
     s = xp.select(wo[2] < 0.0, -1.0, 1.0)
     wo = xp.vec3(wo[0], wo[1], wo[2] * s)
     wi = xp.vec3(xp.zeros(u[0]), xp.zeros(u[0]), xp.zeros(u[0]) + 1.0)
     transmitted = u[0] < 0.0  # all False: the chosen lobe's side, filled in below
+    delta = u[0] < 0.0
+    delta_value = xp.zeros(u[0]) * prep["ends"]["specN"][0]
+    delta_prob = xp.zeros(u[0])
     cumulative = 0.0
     for lobe, prob in _selection(xp, prep, wo).items():
         chosen = (u[0] >= cumulative) & (u[0] < cumulative + prob)
@@ -199,9 +248,21 @@ def scatter_sample(xp: Any, prep: dict[str, Any], wo: Any, u: Any) -> tuple[Any,
         wi = xp.select(chosen, _candidate(xp, prep, lobe, wo, u[1], u[2]), wi)
         if lobe.endswith("_t"):
             transmitted = transmitted | chosen
+        if lobe in prep["delta"]:
+            delta = delta | chosen
+            delta_value = xp.select(chosen, _delta_weight(xp, prep, lobe, wo), delta_value)
+            delta_prob = xp.select(chosen, prob, delta_prob)
     # A highlight sample that leaves its own side failed (pdf 0), as in a renderer.
     ok = (u[0] < cumulative) & xp.select(transmitted, wi[2] < 0.0, wi[2] > 0.0)
     pdf = xp.select(ok, _mixture_pdf(xp, prep, wi, wo), 0.0)
     f = scatter_eval(xp, prep, wi, wo)
     weight = f * xp.select(pdf > 0.0, xp.abs(wi[2]) / xp.maximum(pdf, xp.tiny), 0.0)
-    return xp.vec3(wi[0], wi[1], wi[2] * s), weight, pdf
+    if prep["delta"]:
+        ok_d = ok & delta & (delta_prob > 0.0)
+        w_d = delta_value * xp.select(ok_d, 1.0 / xp.maximum(delta_prob, xp.tiny), 0.0)
+        weight = xp.select(delta, w_d, weight)
+        pdf = xp.select(delta, xp.select(ok_d, delta_prob, 0.0), pdf)
+        delta = delta & ok_d
+    else:
+        delta = False
+    return xp.vec3(wi[0], wi[1], wi[2] * s), weight, pdf, delta

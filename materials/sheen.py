@@ -250,7 +250,7 @@ def _pdf(xp: Any, prepared: dict[str, Any], wi: Any, wo: Any) -> Any:
     return xp.select((wi[2] > 0.0) & (wo[2] > 0.0), INV_TWO_PI, 0.0)
 
 
-def _sample(xp: Any, prepared: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any, Any]:
+def _sample(xp: Any, prepared: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any, Any, bool]:
     # Uniform hemisphere (§2): cos θi = u1, φ = 2π u2; pdf 1/2π.
     z = u[1]
     s = xp.safe_sqrt(1.0 - z * z)
@@ -259,7 +259,7 @@ def _sample(xp: Any, prepared: dict[str, Any], wo: Any, u: Any) -> tuple[Any, An
     pdf = _pdf(xp, prepared, wi, wo)
     f = _eval(xp, prepared, wi, wo)
     weight = f * xp.select(pdf > 0.0, z * (2.0 * math.pi), 0.0)
-    return wi, weight, pdf
+    return wi, weight, pdf, False  # no delta lobe
 
 
 # [without, with] terminator softening, each (n_r, n_mu).

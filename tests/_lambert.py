@@ -38,7 +38,7 @@ def _sample(xp, prepared, wo, u):
     ok = wo[2] > 0
     pdf = xp.select(ok, z / math.pi, 0.0)
     weight = prepared["rho"] * xp.select(ok, 1.0, 0.0)
-    return wi, weight, pdf
+    return wi, weight, pdf, False
 
 
 LAMBERT = Model("lambert", LambertParams, _prepare, _eval, _pdf, _sample)
@@ -89,7 +89,7 @@ def _phong_sample(xp, prepared, wo, u):
     pdf = _phong_pdf(xp, prepared, wi, wo)
     ok = (wi[2] > 0) & (wo[2] > 0)
     w = xp.select(ok, (n + 2.0) / (n + 1.0) * wi[2], 0.0)
-    return wi, xp.vec3(w, w, w), pdf
+    return wi, xp.vec3(w, w, w), pdf, False
 
 
 PHONG = Model("phong", PhongParams, _phong_prepare, _phong_eval, _phong_pdf, _phong_sample)

@@ -53,7 +53,7 @@ def _sample(xp, p, wo, u):
     if "diff_trans" in p["lobes"]:
         side = xp.select(u[0] < p["t"], -side, side)
     wi = xp.vec3(r * xp.cos(phi), r * xp.sin(phi), xp.safe_sqrt(1.0 - u[1]) * side)
-    return wi, p["rho"] * _view_factor(xp, wo), _pdf(xp, p, wi, wo)
+    return wi, p["rho"] * _view_factor(xp, wo), _pdf(xp, p, wi, wo), False
 
 
 LOBES = (Lobe("diffuse", "diffuse"), Lobe("diff_trans", "diffuse", transmits=True))

@@ -11,8 +11,9 @@ manner of Mitsuba's ``mitsuba.chi2`` (itself after Wenzel Jakob's original test)
    its estimate agrees with its children's, so even the α = 10⁻³ lobe is resolved. A cell
    that holds samples but whose quadrature sees almost nothing (the peak fell between the
    nodes) is split too.
-3. Samples with pdf 0 are failures; their count is compared against ``n · (1 − ∫ pdf)``
-   as one more bin, so a sampler that loses or invents mass fails.
+3. Samples with pdf 0 are failures, and so are delta-lobe samples (no density); their
+   count is compared against ``n · (1 − ∫ pdf)`` as one more bin, so a sampler that
+   loses or invents mass fails.
 4. Bins expecting fewer than ``min_expected`` samples are pooled into one; Pearson's
    statistic is compared with the χ² distribution (scipy) at significance ``alpha``.
 
@@ -81,8 +82,10 @@ def chi2_details(
     wo = np.asarray(wo, dtype=np.float64)
     wo = wo / np.linalg.norm(wo)
     u = np.random.default_rng(seed).random((n_samples, 3))
-    wi, _, pdf = draw(model, params, wo, u, **maps)
-    ok = (pdf > 0) & np.all(np.isfinite(wi), axis=-1)
+    wi, _, pdf, delta = draw(model, params, wo, u, delta=True, **maps)
+    # Delta-lobe samples have no density: they count with the failures, so the test
+    # checks that their share is the mass the pdf leaves out.
+    ok = (pdf > 0) & ~delta & np.all(np.isfinite(wi), axis=-1)
     c, p = _sphere_coords(wi[ok])
     observed = _histogram(c, p, res, 2 * res)
 

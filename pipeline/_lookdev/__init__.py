@@ -9,6 +9,9 @@ The Python API (:mod:`lookdev.pipeline.api`), for notebooks and DCCs' Python::
     lookdev.export_usd([gold], "gold.usda")
     lookdev.proof(["gold"], ibls=["studio"], out="proofs")
 
+    with lookdev.colour_settings(working_space="acescg", view="Un-tone-mapped"):
+        lookdev.proof(["gold"], out="proofs_acescg")       # the CLI's global colour options
+
 Names are imported on first use, so ``import lookdev`` stays cheap (no Mitsuba, USD or
 even numpy until a function is called). This file lives at ``pipeline/_lookdev`` because
 the repository's top level is fixed; ``pyproject.toml`` maps it to the package ``lookdev``.
@@ -24,6 +27,7 @@ __all__ = [
     "bake",
     "blend",
     "check",
+    "colour_settings",
     "evaluate",
     "export_mitsuba",
     "export_usd",

@@ -200,7 +200,7 @@ def draw_albedo(ax: Any, hub: BlendedMaterial) -> None:
 def polar_curves(
     model: Model, params: Any, incidence_deg: Sequence[float] = (0, 30, 60, 80), n: int = 361
 ) -> tuple[np.ndarray, np.ndarray]:
-    """θo in (−90°, 90°) and the Rec.709 luminance of f for each incidence angle, (A, n).
+    """θo in (−90°, 90°) and the luminance (working space) of f for each incidence angle, (A, n).
 
     The light is at −θi in the x-z plane, so the mirror direction is θo = +θi.
     """

@@ -12,7 +12,8 @@ players are ``review.js`` (package data, copied into ``report/``) reading the pa
 
 Everything the page shows lives under the batch folder and is linked relatively, so the
 folder can be moved, zipped or served as it is. Browsers cannot show EXR, so EXR frames
-get sRGB PNG thumbnails in ``report/``; plots go there too. Images are only linked once
+get PNG thumbnails in ``report/`` through the OCIO view (:mod:`lookdev.pipeline.proof.
+tonemap`); plots go there too. Images are only linked once
 they exist on disk: the page has no broken images by construction, and the test opens it
 in headless Chromium, plays, scrubs, toggles and compares to make sure.
 """
@@ -200,7 +201,7 @@ def _fmt(v: Any) -> str:
 
 # -- images ---------------------------------------------------------------------------
 def web_image(src: Path, out_dir: Path, exposure: float = 0.0) -> Path:
-    """A browser-viewable version of ``src``: itself, or an sRGB PNG of an EXR."""
+    """A browser-viewable version of ``src``: itself, or a PNG of an EXR through the view."""
     if src.suffix.lower() in WEB_IMAGES:
         return src
     import OpenImageIO as oiio

@@ -205,12 +205,13 @@ def ibl_sphere(
     per = _per_sample(maps_at(maps or {}, nn))
 
     # Strategy 1: the BSDF's own sampler.
-    wi, weight, p_bsdf = draw(
-        model, params, np.broadcast_to(wo, (m, spp, 3)), rng.random((m, spp, 3)), **per
+    wi, weight, p_bsdf, delta = draw(
+        model, params, np.broadcast_to(wo, (m, spp, 3)), rng.random((m, spp, 3)), delta=True, **per
     )
     world = sum(wi[..., k : k + 1] * frame[k] for k in range(3))
     p_env = env.pdf(world)
-    mis = np.where(p_bsdf > 0, p_bsdf / (p_bsdf + p_env), 0.0)
+    # A delta lobe's direction cannot be drawn by the environment: weight 1.
+    mis = np.where(delta, 1.0, np.where(p_bsdf > 0, p_bsdf / (p_bsdf + p_env), 0.0))
     est = np.nan_to_num(weight * env.lookup(world) * mis[..., None]).sum(axis=1)
 
     # Strategy 2: the environment's luminance.

@@ -6,20 +6,28 @@ every ``lookdev`` command only parses its options, calls one of these and prints
 result. Bad input raises the :class:`LookdevError` family, with the one-line message the
 CLI prints.
 
-=====================  ==========================================================
-:func:`load`           a preset (name or ``.toml`` file) resolved into a material
-:func:`blend`          a layered material blended into constants and maps
-:func:`bake`           a blend's varying maps written as EXR (and a JSON sidecar)
-:func:`evaluate`       f(wi, wo) without the cosine, numpy ``(..., 3)``
-:func:`sample`         ``(wi, weight, pdf)`` drawn for ``wo`` and uniforms ``u``
-:func:`pdf`            the density with which :func:`sample` draws ``wi``
-:func:`export_usd`     UsdShade materials, and what each render context lost
-:func:`export_mitsuba` a Mitsuba 3 scene of one material
-:func:`proof`          turntable proofs, materials × IBLs, resumable; the manifest
-:func:`plot`           BRDF-explorer views of materials, side by side
-:func:`check`          the stability sweep of every reflectance model
-:data:`models`         the reflectance models by name
-=====================  ==========================================================
+=======================  ==========================================================
+:func:`load`             a preset (name or ``.toml`` file) resolved into a material
+:func:`blend`            a layered material blended into constants and maps
+:func:`bake`             a blend's varying maps written as EXR (and a JSON sidecar)
+:func:`evaluate`         f(wi, wo) without the cosine, numpy ``(..., 3)``
+:func:`sample`           ``(wi, weight, pdf)`` drawn for ``wo`` and uniforms ``u``
+:func:`pdf`              the density with which :func:`sample` draws ``wi``
+:func:`export_usd`       UsdShade materials, and what each render context lost
+:func:`export_mitsuba`   a Mitsuba 3 scene of one material
+:func:`proof`            turntable proofs, materials × IBLs, resumable; the manifest
+:func:`plot`             BRDF-explorer views of materials, side by side
+:func:`check`            the stability sweep of every reflectance model
+:data:`models`           the reflectance models by name
+:func:`colour_settings`  a ``with`` block: OCIO config, working space, display/view/look
+=======================  ==========================================================
+
+Colour is set one way, for everything inside a ``with lookdev.colour_settings(...)``
+block (what the CLI's global ``--config``, ``--working-space``, ``--display``, ``--view``
+and ``--look`` do): presets load into that working space, exports and EXRs name it, and
+proofs, plots and the review page show pixels through that view. Load a material inside
+the block it is used in: its colours were converted into the working space in force
+when it was loaded.
 
 Materials are accepted in any form a step can use: a preset name or ``.toml`` path
 (loaded through ``library``), a :class:`~lookdev.library.Material`, or where it makes
@@ -35,6 +43,8 @@ of folders or a :class:`~lookdev.library.Library`; the folders are searched befo
 Heavy dependencies (Mitsuba, usd-core, matplotlib) are imported by the functions that
 need them, never by ``import lookdev``.
 """
+
+from lookdev.materials.colour import use as colour_settings
 
 from .materials import (
     EVALUATE_RESOLUTION,
@@ -78,6 +88,7 @@ __all__ = [
     "bake",
     "blend",
     "check",
+    "colour_settings",
     "evaluate",
     "export_mitsuba",
     "export_usd",

@@ -350,13 +350,22 @@ def pdf(material: Any, wi: Any, wo: Any, uv: Any = None, *, dtype: Any = np.floa
 
 
 def sample(
-    material: Any, wo: Any, u: Any, uv: Any = None, *, dtype: Any = np.float64
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    material: Any,
+    wo: Any,
+    u: Any,
+    uv: Any = None,
+    *,
+    dtype: Any = np.float64,
+    delta: bool = False,
+) -> tuple[np.ndarray, ...]:
     """Draw a light direction for the view ``wo``: ``(wi, weight, pdf)``.
 
     ``u`` holds three uniforms in [0, 1) per element, ``(..., 3)``: the first picks the
     lobe, the other two the direction. ``weight`` is ``f · |cos θi| / pdf`` ``(..., 3)``;
     a failed sample has ``pdf`` 0 and ``weight`` 0. Other arguments as :func:`evaluate`.
+    A smooth lobe (roughness below √10⁻³: glass, water, a mirror) is a delta: its
+    samples have the probability of the lobe's choice as ``pdf``, and :func:`evaluate`
+    and :func:`pdf` leave it out; ``delta=True`` adds a fourth array marking them.
 
     >>> import numpy as np, lookdev
     >>> wi, weight, p = lookdev.sample("gold", [0, 0, 1.0], np.full((5, 3), 0.5))
@@ -367,4 +376,5 @@ def sample(
 
     lead = _lead(uv, wo=wo, u=u)
     model, params, maps = _bsdf(material, uv, lead)
-    return draw(model, params, _full(wo, lead, dtype), _full(u, lead, dtype), dtype=dtype, **maps)
+    wo, u = _full(wo, lead, dtype), _full(u, lead, dtype)
+    return draw(model, params, wo, u, dtype=dtype, delta=delta, **maps)

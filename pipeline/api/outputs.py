@@ -223,6 +223,30 @@ def _environment_file(name_or_path: PathLike | None) -> Path | None:
     return Path(ibls.resolve(str(name_or_path)))
 
 
+def _in_working_space(env: Path | None, scene: Path) -> Path | None:
+    """The environment file as the scene renders it: itself when it is in the working
+    space, else a converted copy beside the scene (``<stem>_env.exr``, written through
+    OCIO like the proofs' IBLs, :func:`lookdev.pipeline.proof.ibl.load`), so an ACEScg
+    scene is lit by ACEScg light."""
+    if env is None:
+        return None
+    import numpy as np
+
+    from lookdev.materials import colour
+    from lookdev.pipeline.proof import contact
+    from lookdev.pipeline.proof import ibl as ibls
+
+    space = ibls.file_space(env)
+    if space == colour.working_space():
+        return env
+    try:
+        pixels = colour.to_working(ibls.read_image(env), space)
+        out = scene.with_name(f"{scene.stem}_env.exr")
+        return contact.write_exr(np.clip(pixels, 0.0, None), out).resolve()
+    except LookdevError as exc:
+        raise IBLNotFoundError(exc.message, where=str(env)) from None
+
+
 FILM_MAX_SIDE = 16384
 """Largest film width or height of an exported Mitsuba scene, in pixels."""
 
@@ -279,7 +303,7 @@ def export_mitsuba(
     check_range(spp, 1, 2**20, field="--spp", error=MitsubaExportError)
     check_range(ibl_rotation, -360.0, 360.0, field="--ibl-rotation", error=MitsubaExportError)
     material = hub(material, map_resolution, library)
-    env = _environment_file(ibl)
+    env = _in_working_space(_environment_file(ibl), Path(path))
     scene = export_scene(
         material,
         path,

@@ -315,7 +315,13 @@ def peak_bytes(fn) -> int:
 
 
 def write_mask(path: Path, values: np.ndarray, fmt: Any = oiio.FLOAT) -> Path:
-    """A one-channel image written with OpenImageIO (float EXR by default)."""
+    """A one-channel image written with OpenImageIO (float EXR by default, data: ``Raw``,
+    through the one EXR writer; other formats, such as 8-bit PNG, as they are)."""
+    if Path(path).suffix.lower() == ".exr" and fmt == oiio.FLOAT:
+        from lookdev.materials.colour import RAW
+        from lookdev.pipeline.exr import write_exr
+
+        return write_exr(path, values, RAW)
     height, width = values.shape
     buf = oiio.ImageBuf(oiio.ImageSpec(width, height, 1, fmt))
     pixels = values.astype(np.float32) if values.dtype.kind == "f" else values

@@ -116,7 +116,12 @@ AGREEMENT_CASES: dict[str, tuple[tuple[str, ...] | None, DisneyParams]] = {
         None,
         DisneyParams(base_color=(0.9, 0.6, 0.3), metallic=1.0, roughness=0.3, anisotropic=0.5),
     ),
-    "metal_r0": (None, DisneyParams(base_color=(0.9, 0.6, 0.3), metallic=1.0, roughness=0.0)),
+    # Roughness 0 is a delta (no eval); 0.04 stretched by anisotropic 1 puts α_y at the
+    # glossy minimum α (10⁻³) that both models clamp to.
+    "metal_r0.04_aniso1": (
+        None,
+        DisneyParams(base_color=(0.9, 0.6, 0.3), metallic=1.0, roughness=0.04, anisotropic=1.0),
+    ),
     "metal_r1_aniso1": (
         None,
         DisneyParams(base_color=(0.9, 0.6, 0.3), metallic=1.0, roughness=1.0, anisotropic=1.0),

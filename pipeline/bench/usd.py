@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from lookdev.materials import colour
 from lookdev.materials.params import DisneyParams
 from lookdev.pipeline.export.usd.mtlx import mtlx_version
 from lookdev.pipeline.export.usd.network import (
@@ -44,6 +45,8 @@ from lookdev.pipeline.export.usd.network import (
     source_from_params,
 )
 from lookdev.pipeline.export.usd.writer import (
+    COLOUR_SPACE_API,
+    COLOUR_SPACE_ATTR,
     MTLX_CONFIG_API,
     author,
     export_usd,
@@ -138,6 +141,8 @@ def spec_paths(specs: list[MaterialSpec]) -> tuple[list[Any], list[tuple[Any, An
     for spec in specs:
         path = scope.AppendChild(prim_name(spec.name))
         prims.append(path)
+        space = path.AppendProperty(COLOUR_SPACE_ATTR)
+        attributes.append((space, types["token"], Sdf.VariabilityUniform))
         if any(net.context == "mtlx" for net in spec.networks):
             version = path.AppendProperty("config:mtlx:version")
             attributes.append((version, types["string"], Sdf.VariabilityUniform))
@@ -194,10 +199,14 @@ def author_naive(specs: list[MaterialSpec], base: Path):
         material = UsdShade.Material.Define(stage, path)
         material.GetPrim().SetCustomData({"lookdev": dict(spec.custom)})
         material.GetPrim().SetDocumentation(loss_doc(spec))
-        if any(net.context == "mtlx" for net in spec.networks):
-            material.GetPrim().SetMetadata(
-                "apiSchemas", Sdf.TokenListOp.Create(prependedItems=[MTLX_CONFIG_API])
-            )
+        schemas = [COLOUR_SPACE_API]
+        material.GetPrim().CreateAttribute(
+            COLOUR_SPACE_ATTR, types["token"], True, Sdf.VariabilityUniform
+        ).Set(colour.interop_id())
+        mtlx = any(net.context == "mtlx" for net in spec.networks)
+        schemas += [MTLX_CONFIG_API] if mtlx else []
+        material.GetPrim().SetMetadata("apiSchemas", Sdf.TokenListOp.Create(prependedItems=schemas))
+        if mtlx:
             material.GetPrim().CreateAttribute(
                 "config:mtlx:version", types["string"], True, Sdf.VariabilityUniform
             ).Set(mtlx_version())

@@ -2,7 +2,8 @@
 
 Layout for a material ``NAME`` in ``out_dir``::
 
-    NAME.json              constants, map files, resolution, decisions (the sidecar)
+    NAME.json              constants, map files, resolution, decisions (the sidecar), and
+                           the colour space of each (the working space; Raw for data)
     NAME_roughness.exr     one file per varying parameter (float32, ZIP), "Y" or "R,G,B"
     NAME_normal_map.exr    unit normals encoded (n + 1)/2, the usual normal-map encoding
 
@@ -25,9 +26,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import OpenImageIO as oiio
 
 from lookdev.library import files
+from lookdev.materials import colour
+from lookdev.pipeline.exr import colour_space_of, write_exr
 
 from .errors import BlendError
 from .result import BlendedMaterial
@@ -57,7 +59,8 @@ def bake(
             staged.created.append(out_dir)  # a failed first bake leaves no empty folder
         for i, (name, array) in enumerate(arrays.items()):
             final = out_dir / names[name]
-            _write_exr(staged.temp_for(final), _encode(name, array), blended.name, final)
+            space = colour_space_of(array, data=name.endswith("normal_map"))
+            _write_exr(staged.temp_for(final), _encode(name, array), blended.name, final, space)
             if progress is not None:
                 progress(i + 1, len(arrays) + 1)
         text = json.dumps(sidecar_dict(blended, names), indent=2)
@@ -79,6 +82,8 @@ def sidecar_dict(blended: BlendedMaterial, files: dict[str, str]) -> dict[str, A
         "representation": blended.representation,
         "resolution": [width, height],
         "orientation": "top row of each file is v = 1; UV (0, 0) is the bottom-left texel",
+        # the OCIO name of the space colour constants and RGB colour maps are in
+        "colour_space": colour.working_space(),
         "uv_extent": list(blended.uv_extent),
         "udim_tiles": list(blended.tiles),
         "textures": {k: t.model_dump(mode="json") for k, t in blended.textures.items()},
@@ -86,6 +91,7 @@ def sidecar_dict(blended: BlendedMaterial, files: dict[str, str]) -> dict[str, A
         "maps": {
             name: {
                 "file": files[name],
+                "colour_space": colour_space_of(array, data=name.endswith("normal_map")),
                 "channels": ["R", "G", "B"] if array.ndim == 3 else ["Y"],
                 "encoding": "(n + 1) / 2" if name.endswith("normal_map") else "linear",
             }
@@ -106,19 +112,11 @@ def _encode(name: str, array: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(array[::-1], dtype=np.float32)
 
 
-def _write_exr(path: Path, pixels: np.ndarray, where: str, final: Path) -> None:
-    height, width, channels = pixels.shape
-    spec = oiio.ImageSpec(width, height, channels, oiio.FLOAT)
-    spec.channelnames = ("Y",) if channels == 1 else ("R", "G", "B")
-    spec.attribute("compression", "zip")
-    out = oiio.ImageOutput.create(str(path))
-    ok = out is not None and out.open(str(path), spec) and out.write_image(pixels)
-    message = (out.geterror() if out is not None else oiio.geterror()) if not ok else ""
-    if out is not None:
-        out.close()
-    if not ok:
-        reason = files.failure_reason(path, message or "unknown error")
-        raise BlendError(f"cannot write {final}: {reason}", where=where)
+def _write_exr(path: Path, pixels: np.ndarray, where: str, final: Path, space: str) -> None:
+    try:
+        write_exr(path, pixels, space, shown=final)
+    except files.WriteError as exc:
+        raise BlendError(exc.message, where=where) from None
 
 
 def _listed_files(sidecar: Path) -> set[str]:

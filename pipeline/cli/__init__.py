@@ -20,7 +20,10 @@ from .common import quiet_numerics
 
 app = typer.Typer(
     name="lookdev",
-    help="Author, blend, export and proof Disney and Pixar materials.",
+    help="Author, blend, export and proof Disney and Pixar materials.\n\n"
+    "Colour is managed by OpenColorIO. Colour options go before the command and hold for "
+    "all of it: `lookdev --working-space acescg --view Un-tone-mapped proof gold`. "
+    "`lookdev colour spaces` and `lookdev colour views` list the names the config knows.",
     no_args_is_help=True,
     pretty_exceptions_enable=False,
     add_completion=False,
@@ -33,18 +36,82 @@ def _version(value: bool) -> None:
         raise typer.Exit()
 
 
+COLOUR_PANEL = "Colour (global: before the command, for every command)"
+GLOBAL_OPTIONS = ("--config", "--working-space", "--display", "--view", "--look")
+"""Options of :func:`_root`: a user who types one after the command is told where it goes."""
+
+
 @app.callback()
 def _root(
+    ctx: typer.Context,
     version: bool = typer.Option(
         False, "--version", callback=_version, is_eager=True, help="Print the version and exit."
     ),
+    config: str | None = typer.Option(
+        None,
+        "--config",
+        metavar="FILE|ocio://NAME",
+        help="OpenColorIO config: a .ocio file or a built-in ocio:// name. Default: $OCIO, "
+        "else OCIO's built-in ACES 2.0 studio config.",
+        rich_help_panel=COLOUR_PANEL,
+        show_default=False,
+    ),
+    working_space: str | None = typer.Option(
+        None,
+        "--working-space",
+        metavar="lin_rec709|acescg",
+        help="Scene-linear space every colour is held, rendered, exported and written in "
+        "(or any colour space of the config). Default lin_rec709.",
+        rich_help_panel=COLOUR_PANEL,
+        show_default=False,
+    ),
+    display: str | None = typer.Option(
+        None,
+        "--display",
+        help="OCIO display of the view transform for PNGs, contact sheets, plots and the "
+        "review page. Default: the config's (sRGB - Display).",
+        rich_help_panel=COLOUR_PANEL,
+        show_default=False,
+    ),
+    view: str | None = typer.Option(
+        None,
+        "--view",
+        help="OCIO view of that display. Default: the config's (ACES 2.0 - SDR 100 nits "
+        "(Rec.709): highlights roll off, hue kept); Un-tone-mapped: the sRGB curve alone.",
+        rich_help_panel=COLOUR_PANEL,
+        show_default=False,
+    ),
+    look: str | None = typer.Option(
+        None,
+        "--look",
+        help="OCIO look(s) applied before the view, comma-separated.",
+        rich_help_panel=COLOUR_PANEL,
+        show_default=False,
+    ),
 ) -> None:
-    """lookdev: material presets in, USD networks and Mitsuba proofs out."""
+    """lookdev: material presets in, USD networks and Mitsuba proofs out.
+
+    Colour is managed by OpenColorIO: colour options go before the command and hold for
+    all of it, e.g. `lookdev --working-space acescg --view Un-tone-mapped proof gold`.
+    `lookdev colour spaces` and `lookdev colour views` list the names the config knows.
+    """
+    given = {
+        "config": config,
+        "working_space": working_space,
+        "display": display,
+        "view": view,
+        "look": look,
+    }
+    if any(v is not None for v in given.values()):
+        from lookdev.materials import colour
+
+        ctx.with_resource(colour.use(**given))
 
 
 def _register() -> None:
     from . import bench, check, export, export_usd, plot, presets, proof
     from . import blend as blend_cli
+    from . import colour as colour_cli
 
     app.add_typer(bench.app, name="bench")
     app.command("check")(check.check)
@@ -56,6 +123,7 @@ def _register() -> None:
     app.add_typer(presets.app, name="presets")
     app.command("plot")(plot.plot)
     app.command("proof")(proof.proof)
+    app.add_typer(colour_cli.app, name="colour")
     _reflow_help(app)
 
 
@@ -143,6 +211,13 @@ def _usage_line(exc) -> str:
             message = f"{name}: {given} is out of range; allowed {allowed}"
         else:
             message = f"{name}: {given!r} is not a number in {allowed}"
+    elif getattr(exc, "option_name", None) in GLOBAL_OPTIONS and ctx is not None:
+        name = exc.option_name
+        command = ctx.command_path.removeprefix("lookdev").strip()
+        return (
+            f"{name} is a global colour option: put it before the command, "
+            f"as in 'lookdev {name} VALUE {command} …' (see 'lookdev --help')"
+        )
     else:
         message = exc.format_message().replace("Value error, ", "").rstrip(".")
         message = message[:1].lower() + message[1:]

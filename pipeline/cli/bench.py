@@ -14,7 +14,7 @@ from typing import Annotated, Any
 import typer
 from rich.progress import Progress
 
-from lookdev.pipeline.bench import blend, depth, error, library, noise, proof, usd
+from lookdev.pipeline.bench import blend, depth, error, glass, library, noise, proof, usd
 from lookdev.pipeline.bench import eval as eval_bench
 
 from .common import console, err_console, print_json, table
@@ -244,6 +244,70 @@ def eval_(
     )
 
 
+def glass_(
+    presets: Annotated[
+        list[str] | None,
+        typer.Argument(help="Glass presets to measure (default: every built-in glass)."),
+    ] = None,
+    ibl: Annotated[str, typer.Option("--ibl", help="Built-in IBL name or an .exr/.hdr.")] = "sky",
+    spp: Annotated[int, typer.Option("--spp", min=1, help="Samples per pixel.")] = 16,
+    reference_spp: Annotated[
+        int, typer.Option("--reference-spp", min=4, help="Samples of each reference.")
+    ] = 1024,
+    resolution: Annotated[
+        tuple[int, int], typer.Option("--resolution", help="Width and height in pixels.")
+    ] = (128, 64),
+    repeat: Annotated[
+        int, typer.Option("--repeat", min=1, help="Seeds (interleaved rounds).")
+    ] = 16,
+    as_json: JsonOut = False,
+) -> None:
+    """Cost of our glass at equal noise against Mitsuba's dielectric / roughdielectric.
+
+    Per preset: relative MSE of a SPP render against each renderer's own reference,
+    times its wall time, ours over the built-in's (target ≤ 1.5), interleaved in one run.
+
+    Example:
+
+      lookdev bench glass glass_clear glass_frosted --spp 16 --json
+    """
+    if min(resolution) < 8:
+        raise glass.BenchGlassError(
+            f"{resolution[0]} {resolution[1]}: at least 8", field="--resolution"
+        )
+    settings = glass.Settings(
+        presets=tuple(presets or glass.DEFAULT_PRESETS),
+        ibl=ibl,
+        spp=spp,
+        reference_spp=reference_spp,
+        resolution=resolution,
+        repeat=repeat,
+    )
+    with Progress(console=console, transient=True, disable=as_json) as bar:
+        task = bar.add_task("rendering", total=len(settings.presets))
+        result = glass.run(settings, progress=lambda: bar.advance(task))
+    if as_json:
+        print_json(result)
+        return
+    columns = ["preset", "built-in", "relMSE ours", "relMSE built-in", "s ours", "s built-in"]
+    columns += ["cost ratio", "target"]
+    rows = [
+        [
+            r["preset"],
+            r["builtin"],
+            f"{r['ours_relmse']:.3g}",
+            f"{r['builtin_relmse']:.3g}",
+            f"{r['ours_seconds']:.3g}",
+            f"{r['builtin_seconds']:.3g}",
+            f"{r['ratio']:.2f}",
+            "met" if r["met"] else "missed",
+        ]
+        for r in result["presets"]
+    ]
+    title = f"glass cost at equal noise ({spp} spp, {ibl}, ≤ {glass.TARGET:g}×)"
+    console.print(table(title, columns, rows))
+
+
 def library_(
     n: Annotated[int, typer.Option("--n", min=1, help="Presets in the generated library.")] = 10000,
     repeat: Annotated[int, typer.Option("--repeat", min=1, help="Runs per timing (best).")] = 5,
@@ -464,6 +528,7 @@ app.command("blend")(blend_)
 app.command("depth")(depth_)
 app.command("error")(error_)
 app.command("eval")(eval_)
+app.command("glass")(glass_)
 app.command("library")(library_)
 app.command("noise")(noise_)
 app.command("proof")(proof_)

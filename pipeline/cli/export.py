@@ -76,6 +76,11 @@ def mitsuba(
       lookdev export mitsuba gold -o gold.xml
 
       lookdev export mitsuba rusty_iron -o rust/scene.xml --ibl studio --spp 64
+
+      lookdev --working-space acescg export mitsuba gold -o gold.xml --ibl sky
+
+    The scene is in the working space (global --working-space): its maps carry its
+    chromaticities, and an IBL in another space is converted beside it (NAME_env.exr).
     """
     from lookdev.pipeline import api
 

@@ -128,6 +128,11 @@ def export_usd(
       lookdev export usd --all -o library.usda --split materials/ --mtlx library.mtlx
 
       lookdev export usd rusty_iron -o rust.usdz --package
+
+      lookdev --working-space acescg export usd gold -o gold.usda --mtlx gold.mtlx
+
+    Values and maps are in the working space (global --working-space), named on each
+    Material (ColorSpaceAPI colorSpace:name) and in the MaterialX document (colorspace).
     """
     from lookdev.pipeline import api
 

@@ -37,7 +37,8 @@ def plot(
             help="slice: f(θh, θd) at φd = 90° (left edge = specular peak, top = Fresnel "
             "peak). albedo: directional albedo per channel vs incidence angle. polar: f in "
             "the plane of incidence for θi = 0, 30, 60, 80°. sphere: a lit sphere under a "
-            "point light (and under --ibl).",
+            "point light (and under --ibl). (The OCIO display view is the global option: "
+            "`lookdev --view Un-tone-mapped plot …`.)",
         ),
     ] = View.slice,
     exposure: Annotated[
@@ -94,6 +95,7 @@ def plot(
       lookdev plot velvet --view sphere --ibl studio -o velvet.png --exposure -1
 
       lookdev plot gold --vary specular_gamma=1,1.5,2,3 -o gamma.png --exposure -3
+      lookdev --view Un-tone-mapped plot gold -o gold.png    # another OCIO view (global)
     """
     from lookdev.pipeline import api
 

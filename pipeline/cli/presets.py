@@ -28,7 +28,8 @@ app = typer.Typer(
     'A preset with `extends = "parent"` takes the parent\'s parameters and overrides some '
     "(giving `ior` drops an inherited `specular` and vice versa); description, tags, source "
     "and layers are inherited unless given. A layer naming a layered preset brings its layers, "
-    'masks multiplied. Colours are linear \\[r, g, b] or sRGB "#rrggbb".',
+    'masks multiplied. Colours are linear Rec.709 \\[r, g, b] or sRGB "#rrggbb", converted '
+    "to the working space (`lookdev --working-space`).",
     no_args_is_help=True,
 )
 

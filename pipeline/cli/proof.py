@@ -217,6 +217,11 @@ def proof(
       lookdev proof copper --spp 256 --resolution 640 320 --scheduler tcp://farm:8786
 
       lookdev proof hero.toml --geometry hero.usd --ibl studio
+
+      lookdev --working-space acescg --view Un-tone-mapped proof gold   # colour: global options
+
+    Frames render in the working space (EXRs carry its chromaticities); PNGs and contact
+    sheets show them through the OCIO view (`lookdev --help`, Colour).
     """
     from lookdev.pipeline import api
     from lookdev.pipeline.proof import batch

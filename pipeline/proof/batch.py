@@ -35,13 +35,14 @@ from collections import Counter
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Executor, Future, ProcessPoolExecutor, wait
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from lookdev.library import files
+from lookdev.materials import colour
 from lookdev.materials.errors import LookdevError
 
 from . import contact, ibl, rig, tonemap
@@ -156,6 +157,11 @@ def run_job(job: Job) -> dict[str, Any]:
     from lookdev.pipeline.variant import use_mitsuba
 
     variant = use_mitsuba()
+    with colour.use(**asdict(job.settings.colour)):
+        return _run_job(job, variant)
+
+
+def _run_job(job: Job, variant: str) -> dict[str, Any]:
     folder = job.folder
     folder.mkdir(parents=True, exist_ok=True)
     done = read_manifest(folder, job.key)

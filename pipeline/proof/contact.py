@@ -159,14 +159,12 @@ def _first_line(text: str) -> str:
     return next((line for line in str(text).splitlines() if line.strip()), "unknown error")
 
 
-def write_exr(pixels: np.ndarray, path: Path) -> Path:
-    """Write scene-linear (H, W, C) pixels as a float EXR, atomically."""
-    import OpenImageIO as oiio
+def write_exr(pixels: np.ndarray, path: Path, space: str | None = None) -> Path:
+    """Write scene-linear (H, W, C) pixels in ``space`` (default: the working space) as a
+    float EXR naming it (:func:`lookdev.pipeline.exr.write_exr`), atomically."""
+    from lookdev.pipeline.exr import write_exr as write
 
-    buf = oiio.ImageBuf(np.ascontiguousarray(pixels, dtype=np.float32))
-    return _atomic_write(
-        path, ".exr", lambda tmp: None if buf.write(tmp, oiio.FLOAT) else buf.geterror()
-    )
+    return _atomic_write(path, ".exr", lambda tmp: write(tmp, pixels, space, shown=path) and None)
 
 
 def write_png(display: np.ndarray, path: Path) -> Path:

@@ -10,6 +10,12 @@ Every IBL of a batch is brought to one resolution and its exposure is folded int
 pixels (:func:`load`): in Mitsuba 3.9 a new envmap resolution or ``scale`` compiles a new
 kernel, while new pixel values of the same size do not (DESIGN.md, Proofing).
 
+Colour: the proof renders in the working space. Built-ins are generated in linear Rec.709
+(:data:`IBL_SPACE`); a file is in the space its header names (``colorSpace``,
+``oiio:ColorSpace``), else linear Rec.709. :func:`load` converts each into the working
+space through OCIO (for ACEScg, Rec.709 → AP1 with the config's chromatic adaptation),
+so one IBL lights a material identically in either working space.
+
 Lat-long convention (Mitsuba's ``envmap``): (u, v) looks along
 ``(sin φ sin θ, cos θ, −cos φ sin θ)`` with φ = 2πu, θ = πv; row 0 is the zenith (+y)
 (see :func:`directions` for where exactly each pixel sits).
@@ -40,6 +46,7 @@ from typing import Any
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
+from lookdev.materials import colour
 from lookdev.materials.errors import LookdevError, one_line
 
 from .contact import ProofImageError, write_exr
@@ -292,6 +299,11 @@ def cache_dir() -> Path:
     return Path(root) / "ibl"
 
 
+IBL_SPACE = colour.WORKING_SPACES["lin_rec709"]
+"""Built-in IBLs are generated (and cached) in linear Rec.709; :func:`load` converts every
+IBL into the working space."""
+
+
 def _key(defn: IblDefinition, width: int) -> str:
     text = json.dumps([GENERATOR_VERSION, width, defn.model_dump(mode="json")], sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:12]
@@ -312,10 +324,34 @@ def resolve(name_or_path: str | Path, width: int = DEFAULT_WIDTH) -> Path:
     out = cache_dir() / f"{defn.name}-{width}-{_key(defn, width)}.exr"
     if not out.is_file():
         try:
-            write_exr(generate(defn, width), out)
+            write_exr(generate(defn, width), out, IBL_SPACE)
         except ProofImageError as exc:
             raise IblError(f"cannot cache the IBL ({exc.message})", where=str(out)) from None
     return out
+
+
+def file_space(path: Path) -> str:
+    """The colour space an IBL file declares (its ``colorSpace`` or OpenImageIO's
+    ``oiio:ColorSpace``, when the OCIO config knows the name), else :data:`IBL_SPACE`.
+
+    Radiance .hdr files and EXRs without such attributes are taken as linear Rec.709, as
+    HDRI sites publish them."""
+    import OpenImageIO as oiio
+
+    from .contact import quiet_c_stderr
+
+    with quiet_c_stderr():
+        inp = oiio.ImageInput.open(str(path))
+        if inp is None:
+            oiio.geterror()
+            return IBL_SPACE
+        spec = inp.spec()
+        named = [spec.get_string_attribute(a) for a in ("colorSpace", "oiio:ColorSpace")]
+        inp.close()
+    for name in named:
+        if name and colour.config().getColorSpace(name) is not None:
+            return colour.canonical(name)
+    return IBL_SPACE
 
 
 def _cached(path: Path) -> bool:
@@ -377,6 +413,8 @@ def load(
         path.unlink(missing_ok=True)
         path = resolve(name_or_path, width)
         image = read_image(path)
-    pixels = resample(image, width) * np.float32(2.0**exposure)
+    # the proof renders in the working space: an ACEScg one gets the IBL converted (OCIO)
+    pixels = colour.to_working(resample(image, width), file_space(path))
+    pixels = np.clip(pixels, 0.0, None) * np.float32(2.0**exposure)
     name = path.stem if Path(str(name_or_path)).suffix.lower() in SUFFIXES else str(name_or_path)
     return Environment(name, path, pixels)

@@ -12,9 +12,10 @@ frame is at most it, or ``max_spp`` / ``time_budget`` is reached; :mod:`.passes`
 from __future__ import annotations
 
 import json
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from typing import Any
 
+from lookdev.materials import colour
 from lookdev.materials.errors import LookdevError, check_range
 
 from . import shaderball
@@ -88,6 +89,9 @@ class Settings:
     """A mesh in the cup's place (the cached PLY of :func:`.geometry.proof_mesh`: its
     name holds the hash of the user's file, so the proof key follows the mesh)."""
     rig: str = DEFAULT_RIG  # the calibrated rig beside the material (.rig)
+    colour: colour.Settings = field(default_factory=colour.pinned)
+    """The OCIO config, working space and view the batch was asked in (workers are other
+    processes, perhaps on other machines: they enter these, not their own defaults)."""
 
     def __post_init__(self) -> None:
         if self.spp is not None:

@@ -1,18 +1,22 @@
-"""The view transform: scene-linear Rec.709 → display sRGB without hue shifts.
+"""The view transform: scene-linear working-space pixels → display code values, via OCIO.
 
-The one way lookdev shows scene-linear values: proofs and contact sheets, the plots'
-images (BRDF slices, spheres) and the review page's frame thumbnails all go through
-:func:`view`, so one material looks the same on every page.
+The one way lookdev shows scene-linear values: proofs' PNG frames and contact sheets, the
+plots' images (BRDF slices, spheres) and the review page's frame thumbnails all go through
+:func:`view`, so one material looks the same on every page. :func:`view` is the OCIO
+``DisplayViewTransform`` of the one config (:func:`lookdev.materials.colour.to_display`):
+from the working space to the display and view in force (``--display``, ``--view``,
+``--look``, or ``lookdev.colour_settings(display=, view=, look=)``), after ``exposure``.
 
-Burley 2012 §6.2: clipping highlights "introduces banding as each color channel clips at
-a different location, and forces the core to always go to white"; Disney's operator
-"preserves color values for most of the display range and rolls off the top end while
-preserving color and contrast". This one does that with a curve on the *maximum channel*:
-identity below a knee, an exponential shoulder above it that approaches 1, and every
-pixel's RGB scaled by the same ratio ``curve(m)/m``. The ratios between channels (the hue
-and saturation) are kept exactly and no channel can exceed 1, so nothing clips. The sRGB
-encoding (IEC 61966-2-1, :func:`lookdev.materials.colour.srgb_encode`) encodes the result
-for an 8-bit PNG.
+Default: the config's default display and view, for the built-in ACES 2.0 studio config
+``sRGB - Display`` / ``ACES 2.0 - SDR 100 nits (Rec.709)``. Proof frames put suns and
+soft boxes in speculars and glass caustics at tens to hundreds of times diffuse white;
+through ``Un-tone-mapped`` (the sRGB curve, no tone scale) those clip channel by channel,
+so a hot saturated highlight turns orange then white and its shape is lost (Burley 2012
+§6.2: clipping "forces the core to always go to white"). The ACES 2.0 view rolls highlights
+off, keeps their hue through the shoulder and reaches white only near the top; BRDF slice
+plots, whose peaks are thousands of times their tails, read the same way. The price is
+mid-tone contrast (18 % grey shows at code 0.35 instead of 0.46): judge albedo against the
+grey ball, or switch to ``--view Un-tone-mapped`` for values near diffuse white.
 """
 
 from __future__ import annotations
@@ -21,41 +25,24 @@ import numpy as np
 
 from lookdev.materials import colour
 
-DEFAULT_KNEE = 0.6
+__all__ = ["EXPOSURE_MAX", "view", "to_8bit"]
+
 EXPOSURE_MAX = 32.0
 """Largest |exposure| in stops (proofs, plots): 2³² scales any float32 radiance of a
 proof or a plot without overflow worth showing, and a display needs far less."""
 
 
-def shoulder(m: np.ndarray, knee: float = DEFAULT_KNEE) -> np.ndarray:
-    """Identity up to ``knee``, then ``k + (1 − k)(1 − exp(−(m − k)/(1 − k)))``.
+def view(rgb: np.ndarray, exposure: float = 0.0) -> np.ndarray:
+    """Display code values (…, 3) in [0, 1] of scene-linear ``rgb`` at ``exposure`` stops.
 
-    The shoulder meets the line with equal value and slope (C¹) and tends to 1.
-
-    >>> [round(float(v), 4) for v in shoulder(np.array([0.3, 0.6, 1.0, 100.0]))]
-    [0.3, 0.6, 0.8528, 1.0]
-    """
-    m = np.asarray(m, dtype=np.float64)
-    over = np.maximum(m - knee, 0.0) / (1.0 - knee)
-    return np.where(m <= knee, m, knee + (1.0 - knee) * -np.expm1(-over))
-
-
-def view(rgb: np.ndarray, exposure: float = 0.0, knee: float = DEFAULT_KNEE) -> np.ndarray:
-    """Display-referred sRGB (…, 3) in [0, 1] of scene-linear ``rgb`` at ``exposure`` stops.
-
-    NaN, infinite and negative values show black; the maximum channel rolls off through
-    :func:`shoulder` with every channel scaled by the same ratio; then sRGB encoding.
+    NaN, infinite and negative values show black; see
+    :func:`lookdev.materials.colour.to_display`.
 
     >>> out = view(np.array([[8.0, 4.0, 2.0]]))
-    >>> bool(out.max() <= 1.0), round(float(out[0, 0] / out[0, 1]), 3) > 1.0
+    >>> bool(out.max() <= 1.0), bool(out[0, 0] > out[0, 1] > out[0, 2])
     (True, True)
     """
-    rgb = np.nan_to_num(np.asarray(rgb, dtype=np.float64)[..., :3], nan=0.0, posinf=0.0)
-    rgb = np.maximum(rgb, 0.0) * 2.0**exposure
-    m = rgb.max(axis=-1, keepdims=True)
-    scale = np.divide(shoulder(m, knee), m, out=np.ones_like(m), where=m > 0)
-    encoded = colour.convert(rgb * scale, colour.working_space(), colour.SRGB_TEXTURE)
-    return np.clip(encoded, 0.0, 1.0)
+    return colour.to_display(np.asarray(rgb)[..., :3], exposure).astype(np.float64)
 
 
 def to_8bit(display: np.ndarray) -> np.ndarray:

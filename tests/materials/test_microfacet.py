@@ -119,7 +119,7 @@ def _dist_sample(xp, p, wo, u):
     else:
         h = mf.sample_visible_ggx(xp, xp.color(p.wo), p.ax, p.ay, u[1], u[2])
     pdf = _dist_pdf(xp, p, h, wo)
-    return h, xp.vec3(pdf, pdf, pdf), pdf
+    return h, xp.vec3(pdf, pdf, pdf), pdf, False
 
 
 def _dist_eval(xp, p, wi, wo):

@@ -268,7 +268,7 @@ def test_sample_weight_is_f_cos_over_pdf():
 
 def test_refraction_lobe_peaks_in_the_refracted_direction():
     eta = 1.5
-    p = P(roughness=0.05, clear=1.0, ior=eta, diffuse_scale=0, reflection_scale=0)
+    p = P(roughness=0.1, clear=1.0, ior=eta, diffuse_scale=0, reflection_scale=0)
     wo = _dir(math.cos(math.radians(45.0)))  # in the x-z plane, x > 0
     # Far-side directions continuing away from the viewer: β from −z towards −x.
     beta = np.radians(np.linspace(0.0, 89.5, 1791))
@@ -276,6 +276,28 @@ def test_refraction_lobe_peaks_in_the_refracted_direction():
     peak = beta[np.argmax(pixar.eval(p, wi, wo)[:, 0])]
     snell = math.asin(math.sin(math.radians(45.0)) / eta)  # sin θt = sin θo / η
     assert abs(peak - snell) < math.radians(0.1)
+
+
+def test_a_closed_reflection_cone_is_a_delta_along_the_mirror_and_the_refraction():
+    # roughness 0.05: cone 0.5°, the old floor: now the delta limit of the lobe (issue 16).
+    eta = 1.5
+    p = P(surface_color=1.0, roughness=0.05, clear=1.0, ior=eta)
+    assert pixar.MODEL.prepare(XP, p)["delta"] == ("reflection", "reflection_t")
+    wo = _dir(math.cos(math.radians(45.0)))
+    u = np.random.default_rng(2).random((4096, 3))
+    wi, weight, pdf, delta = pixar.sample(p, wo, u, delta=True)
+    ok = pdf > 0
+    refl = ok & delta & (wi[:, 2] > 0)
+    trans = ok & delta & (wi[:, 2] < 0)
+    assert refl.any() and trans.any()
+    np.testing.assert_allclose(wi[refl], np.broadcast_to(wo * [-1, -1, 1], wi[refl].shape))
+    snell = math.sin(math.radians(45.0)) / eta
+    np.testing.assert_allclose(np.hypot(wi[trans, 0], wi[trans, 1]), snell, rtol=1e-12)
+    # The delta is the lobe's limit: the albedo does not jump at the cone's floor.
+    u = np.random.default_rng(3).random((400_000, 3))
+    closed = pixar.sample(p, wo, u)[1].mean(axis=0)
+    open_ = pixar.sample(p.replace(roughness=0.06), wo, u)[1].mean(axis=0)  # 0.6°, glossy
+    np.testing.assert_allclose(closed, open_, rtol=0.01)
 
 
 def test_two_sided():
@@ -357,7 +379,7 @@ def test_drjit_backend_agrees_with_numpy():
     np.testing.assert_allclose(got, pixar.eval(p, wi, wo).T, rtol=2e-4, atol=1e-6)
     got_pdf = np.array(pixar.MODEL.pdf(xp, prepared, vi, vo))
     np.testing.assert_allclose(got_pdf, pixar.pdf(p, wi, wo), rtol=2e-4, atol=1e-6)
-    d_wi, _, d_pdf = pixar.MODEL.sample(xp, prepared, vo, mi.Vector3f(u.T))
+    d_wi, _, d_pdf, _ = pixar.MODEL.sample(xp, prepared, vo, mi.Vector3f(u.T))
     n_wi, _, n_pdf = pixar.sample(p, wo, u)
     np.testing.assert_allclose(np.array(d_wi).T, n_wi, atol=1e-4)
     np.testing.assert_allclose(np.array(d_pdf), n_pdf, rtol=1e-3, atol=1e-5)
@@ -416,5 +438,5 @@ def test_drjit_constant_roughness_zero():
     got = np.array(pixar.MODEL.eval(xp, prepared, mi.Vector3f(wi.T), mi.Vector3f(*map(float, wo))))
     np.testing.assert_allclose(got, pixar.eval(p, wi, wo).T, rtol=1e-3, atol=1e-6)
     u = mi.Vector3f(np.random.default_rng(8).random((3, 64)))
-    _, weight, pdf = pixar.MODEL.sample(xp, prepared, mi.Vector3f(*map(float, wo)), u)
+    _, weight, pdf, _ = pixar.MODEL.sample(xp, prepared, mi.Vector3f(*map(float, wo)), u)
     assert np.all(np.isfinite(np.array(weight))) and np.all(np.isfinite(np.array(pdf)))

@@ -22,6 +22,14 @@ Conventions at the boundary, and only here (DESIGN.md, Conventions):
   : 1`` in ``sample``), and like it the refracting component is flagged ``NonSymmetric``.
   Reflection, thin sheets and η = 1 do not refract and are symmetric in both modes.
 
+Delta lobes. A model may sample some lobes as Dirac deltas (smooth glass, mirrors:
+``prepared["delta"]``, :mod:`lookdev.materials.disney_interface`). They form their own
+components, flagged ``DeltaReflection`` / ``DeltaTransmission`` (a BSDF with no other
+lobe has no ``Smooth`` flag, so the path tracer samples no light at its vertices);
+``eval`` and ``pdf`` leave them out, as the model does, and a sample of one reports that
+type and component (the model's ``delta`` mask), its pdf the probability of its choice.
+A context that asks for the smooth components only gets such samples with weight 0.
+
 Parameters arrive as Mitsuba properties, one per schema field: a constant (float, bool,
 string, ``rgb``) or a texture (``bitmap`` …). Constants are handed to ``prepare`` as Python
 values, so a lobe whose weight is a constant zero is pruned while the kernel is traced;
@@ -66,13 +74,28 @@ def lobes_of(prepared: Any) -> tuple[str, ...]:
     return tuple(lobes)
 
 
-def lobe_kinds(lobes: Iterable[str], model: Model) -> set[str]:
+def lobe_kinds(lobes: Iterable[str], model: Model, delta: Iterable[str] = ()) -> set[str]:
     """Mitsuba flag names (``GlossyReflection`` …) of the given lobes of ``model``,
-    as the registry describes them (:class:`lookdev.materials.bsdf.Lobe`)."""
+    as the registry describes them (:class:`lookdev.materials.bsdf.Lobe`); the lobes in
+    ``delta`` (a prepared material's smooth lobes) are ``DeltaReflection`` /
+    ``DeltaTransmission`` instead."""
+    delta = set(delta)
     try:
-        return {model.lobe(name).mitsuba_flag for name in lobes}
+        return {_kind(model.lobe(name), name in delta) for name in lobes}
     except KeyError as exc:
         raise MitsubaExportError(exc.args[0]) from None
+
+
+def _kind(lobe: Any, delta: bool) -> str:
+    if not delta:
+        return lobe.mitsuba_flag
+    return "Delta" + ("Transmission" if lobe.transmits else "Reflection")
+
+
+def delta_lobes(prepared: Any) -> tuple[str, ...]:
+    """The kept lobes a prepared material samples as deltas (``prepared["delta"]``)."""
+    delta = prepared.get("delta", ()) if isinstance(prepared, dict) else ()
+    return tuple(k for k in lobes_of(prepared) if k in delta)
 
 
 def plugin_name(model: Model) -> str:
@@ -156,12 +179,20 @@ def _plugin_class(variant: str) -> type:
             )
             self.lobes = lobes_of(prepared)
             """The lobes this instance traces (the model's live lobes, or ``only_lobes``)."""
-            kinds = lobe_kinds(self.lobes, self.model)
-            reflect = [getattr(flag, k) for k in sorted(kinds) if "Reflection" in k]
-            transmit = [getattr(flag, k) for k in sorted(kinds) if "Transmission" in k]
-            self.components = [_union(reflect, flag), _union(transmit, flag)]
-            # Mitsuba numbers only the components that exist: reflection first.
-            self.component_index = (0, 1 if reflect else 0)
+            kinds = sorted(lobe_kinds(self.lobes, self.model, delta_lobes(prepared)))
+            # Components: reflection and transmission with a density, then the deltas.
+            groups = [
+                [k for k in kinds if side in k and ("Delta" in k) == delta]
+                for delta in (False, True)
+                for side in ("Reflection", "Transmission")
+            ]
+            self.components = [_union([getattr(flag, k) for k in g], flag) for g in groups]
+            # Mitsuba numbers only the components that exist, in this order.
+            present = [i for i, c in enumerate(self.components) if c]
+            self.component_index = tuple(
+                present.index(i) if c else 0 for i, c in enumerate(self.components)
+            )
+            transmit = self.components[1] or self.components[3]
             extra = flag.FrontSide | (flag.BackSide if transmit else flag.Empty)
             if self.textures:
                 extra |= flag.SpatiallyVarying
@@ -169,7 +200,8 @@ def _plugin_class(variant: str) -> type:
                 extra |= flag.Anisotropic
             self.refracts = self._refracts(prepared)
             """Transmission bends the path (η ≠ 1 through a solid): non-symmetric."""
-            non_symmetric = [flag.Empty, flag.NonSymmetric if self.refracts else flag.Empty]
+            ns = flag.NonSymmetric if self.refracts else flag.Empty
+            non_symmetric = [flag.Empty, ns, flag.Empty, ns]
             self.m_components = [
                 c | extra | ns
                 for c, ns in zip(self.components, non_symmetric, strict=True)
@@ -269,21 +301,35 @@ def _plugin_class(variant: str) -> type:
         def sample(self, ctx, si, sample1, sample2, active=True):
             prepared = self._prepare(si, active)
             u = self.xp.vec3(sample1, sample2.x, sample2.y)
-            wi, weight, pdf = self.model.sample(self.xp, prepared, si.wi, u)
+            wi, weight, pdf, delta = self.model.sample(self.xp, prepared, si.wi, u)
             bs = dr.zeros(mi.BSDFSample3f)
             bs.wo = mi.Vector3f(wi)
             bs.pdf = mi.Float(pdf)
             reflected = si.wi.z * bs.wo.z > 0
             bs.eta = self._eta(prepared, si.wi.z, reflected)
-            bs.sampled_component = dr.select(
-                reflected, mi.UInt32(self.component_index[0]), mi.UInt32(self.component_index[1])
-            )
-            bs.sampled_type = dr.select(
-                reflected,
-                mi.UInt32(_leading(self.components[0], flag)),
-                mi.UInt32(_leading(self.components[1], flag)),
-            )
-            ok = active & (bs.pdf > 0) & self._hemisphere_mask(ctx, si.wi.z, bs.wo.z)
+            delta = mi.Bool(delta) if not isinstance(delta, bool) else delta
+            # Component i: 0/1 reflection/transmission with a density, 2/3 the deltas.
+            pick = [(reflected, 0, 1), (reflected, 2, 3)]
+            index, kind, enabled = [], [], []
+            for cond, r, t in pick:
+                index.append(dr.select(cond, self.component_index[r], self.component_index[t]))
+                kind.append(
+                    dr.select(
+                        cond,
+                        _leading(self.components[r], flag),
+                        _leading(self.components[t], flag),
+                    )
+                )
+                enabled.append(
+                    dr.select(
+                        cond,
+                        _is_enabled(ctx, self.components[r], self.component_index[r]),
+                        _is_enabled(ctx, self.components[t], self.component_index[t]),
+                    )
+                )
+            bs.sampled_component = mi.UInt32(dr.select(delta, index[1], index[0]))
+            bs.sampled_type = mi.UInt32(dr.select(delta, kind[1], kind[0]))
+            ok = active & (bs.pdf > 0) & dr.select(delta, enabled[1], enabled[0])
             if self.refracts and ctx.mode == mi.TransportMode.Importance:
                 weight = self.xp.Array3(weight) * (bs.eta * bs.eta)  # see _transport
             value = dr.select(ok, self._scaled(mi.Spectrum(weight)), 0.0)
@@ -294,7 +340,8 @@ def _plugin_class(variant: str) -> type:
             """Whether a transmitted path changes medium (see :meth:`_eta`)."""
             eta = prepared.get("eta") if isinstance(prepared, dict) else None
             solid = not getattr(self.params, "thin", False)
-            glossy_t = bool(self.components[1] & flag.GlossyTransmission)
+            bends = flag.GlossyTransmission | flag.DeltaTransmission
+            glossy_t = bool((self.components[1] | self.components[3]) & bends)
             if eta is None or not solid or not glossy_t:
                 return False
             try:
@@ -321,7 +368,8 @@ def _plugin_class(variant: str) -> type:
             """
             eta = prepared.get("eta") if isinstance(prepared, dict) else None
             solid = not getattr(self.params, "thin", False)
-            if eta is None or not solid or not self.components[1] & flag.GlossyTransmission:
+            bends = flag.GlossyTransmission | flag.DeltaTransmission
+            if eta is None or not solid or not (self.components[1] | self.components[3]) & bends:
                 return mi.Float(1.0)
             crossing = dr.select(cos_view > 0, eta, 1.0 / eta)
             return dr.select(reflected, 1.0, crossing)
@@ -345,6 +393,9 @@ def _is_enabled(ctx: Any, component: int, index: int) -> bool:
 
 def _leading(component: Any, flag: Any) -> int:
     """The sampled type reported for a component: glossy if it has a glossy lobe."""
+    for kind in (flag.DeltaReflection, flag.DeltaTransmission):
+        if component & kind:
+            return int(kind)
     for kind in (flag.GlossyReflection, flag.GlossyTransmission):
         if component & kind:
             return int(kind)

@@ -23,9 +23,12 @@ import numpy as np
 
 from lookdev.library import files
 from lookdev.materials import registry
+from lookdev.materials.microfacet import is_delta
 from lookdev.materials.pixar import GRAZING
 from lookdev.materials.registry import is_color_field
+from lookdev.pipeline import exr
 from lookdev.pipeline.blend.result import LOBE_WEIGHTS, BlendedMaterial, as_hub
+from lookdev.pipeline.exr import colour_space_of
 
 from .depth import max_depth_for
 from .normals import with_normals
@@ -108,8 +111,10 @@ def principled_equivalent(hub: BlendedMaterial) -> dict[str, Any] | None:
     specular is Schlick's Fresnel on the base colour with the anisotropic GGX and Smith G
     of the 2014 addendum, which ``principled`` implements the same way (DESIGN.md, Traps);
     tests/test_mitsuba_scene.py measures the two equal to float32 precision over roughness
-    0..1 and anisotropic 0..1. Tinted and dielectric speculars, clearcoat (Mitsuba leaves
-    out its 1/(4 cos θl cos θv)) and transmission differ on purpose and keep our plugin.
+    0.04..1 and anisotropic 0..1. Tinted and dielectric speculars, clearcoat (Mitsuba leaves
+    out its 1/(4 cos θl cos θv)) and transmission differ on purpose and keep our plugin,
+    and so does a smooth metal (roughness below √10⁻³): a delta mirror in our model
+    (:func:`lookdev.materials.microfacet.is_delta`), a glossy α = 10⁻³ lobe in principled.
     """
     c = hub.constants
     if hub.bsdf_model.name != "disney" or hub.maps or c.get("metallic") != 1.0:
@@ -118,6 +123,8 @@ def principled_equivalent(hub: BlendedMaterial) -> dict[str, Any] | None:
         return None
     if getattr(hub.params, "specular_gamma", 2.0) != 2.0:
         return None  # ``principled`` is GGX only (γ = 2): the plugin renders any GTR γ
+    if is_delta(float(hub.params.roughness), float(hub.params.anisotropic)):
+        return None  # a smooth metal is a delta in our model, principled is glossy (α 10⁻³)
     out: dict[str, Any] = {"type": "principled", "metallic": 1.0}
     out["base_color"] = {"type": "rgb", "value": list(hub.params.base_color)}
     for key in ("roughness", "anisotropic"):
@@ -156,7 +163,7 @@ def bsdf_dict(
 
     def normal_texture(normals: np.ndarray, name: str) -> dict[str, Any]:
         encoded = _encode_normals(np.asarray(normals, dtype=np.float32))
-        return _tiled(_bitmap(encoded, True, hub.name, name, texture_dir), hub)
+        return _tiled(_bitmap(encoded, True, hub.name, name, texture_dir, data_map=True), hub)
 
     frames = (hub.normal_map, hub.specular_normal_map)
     return with_bump(hub, with_normals(out, model, lobes, frames, normal_texture), texture_dir)
@@ -224,6 +231,8 @@ def _bitmap(
     name: str,
     key: str,
     texture_dir: str | Path | None,
+    *,
+    data_map: bool = False,
 ) -> dict[str, Any]:
     """A ``bitmap`` of a hub map (see :func:`_tiled` for maps over UDIM tiles)."""
     import mitsuba as mi
@@ -242,7 +251,9 @@ def _bitmap(
     if texture_dir is None:
         tex["data"] = mi.TensorXf(np.ascontiguousarray(data))
     else:
-        tex["filename"] = str(write_exr(data, Path(texture_dir) / f"{_slug(name)}_{key}.exr"))
+        space = colour_space_of(data, data=data_map or not color)
+        path = Path(texture_dir) / f"{_slug(name)}_{key}.exr"
+        tex["filename"] = str(write_exr(data, path, space))
     return tex
 
 
@@ -250,26 +261,20 @@ def _slug(name: str) -> str:
     return "".join(ch if ch.isalnum() or ch in "-_" else "_" for ch in name) or "material"
 
 
-def write_exr(data: np.ndarray, path: Path) -> Path:
-    """Write a float32 (H, W, C) array as a scanline EXR, row 0 first, atomically."""
-    import OpenImageIO as oiio
-
+def write_exr(data: np.ndarray, path: Path, space: str | None = None) -> Path:
+    """Write a float32 (H, W, C) array in ``space`` as an EXR, row 0 first, atomically."""
     path = Path(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
+        with files.atomic_path(path) as tmp:
+            exr.write_exr(tmp, data, space, shown=path)
     except OSError as exc:
         raise MitsubaExportError(
             f"cannot write textures: {exc.strerror}", where=str(path)
         ) from None
-    spec = oiio.ImageSpec(data.shape[1], data.shape[0], data.shape[2], oiio.FLOAT)
-    with files.atomic_path(path) as tmp:
-        out = oiio.ImageOutput.create(str(tmp))
-        ok = out is not None and out.open(str(tmp), spec) and out.write_image(data)
-        if out is not None:
-            out.close()
-        if not ok:
-            reason = files.failure_reason(tmp, oiio.geterror())
-            raise MitsubaExportError(f"cannot write: {reason}", where=str(path))
+    except files.WriteError as exc:
+        reason = exc.message.removeprefix(f"cannot write {path}: ")
+        raise MitsubaExportError(f"cannot write: {reason}", where=str(path)) from None
     return path
 
 

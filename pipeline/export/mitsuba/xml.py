@@ -114,9 +114,21 @@ def to_xml(tree: Mapping[str, Any], *, relative_to: Path | None = None) -> str:
     body = ET.tostring(root, encoding="unicode")
     if _has_envmap(tree):
         body = f"<!--{orientation_note()}-->\n{body}"
+    body = f"<!--{colour_note()}-->\n{body}"
     if uses_our_plugins(tree):
         body = f"<!--{LOAD_HINT}-->\n{body}"
     return body + "\n"
+
+
+def colour_note() -> str:
+    """The comment naming the space every RGB value and map of the scene is in (Mitsuba's
+    RGB variants do not convert: the scene renders in the working space)."""
+    from lookdev.materials import colour
+
+    return (
+        f" lookdev colour: RGB values, maps and the environment are linear "
+        f"{colour.working_space()} (OCIO config {colour.settings().config_name}) "
+    )
 
 
 def orientation_note() -> str:

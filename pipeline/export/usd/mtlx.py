@@ -291,6 +291,9 @@ def document(specs: list[MaterialSpec], relative_to: Path):
     import MaterialX as mx
 
     doc = mx.createDocument()
+    # the document's colour space: every value and image in it is in the working space
+    # unless an input says otherwise (MaterialX names: lin_rec709, acescg)
+    doc.setColorSpace(mtlx_color_space(colour.working_space()))
     for spec in specs:
         for net in spec.networks:
             if net.context == "mtlx":

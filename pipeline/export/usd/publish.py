@@ -26,6 +26,7 @@ import numpy as np
 
 from lookdev.library import files
 from lookdev.materials import colour
+from lookdev.pipeline.exr import colour_space_of, name_colour_space
 
 from .network import ExportError, Image, MaterialSpec
 
@@ -110,12 +111,12 @@ def write_texture(target: Path, image: Image, shown: Path | None = None) -> None
         raise ExportError(f"cannot read {image.origin}: {buf.geterror()}", where=str(shown))
     spec = buf.specmod()
     spec.attribute("DateTime", FIXED_DATETIME)
-    if (
-        spec.nchannels == 3
-        and image.colorspace is not None
-        and not colour.is_data(image.colorspace)
-    ):
-        spec.attribute("oiio:ColorSpace", colour.canonical(image.colorspace))
+    # the one place EXR colour attributes are set (pipeline/exr.py): chromaticities too
+    # (no colour space given: written by lookdev, RGB colour in the working space, else data)
+    space = image.colorspace
+    if space is None or spec.nchannels not in (3, 4):
+        space = colour_space_of(np.zeros((1, 1, spec.nchannels)))
+    name_colour_space(spec, space)
     config = oiio.ImageSpec()
     config.format = oiio.HALF
     config.tile_width = config.tile_height = TILE

@@ -17,6 +17,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from lookdev.materials.colour import luminance
 from lookdev.materials.errors import LookdevError
 from lookdev.materials.fresnel import SPECULAR_F0_SCALE, ior_to_specular, specular_to_ior
@@ -81,6 +83,39 @@ def read_networks(stage) -> list[MaterialSpec]:
             MaterialSpec(_custom(prim).get("preset", prim.GetName()), networks, _custom(prim))
         )
     return specs
+
+
+def colour_spaces(stage) -> dict[str, str]:
+    """Each material's colour space (UsdColorSpaceAPI, on it or an ancestor; "" if none),
+    by the name :func:`read_networks` gives it."""
+    from pxr import Usd, UsdShade
+
+    return {
+        _custom(prim).get("preset", prim.GetName()): Usd.ColorSpaceAPI.ComputeColorSpaceName(
+            prim, None
+        )
+        or ""
+        for prim in stage.Traverse(Usd.TraverseInstanceProxies())
+        if prim.IsA(UsdShade.Material)
+    }
+
+
+def _to_preset_space(values: dict[str, Any], space: str, result: Imported) -> None:
+    """Colours read in the stage's colour space → linear Rec.709, the space a preset's
+    ``[r, g, b]`` is written in (:data:`~lookdev.materials.colour.PRESET_LINEAR`)."""
+    from lookdev.materials import colour
+
+    if not space:
+        return
+    try:
+        source = colour.canonical(space)
+    except colour.ColourError:
+        result.loss.append(f"colour space {space!r} is unknown to the OCIO config: kept as is")
+        return
+    for key, value in values.items():
+        if isinstance(value, tuple) and len(value) == 3:
+            converted = colour.convert(value, source, colour.PRESET_LINEAR)
+            values[key] = tuple(float(v) for v in np.clip(converted, 0.0, None))
 
 
 def _custom(prim) -> dict[str, Any]:
@@ -172,9 +207,10 @@ def import_usd(path: Path, skipped: list[str] | None = None) -> list[Imported]:
     except Tf.ErrorException:
         raise ExportError("USD cannot open it", where=str(path)) from None
     found, left = [], []
+    spaces = colour_spaces(stage)
     for spec in read_networks(stage):
         try:
-            imported = _imported(spec)
+            imported = _imported(spec, spaces.get(spec.name, ""))
         except LookdevError as exc:
             raise ExportError(
                 exc.message, where=f"{path}: material {spec.name!r}", field=exc.field
@@ -194,7 +230,7 @@ def import_usd(path: Path, skipped: list[str] | None = None) -> list[Imported]:
     return found
 
 
-def _imported(spec: MaterialSpec) -> Imported | None:
+def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
     model = spec.custom.get("model", "disney")
     values = dict(DEFAULTS[model])
     result = Imported(spec.name, model, {})
@@ -219,6 +255,7 @@ def _imported(spec: MaterialSpec) -> Imported | None:
         if "roughness" in spec.custom:
             values["roughness"] = float(spec.custom["roughness"])
     spelling = spec.custom.get("spelling") or "ior"
+    _to_preset_space(values, space, result)
     result.params = _preset_params(values, model, spelling)
     return result
 

@@ -18,6 +18,7 @@ import numpy as np
 
 from lookdev.library import files
 from lookdev.materials import colour
+from lookdev.pipeline.exr import colour_space_of, write_exr
 
 from .names import Slot
 from .network import ExportError, Image
@@ -122,22 +123,13 @@ def converted(image: Image, slot: Slot) -> Image:
     return Image(path, out.astype(np.float32), write=True, fallback=fallback)
 
 
-def write_image(path: Path, pixels: np.ndarray, shown: Path | None = None) -> None:
-    """Write float32 ``pixels`` ((H, W) or (H, W, C), row 0 = top) as an EXR."""
-    import OpenImageIO as oiio
-
-    px = np.ascontiguousarray(pixels, dtype=np.float32)
-    channels = 1 if px.ndim == 2 else px.shape[2]
-    spec = oiio.ImageSpec(px.shape[1], px.shape[0], channels, oiio.FLOAT)
-    out = oiio.ImageOutput.create(str(path))
-    if out is None or not out.open(str(path), spec):
-        raise ExportError(
-            f"cannot write {shown or path}: {files.failure_reason(path, oiio.geterror())}"
-        )
+def write_image(
+    path: Path, pixels: np.ndarray, shown: Path | None = None, *, data: bool = False
+) -> None:
+    """Write float32 ``pixels`` ((H, W) or (H, W, C), row 0 = top) as a scanline EXR
+    naming its colour space (:func:`lookdev.pipeline.exr.write_exr`): the working space
+    for RGB colour, ``Raw`` for data (``data``, or one channel)."""
     try:
-        ok = out.write_image(px)
-        message = "" if ok else out.geterror()
-    finally:
-        out.close()
-    if not ok:
-        raise ExportError(f"cannot write {shown or path}: {files.failure_reason(path, message)}")
+        write_exr(path, pixels, colour_space_of(pixels, data=data), shown=shown or path)
+    except files.WriteError as exc:
+        raise ExportError(exc.message) from None

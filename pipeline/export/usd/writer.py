@@ -17,6 +17,7 @@ from typing import Any
 from pxr import Gf, Sdf
 
 from lookdev.library import files
+from lookdev.materials import colour
 
 from . import mtlx, preview, publish, ri
 from .names import PREVIEW_OPACITY
@@ -34,6 +35,8 @@ from .network import (
 
 BUILDERS = {"universal": preview.build, "mtlx": mtlx.build, "ri": ri.build}
 MTLX_CONFIG_API = "MaterialXConfigAPI"
+COLOUR_SPACE_API = "ColorSpaceAPI"
+COLOUR_SPACE_ATTR = "colorSpace:name"
 SWITCH = "Look"  # the prim whose variant set switches between the exported presets
 ROOT = "Materials"  # the default prim: every material, the switch, preview geometry
 USD_SUFFIXES = (".usda", ".usdc", ".usd")
@@ -116,6 +119,11 @@ def new_layer(default_prim: str = "Materials"):
     layer.defaultPrim = default_prim
     layer.pseudoRoot.SetInfo("upAxis", "Y")
     layer.pseudoRoot.SetInfo("metersPerUnit", 1.0)
+    # The stage's colour management system (UsdStage colorManagementSystem). The config is
+    # recorded as data, not as colorConfiguration: that is an asset path, which would make
+    # a built-in ocio:// config (or a file on this machine) an unresolvable dependency.
+    layer.pseudoRoot.SetInfo("colorManagementSystem", "OpenColorIO")
+    layer.customLayerData = {"lookdev": {"ocioConfig": colour.settings().config_name}}
     return layer
 
 
@@ -143,13 +151,20 @@ def _author_material(layer, scope, spec: MaterialSpec, base: Path, types: dict[s
     prim.customData = {"lookdev": dict(spec.custom)}
     prim.documentation = loss_doc(spec)
     path = prim.path
+    # Every colour value and map of the material is in the working space: UsdColorSpaceAPI
+    # names it by USD's canonical name (lin_rec709_scene, lin_ap1_scene) for the material
+    # and everything under it; textures that differ say so on their own inputs.
+    schemas = [COLOUR_SPACE_API]
+    space = path.AppendProperty(COLOUR_SPACE_ATTR)
+    _attribute(layer, space, types["token"], Sdf.VariabilityUniform).default = colour.interop_id()
     if any(net.context == "mtlx" for net in spec.networks):
         # UsdMtlx reads the MaterialX version of the networks from MaterialXConfigAPI.
-        prim.SetInfo("apiSchemas", Sdf.TokenListOp.Create(prependedItems=[MTLX_CONFIG_API]))
+        schemas.append(MTLX_CONFIG_API)
         version = path.AppendProperty("config:mtlx:version")
         _attribute(
             layer, version, types["string"], Sdf.VariabilityUniform
         ).default = mtlx.mtlx_version()
+    prim.SetInfo("apiSchemas", Sdf.TokenListOp.Create(prependedItems=schemas))
     for name, (kind, value) in spec.interface().items():
         attr = _attribute(layer, path.AppendProperty(f"inputs:{name}"), types[kind])
         attr.default = usd_value(kind, value, base)

@@ -38,7 +38,7 @@ def _sample(xp, prepared, wo, u):
     wi = xp.vec3(r * xp.cos(phi), r * xp.sin(phi), xp.safe_sqrt(1.0 - u[1]))
     pdf = _pdf(xp, prepared, wi, wo)
     f = _eval(xp, prepared, wi, wo)
-    return wi, f * xp.select(pdf > 0, wi[2] / xp.maximum(pdf, 1e-30), 0.0), pdf
+    return wi, f * xp.select(pdf > 0, wi[2] / xp.maximum(pdf, 1e-30), 0.0), pdf, False
 
 
 MODEL = Model("broken", LambertParams, _prepare, _eval, _pdf, _sample)

@@ -56,8 +56,8 @@ def batch(tmp_path: Path) -> Path:
                         "path": f,
                         "kind": "element",
                         "angle": 120.0 * k,
-                        "seconds": 0.5,
-                        "noise_relative": 0.01 * (k + 1),
+                        "time_s": 0.5,
+                        "noise": 0.01 * (k + 1),
                     }
                     for k, f in enumerate(frames)
                 ]
@@ -95,7 +95,7 @@ def test_time_noise_table_has_every_scalar_of_the_manifests(batch):
     assert rows[0][columns.index("noise.relative_mse")] == "0.0123"
     # per-frame numbers are summarised: times summed, noise averaged
     gold = rows[2]
-    assert gold[columns.index("frames.seconds (sum)")] == "1.5"
+    assert gold[columns.index("frames.time_s (sum)")] == "1.5"
     assert gold[columns.index("frames.noise (mean)")] == "0.02"
     assert gold[columns.index("frames")] == "3"
 

@@ -48,9 +48,12 @@ def test_sidecar_holds_constants_and_map_files(tmp_path):
     assert doc["constants"]["clearcoat"] == 0.0 and doc["constants"]["thin"] is False
     assert doc["maps"]["roughness"] == {
         "file": "worn_roughness.exr",
+        "colour_space": "Raw",
         "channels": ["Y"],
         "encoding": "linear",
     }
+    assert doc["colour_space"] == "Linear Rec.709 (sRGB)"  # of the constants and colour maps
+    assert doc["maps"]["base_color"]["colour_space"] == "Linear Rec.709 (sRGB)"
     assert set(doc["constants"]).isdisjoint(doc["maps"])
     assert [entry["kept"] for entry in doc["layers"]] == [True, True]
 
@@ -86,11 +89,11 @@ def test_a_failing_write_leaves_nothing_half_written(tmp_path, monkeypatch):
     real = bake_module._write_exr
     calls = []
 
-    def flaky(path, pixels, where, final):
+    def flaky(path, pixels, where, final, space):
         calls.append(path)
         if len(calls) == 3:
             raise BlendError("disk full", where=where)
-        real(path, pixels, where, final)
+        real(path, pixels, where, final, space)
 
     monkeypatch.setattr(bake_module, "_write_exr", flaky)
     with pytest.raises(BlendError, match="disk full"):

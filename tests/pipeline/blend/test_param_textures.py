@@ -162,3 +162,27 @@ def test_a_textured_sheen_votes_on_the_sheen_model(tmp_path):
     velvet = disney("velvet", sheen=1.0, sheen_model="disney")
     with pytest.raises(BlendError, match="sheen_model"):
         blend(layered(layer(cloth), layer(velvet, NoiseMask())), 4)
+
+
+def test_a_plot_at_a_uv_draws_the_constant_material_of_that_texel(tmp_path):
+    """`lookdev plot --uv U V`: the slice drawn is the constant preset's slice at that texel."""
+    from lookdev.pipeline.analysis import plots
+
+    rough = np.linspace(0.1, 0.9, 16, dtype=np.float32).reshape(4, 4)
+    write_image(tmp_path / "r.exr", rough)
+    hub = blend(textured("t", roughness=TextureInput(texture=str(tmp_path / "r.exr"))), 4)
+    for row, col in [(0, 0), (2, 1), (3, 3)]:
+        uv = ((col + 0.5) / 4, (row + 0.5) / 4)
+        at = plots.at_uv(hub, uv)
+        assert not at.maps and at.params.roughness == pytest.approx(rough[::-1][row, col])
+        constant = DisneyParams(metallic=0.3, roughness=float(rough[::-1][row, col]))
+        _, _, f_uv = plots.brdf_slice(at.bsdf_model, at.centre_params, 16)
+        _, _, f_const = plots.brdf_slice(at.bsdf_model, constant, 16)
+        np.testing.assert_allclose(f_uv, f_const, rtol=1e-5, atol=1e-7)
+    out = lookdev.plot(
+        textured("t", roughness=TextureInput(texture=str(tmp_path / "r.exr"))),
+        tmp_path / "p.png",
+        uv=(0.9, 0.9),
+        resolution=16,
+    )
+    assert out.materials == ["t @ uv (0.9, 0.9)"] and (tmp_path / "p.png").stat().st_size > 0

@@ -299,7 +299,7 @@ def test_drjit_backend_agrees_with_numpy_on_composited_weights(mi):
     np.testing.assert_allclose(
         got_pdf, density(LAYERED_MODEL, w, wi, wo, **nmaps), rtol=2e-4, atol=1e-6
     )
-    d_wi, _, d_pdf = LAYERED_MODEL.sample(xp, prepared, vo, mi.Vector3f(u.T))
+    d_wi, _, d_pdf, _ = LAYERED_MODEL.sample(xp, prepared, vo, mi.Vector3f(u.T))
     n_wi, _, n_pdf = draw(LAYERED_MODEL, w, wo, u, **nmaps)
     np.testing.assert_allclose(np.array(d_wi).T, n_wi, atol=1e-4)
     np.testing.assert_allclose(np.array(d_pdf), n_pdf, rtol=1e-3, atol=1e-5)

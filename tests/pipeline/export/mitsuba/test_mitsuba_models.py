@@ -28,7 +28,8 @@ CASES = [
     ("sheen", {"roughness": 0.0}, "sheen-r0", None),
     ("sheen", {"roughness": 0.3, "color": [0.9, 0.5, 0.3]}, "sheen-r0.3", None),
     ("sheen", {"roughness": 1.0, "terminator_softening": False}, "sheen-r1-reciprocal", None),
-    ("disney", {"roughness": 0.0}, "disney-r0", 1e-3),
+    ("disney", {"roughness": 0.0}, "disney-r0", None),  # delta specular over the diffuse
+    ("disney", {"roughness": 0.04, "anisotropic": 1.0}, "disney-alpha-min", 1e-3),
     ("disney", {"roughness": 1.0}, "disney-r1", 1.0),
     ("disney", {"roughness": 0.3, "anisotropic": 1.0}, "disney-aniso1", 0.028),
     ("disney", {"metallic": 1.0, "roughness": 0.2}, "disney-metal", 0.04),
@@ -37,6 +38,9 @@ CASES = [
     ("disney", {"clearcoat": 1.0, "clearcoat_gloss": 0.5, "roughness": 0.6}, "disney-coat.5", 0.05),
     ("disney", {"spec_trans": 1.0, "roughness": 0.1, "ior": 1.5}, "disney-glass", 0.01),
     ("disney", {"spec_trans": 1.0, "roughness": 0.3, "thin": True}, "disney-thin-glass", 0.035),
+    # Refraction into glass narrows the lobe by about (η − 1)/η: α 0.12 → 0.04.
+    ("disney", {"spec_trans": 1.0, "roughness": 0.35, "ior": 1.52}, "disney-frosted", 0.04),
+    ("disney", {"spec_trans": 0.5, "roughness": 0.0, "ior": 1.5}, "disney-smooth-mix", None),
     ("disney", {"diff_trans": 0.7, "thin": True, "flatness": 0.5}, "disney-leaf", 0.25),
     ("disney", {"sheen": 1.0, "sheen_tint": 0.5, "subsurface": 1.0}, "disney-sheen", 0.25),
     (
@@ -50,7 +54,8 @@ CASES = [
     ("disney", {"specular_gamma": 1.5, "metallic": 1.0, "roughness": 0.5}, "disney-gamma1.5", 0.25),
     ("disney", {"specular_gamma": 3.0, "metallic": 1.0, "roughness": 0.3}, "disney-gamma3", 0.09),
     # Pixar: "α" here is the reflection cone's half-angle in radians (10·r degrees).
-    ("pixar", {"roughness": 0.0}, "pixar-r0", math.radians(0.5)),
+    ("pixar", {"roughness": 0.0}, "pixar-r0", None),  # a delta reflection over the diffuse
+    ("pixar", {"clear": 1.0, "roughness": 0.0, "ior": 1.52}, "pixar-clear-glass", None),
     ("pixar", {"roughness": 0.3}, "pixar-r0.3", math.radians(3.0)),
     ("pixar", {"roughness": 1.0}, "pixar-r1", None),
     ("pixar", {"metallic": 1.0, "roughness": 0.4}, "pixar-metal", math.radians(4.0)),

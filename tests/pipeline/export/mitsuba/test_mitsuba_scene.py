@@ -184,7 +184,9 @@ def test_xml_without_our_plugins_has_no_hint(mi):
     from lookdev.pipeline.export.mitsuba import xml
 
     text = xml.to_xml({"type": "scene", "s": {"type": "sphere", "bsdf": {"type": "diffuse"}}})
-    assert text.startswith("<scene")
+    assert xml.LOAD_HINT not in text
+    comment, scene = text.split("\n", 1)  # only the colour note: the space its RGB is in
+    assert comment == f"<!--{xml.colour_note()}-->" and scene.startswith("<scene")
     assert '<bsdf type="diffuse" name="bsdf"' in text
 
 
@@ -237,7 +239,7 @@ def _principled_vs_plugin(mi, m, params, n=4096, seed=0):
     return float(np.max(np.abs(a - b) / np.maximum(np.abs(b), 1e-3)))
 
 
-@pytest.mark.parametrize("roughness", [0.0, 0.05, 0.5, 1.0])
+@pytest.mark.parametrize("roughness", [0.04, 0.05, 0.5, 1.0])
 @pytest.mark.parametrize("anisotropic", [0.0, 1.0])
 def test_principled_fast_path_equals_our_metal(mi, m, disney, roughness, anisotropic):
     from lookdev.materials.params import DisneyParams
@@ -246,6 +248,15 @@ def test_principled_fast_path_equals_our_metal(mi, m, disney, roughness, anisotr
         metallic=1.0, base_color=(0.95, 0.64, 0.54), roughness=roughness, anisotropic=anisotropic
     )
     assert _principled_vs_plugin(mi, m, params) < 1e-4
+
+
+def test_a_smooth_metal_is_our_delta_mirror_not_principled(m):
+    from lookdev.materials.params import DisneyParams
+    from lookdev.pipeline.blend import BlendedMaterial
+
+    for anisotropic in (0.0, 0.5):
+        smooth = DisneyParams(metallic=1.0, roughness=0.0, anisotropic=anisotropic)
+        assert m.principled_equivalent(BlendedMaterial.of_params(smooth)) is None
 
 
 def test_fast_path_only_where_measured(m, disney):

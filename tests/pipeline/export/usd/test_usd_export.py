@@ -117,9 +117,11 @@ def test_plain_diffuse_has_no_clearcoat_sheen_or_transmission(tmp_path):
         "inputs:roughness",
         "outputs:bxdf_out",
     ]
-    # the Material: its interface (the values every context reads, one override for
-    # all), three outputs and MaterialXConfigAPI's config:mtlx:version
+    # the Material: ColorSpaceAPI's colorSpace:name (the working space), its interface
+    # (the values every context reads, one override for all), three outputs and
+    # MaterialXConfigAPI's config:mtlx:version
     assert attrs["/Materials/plaster"] == [
+        "colorSpace:name",
         "config:mtlx:version",
         "inputs:base_color",
         "inputs:ior",
@@ -128,7 +130,7 @@ def test_plain_diffuse_has_no_clearcoat_sheen_or_transmission(tmp_path):
         "outputs:ri:surface",
         "outputs:surface",
     ]
-    assert sum(len(v) for v in attrs.values()) == 4 + 4 + 5 + 7
+    assert sum(len(v) for v in attrs.values()) == 4 + 4 + 5 + 8
 
 
 @pytest.mark.parametrize("specular", [0.0, 0.3, 0.5, 2.0])
@@ -293,7 +295,7 @@ def test_layered_pixar_exports_its_lobe_weights(tmp_path):
 def _write_exr(path: Path, pixels) -> Path:
     from lookdev.pipeline.export.usd.textures import write_image
 
-    write_image(path, pixels)
+    write_image(path, pixels, data=True)
     return path
 
 
