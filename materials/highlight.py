@@ -32,12 +32,16 @@ _SPECULAR = disney.lobe_model("specular")
 
 
 def half_width(params: DisneyParams) -> float:
-    """θh (radians) where the specular lobe's slice at normal view halves (π/4 if never)."""
+    """θh (radians) where the specular lobe's slice at normal view halves (π/4 if never,
+    0 for a delta)."""
     xp = NumpyOps()
     th = np.concatenate([[0.0], np.geomspace(1e-6, 0.25 * math.pi, _SLICE)])
     wi = np.stack([np.sin(2.0 * th), 0.0 * th, np.cos(2.0 * th)])
     wo = np.array([[0.0], [0.0], [1.0]])
-    f = _SPECULAR.eval(xp, _SPECULAR.prepare(xp, params), wi, wo)[1]  # green: any channel
+    prepared = _SPECULAR.prepare(xp, params)
+    if "specular" in prepared["delta"]:
+        return 0.0  # a smooth GGX lobe is a delta (microfacet.is_delta): no width
+    f = _SPECULAR.eval(xp, prepared, wi, wo)[1]  # green: any channel
     below = np.flatnonzero(f < 0.5 * f[0])
     if below.size == 0:
         return 0.25 * math.pi
@@ -52,8 +56,8 @@ def ggx_roughness_like(params: DisneyParams, tol: float = 1e-5) -> float:
 
     A lobe so rough that its slice does not halve before grazing (θh = π/4) has no
     measured width, and GGX reaches no width between ≈ 0.60 rad and π/4: there the
-    closed form for D alone is used. Below the narrowest GGX
-    (α = 10⁻³ at roughness 0) the answer is 0.
+    closed form for D alone is used, as it is for a target narrower than the narrowest
+    glossy GGX (smoother ones are deltas, of width 0).
     """
     gamma = params.specular_gamma
     closed = ggx_roughness_like_gtr(gamma, params.roughness)
