@@ -96,6 +96,10 @@ class Model:
     sample: Callable[..., Any]
     restrict: Callable[..., Any] = keep_lobes
     lobes: tuple[Lobe, ...] = ()
+    guide: Callable[..., Any] | None = None
+    """``guide(xp, prepared, wo) -> colour``: what the model's *glossy* lobes add to a
+    denoiser's albedo guide (:func:`lookdev.materials.guides.guide_albedo` adds the
+    diffuse-like ones itself); None when they add nothing."""
 
     def lobe(self, name: str) -> Lobe:
         """The lobe called ``name``; a ``KeyError`` naming the known ones otherwise."""

@@ -364,8 +364,40 @@ def restrict(xp: Any, prepared: dict[str, Any], names: Any) -> dict[str, Any]:
     return pr
 
 
+def guide_core(xp: Any, pr: dict[str, Any], wo: Any) -> Any:
+    """The glossy lobes' share of a denoiser's albedo guide (:mod:`.guides`), by OIDN's
+    rules: a metal its colour at normal incidence (metallic·base, the F0 of the Schlick
+    blend in ``spec_a``); glass the Fresnel blend of its reflection (1) and its
+    transmission colour at the view, F(θo, η) + (1 − F)·T, with 1/η from inside a solid;
+    the dielectric specular of a plastic and the clearcoat (non-absorbing coats) nothing.
+    Seen from inside an opaque solid, nothing at all. None when no glossy lobe adds.
+    """
+    lobes = pr["lobes"]
+    _, wo_, front, _ = _oriented(xp, pr, wo, wo)
+    if front is None and not pr["thin"]:
+        front = xp.select(wo[2] > 0.0, 1.0, 0.0)  # one-sided: nothing from below, as eval
+    out = None
+    if "specular" in lobes:
+        # 1 − w_d − w_g = metallic (disney_prepare: w_d + w_g = 1 − metallic).
+        metallic = 1.0 - pr["diffuse"] - pr["diff_trans"] - pr["glass"]
+        if not xp.known_zero(metallic):
+            out = times(metallic * pr["base"], front)
+    if "spec_trans" in lobes:
+        f = fr.dielectric(xp, wo_[2], pick(xp, front, pr["eta"], 1.0 / pr["eta"]))
+        out = _add(out, pr["glass"] * (f + (1.0 - f) * pr["trans_color"]))
+    return out
+
+
 MODEL = Model(
-    "disney", DisneyParams, prepare, eval_core, pdf_core, sample_core, restrict, DISNEY_LOBES
+    "disney",
+    DisneyParams,
+    prepare,
+    eval_core,
+    pdf_core,
+    sample_core,
+    restrict,
+    DISNEY_LOBES,
+    guide_core,
 )
 
 
@@ -399,6 +431,7 @@ def lobe_model(*names: str) -> Model:
         sample_core,
         restrict,
         DISNEY_LOBES,
+        guide_core,
     )
 
 

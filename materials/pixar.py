@@ -54,6 +54,7 @@ from .pixar_scatter import (
     delta_lobes,
     prepared,
     scatter_eval,
+    scatter_guide,
     scatter_pdf,
     scatter_sample,
 )
@@ -314,7 +315,14 @@ def _weights_of(lobe: str) -> tuple[str, ...]:
 
 # -- the Model -----------------------------------------------------------------------------
 MODEL = Model(
-    "pixar", PixarParams, _prepare, scatter_eval, scatter_pdf, scatter_sample, lobes=PIXAR_LOBES
+    "pixar",
+    PixarParams,
+    _prepare,
+    scatter_eval,
+    scatter_pdf,
+    scatter_sample,
+    lobes=PIXAR_LOBES,
+    guide=scatter_guide,
 )
 LAYERED_MODEL = Model(
     "pixar_layered",
@@ -324,6 +332,7 @@ LAYERED_MODEL = Model(
     scatter_pdf,
     scatter_sample,
     lobes=tuple(replace(lobe, params=_weights_of(lobe.name)) for lobe in PIXAR_LOBES),
+    guide=scatter_guide,
 )
 """The same lobes driven by composited weights: a layered Pixar material's BSDF."""
 

@@ -266,3 +266,19 @@ def scatter_sample(xp: Any, prep: dict[str, Any], wo: Any, u: Any) -> tuple[Any,
     else:
         delta = False
     return xp.vec3(wi[0], wi[1], wi[2] * s), weight, pdf, delta
+
+
+def scatter_guide(xp: Any, prep: dict[str, Any], wo: Any) -> Any:
+    """The highlight lobes' share of a denoiser's albedo guide (:mod:`.guides`): each
+    one's weight at the view, FrnBlend[N, G, cos θo]. Smits' weights already partition
+    the energy by Fresnel, so a metal gives its coloured reflectance and a glass the
+    Fresnel blend of its reflection and its tinted transmission, as OIDN asks; a
+    dielectric's reflection adds its few percent of white. None without highlights."""
+    cos_v = xp.abs(wo[2])
+    w = at_view(xp, prep["ends"], cos_v)
+    out = None
+    for lobe in prep["lobes"]:
+        if not lobe.startswith("diffuse"):
+            a = lobes.frn_blend(xp, w[PREFIX[lobe] + "N"], w[PREFIX[lobe] + "G"], cos_v)
+            out = a if out is None else out + a
+    return out

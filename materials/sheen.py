@@ -265,7 +265,18 @@ def _sample(xp: Any, prepared: dict[str, Any], wo: Any, u: Any) -> tuple[Any, An
 # [without, with] terminator softening, each (n_r, n_mu).
 _TABLES = np.asarray(_TABLE_VALUES, dtype=np.float64).reshape(2, _N_R, _N_MU)
 SHEEN_LOBES = (Lobe("sheen", "glossy", params=("color", "roughness", "terminator_softening")),)
-MODEL = Model("sheen", SheenParams, _prepare, _eval, _pdf, _sample, lobes=SHEEN_LOBES)
+
+
+def _guide(xp: Any, prepared: dict[str, Any], wo: Any) -> Any:
+    """A denoiser's albedo guide (:mod:`.guides`): the cloth's colour times the lobe's
+    directional albedo E(θo) from the table (OIDN: the surface's approximate colour)."""
+    if not prepared["lobes"]:
+        return None
+    e = albedo_lookup(xp, xp.abs(wo[2]), prepared["r"], prepared["soften"])
+    return prepared["color"] * e
+
+
+MODEL = Model("sheen", SheenParams, _prepare, _eval, _pdf, _sample, lobes=SHEEN_LOBES, guide=_guide)
 
 
 # -- public numpy API ----------------------------------------------------------------------

@@ -368,6 +368,7 @@ def proof(
     library: Any = None,
     progress: Callable[[Any], None] | None = None,
     geometry: PathLike | None = None,
+    denoise: bool = False,
 ) -> dict[str, Any]:
     """Render turntable proofs (Burley §6.1): every material under every IBL.
 
@@ -422,6 +423,11 @@ def proof(
         synchronised comparison, raw/denoised, each material's parameters and losses.
     library
         See :func:`load`.
+    denoise
+        Also write every frame denoised by Intel Open Image Denoise (``pyoidn``), guided
+        by albedo and normal images rendered with it, beside the raw frame
+        (:mod:`lookdev.pipeline.proof.denoise`); a :class:`DenoiseError` when ``pyoidn``
+        is not installed.
     progress
         Called with a :class:`lookdev.pipeline.proof.batch.Progress` about twice a second
         and as each proof finishes (``frames_done``, ``frames_total``, ``finished``).
@@ -453,9 +459,14 @@ def proof(
             clamp=clamp,
             pixel_filter=pixel_filter,
             rig=rig,
+            denoise=denoise,
         ),
         jobs,
     )
+    if denoise:
+        from lookdev.pipeline.proof.denoise import oidn
+
+        oidn()  # missing: one line before anything is loaded or rendered
     lib = library_for(library)
     if materials is None or (not isinstance(materials, str | os.PathLike) and not materials):
         materials = representative_presets(lib)

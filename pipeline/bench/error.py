@@ -8,6 +8,8 @@ render     proof renders of a diffuse, glossy metal, clearcoat, sheen and glass 
 albedo     directional albedo by quadrature, Monte Carlo and the shipped table
 lambda     the Conty-Kulla Λ fit against numerical integration
 precision  float32 against float64 evaluation of every model
+denoise    equal-time curves of raw and OIDN-denoised proof frames (plastic, glass
+           under sky, box filter) against a converged reference (:mod:`.denoise`)
 ========== ==============================================================================
 
 Outputs: a Rich table, ``error_bench.json`` (every row, the settings and the machine)
@@ -31,10 +33,11 @@ from lookdev.library import files
 from lookdev.materials.bsdf import Model
 from lookdev.materials.errors import LookdevError
 
+from . import denoise as denoise_bench
 from . import measure
 from .measure import Row
 
-ITEMS = ("render", "albedo", "lambda", "precision")
+ITEMS = ("render", "albedo", "lambda", "precision", "denoise")
 
 RENDER_IBL = "studio"
 # Proof-render cases: label → built-in preset name.
@@ -61,6 +64,7 @@ class Settings:
     lambda_nodes: tuple[int, ...] = (8, 16, 32, 64, 128)
     lambda_reference_nodes: int = 2048
     precision_pairs: int = 20000
+    denoise: denoise_bench.DenoiseSettings = field(default_factory=denoise_bench.DenoiseSettings)
 
     @classmethod
     def quick(cls) -> Settings:
@@ -75,6 +79,7 @@ class Settings:
             lambda_nodes=(4, 16),
             lambda_reference_nodes=512,
             precision_pairs=2000,
+            denoise=denoise_bench.DenoiseSettings.quick(),
         )
 
 
@@ -82,6 +87,7 @@ class Settings:
 class Report:
     rows: list[Row] = field(default_factory=list)
     skipped: dict[str, str] = field(default_factory=dict)  # "item: case" → reason
+    denoise: list[denoise_bench.Case] = field(default_factory=list)
 
     def to_json(self, settings: Settings) -> dict[str, Any]:
         return {
@@ -96,6 +102,7 @@ class Report:
                 for r in self.rows
             ],
             "skipped": self.skipped,
+            "denoise": [case.as_json() for case in self.denoise],
         }
 
 
@@ -242,6 +249,8 @@ def run(
                     ),
                 )
             )
+    if "denoise" in items:
+        tasks += _denoise_tasks(settings.denoise, report)
     for done, (name, task) in enumerate(tasks):
         progress(name, done, len(tasks))
         try:
@@ -250,6 +259,32 @@ def run(
             first = (str(exc).splitlines() or [""])[0]
             report.skipped[name] = f"failed: {type(exc).__name__}: {first}"
     return report
+
+
+def _denoise_tasks(
+    settings: denoise_bench.DenoiseSettings, report: Report
+) -> list[tuple[str, Callable[[], list[Row]]]]:
+    """One task per (preset, IBL) of ``settings.cases``; each adds its Case."""
+    from lookdev.library import load_material
+    from lookdev.pipeline.blend import blend
+    from lookdev.pipeline.export.mitsuba import register_plugins
+    from lookdev.pipeline.proof import ibl
+    from lookdev.pipeline.proof.batch import MAP_RESOLUTION
+    from lookdev.pipeline.proof.turntable import material_bsdf
+
+    register_plugins()
+
+    def task(preset: str, ibl_name: str) -> list[Row]:
+        bsdf, depth = material_bsdf(blend(load_material(preset), MAP_RESOLUTION))
+        env = ibl.load(ibl_name, settings.ibl_width).pixels
+        case = denoise_bench.bench_case(preset, ibl_name, bsdf, env, depth, settings)
+        report.denoise.append(case)
+        return case.rows()
+
+    return [
+        (f"denoise {preset} × {name}", lambda p=preset, n=name: task(p, n))
+        for preset, name in settings.cases
+    ]
 
 
 # -- output ----------------------------------------------------------------------------
@@ -261,6 +296,8 @@ MARKERS = {
     "integral": "D",
     "path tracer": "o",
     "float32": "v",
+    "raw": "o",
+    "denoised": "*",
 }
 
 
@@ -325,4 +362,5 @@ ERROR_NAMES = {
     "albedo": "relative RMS error",
     "lambda": "relative RMS error",
     "precision": "max relative error of float32",
+    "denoise": "relative MSE (mean over seeds)",
 }

@@ -7,6 +7,7 @@ people, and with ``--json`` as one object for scripts.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from pathlib import Path
 from typing import Annotated, Any
@@ -149,6 +150,15 @@ def error_(
         typer.Option("--item", "-i", help=f"Measure only these items: {', '.join(error.ITEMS)}."),
     ] = None,
     quick: Annotated[bool, typer.Option("--quick", help="Short ladders (CI, tests).")] = False,
+    denoise_cases: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--denoise-case",
+            metavar="PRESET:IBL",
+            help="Item denoise: measure these cases (repeatable) instead of "
+            "plastic_glossy:sky and glass_clear:sky.",
+        ),
+    ] = None,
     as_json: JsonOut = False,
 ) -> None:
     """Error against run time of every approximation lookdev makes, measured now.
@@ -164,6 +174,13 @@ def error_(
             f"unknown item {unknown[0]!r}; allowed {', '.join(error.ITEMS)}", field="--item"
         )
     settings = error.Settings.quick() if quick else error.Settings()
+    if denoise_cases:
+        cases = tuple(tuple(c.split(":", 1)) for c in denoise_cases)
+        if any(len(c) != 2 or not all(c) for c in cases):
+            raise error.BenchError("expected PRESET:IBL", field="--denoise-case")
+        settings = dataclasses.replace(
+            settings, denoise=dataclasses.replace(settings.denoise, cases=cases)
+        )
     start = time.perf_counter()
     with Progress(console=console, transient=True, disable=as_json) as bar:
         task = bar.add_task("measuring", total=None)
@@ -187,6 +204,24 @@ def error_(
                     ERROR_COLUMNS,
                     [_error_row(r) for r in rows],
                 )
+            )
+    if report.denoise:
+        from lookdev.pipeline.bench import denoise as denoise_bench
+
+        console.print(
+            table(
+                "denoise: equal wall time (guides and denoiser included); † = extrapolated "
+                "along relMSE ∝ 1/spp",
+                denoise_bench.EQUAL_TIME_COLUMNS,
+                denoise_bench.equal_time_rows(report.denoise),
+            )
+        )
+        for case in report.denoise:
+            verdict = "met" if case.summary["claim_met"] else "NOT met"
+            console.print(
+                f"{case.preset} × {case.ibl}: {case.summary['claim']}: {verdict}; "
+                f"reference {case.reference_spp} spp, its own relMSE {case.reference_floor:.2g}",
+                highlight=False,
             )
     for what, why in report.skipped.items():
         console.print(f"[yellow]skipped[/] {what}: {why}")

@@ -182,6 +182,15 @@ def proof(
             "ball, with its own UVs (UDIM tiles included).",
         ),
     ] = None,
+    denoise: Annotated[
+        bool,
+        typer.Option(
+            "--denoise",
+            help="Also write each frame denoised by Intel Open Image Denoise (CPU, guided by "
+            "albedo and normal images rendered with it): frame_NNN_denoised.exr/.png beside "
+            "the raw frame, which is kept.",
+        ),
+    ] = False,
     report: Annotated[
         bool,
         typer.Option(
@@ -264,6 +273,7 @@ def proof(
             library=library,
             progress=show,
             geometry=geometry,
+            denoise=denoise,
         )
     if as_json:
         print_json(doc)

@@ -7,6 +7,9 @@ Layout of an output folder::
     OUT/<material>/<ibl>/frame_NNN.exr   scene-linear frames
     OUT/<material>/<ibl>/frame_NNN.png   the same through the proof view transform
     OUT/<material>/<ibl>/contact.png     all frames of the turntable, labelled
+    OUT/<material>/<ibl>/frame_NNN_denoised.exr/.png, contact_denoised.png
+                                         with ``--denoise``: the frames denoised by
+                                         OIDN (:mod:`.denoise`), the raw ones kept
     OUT/<material>/<ibl>/manifest.json   every frame: images and files (size, SHA-256),
                                          spp, noise reached and target, why sampling
                                          stopped, render time, firefly share; the
@@ -45,7 +48,7 @@ from lookdev.library import files
 from lookdev.materials import colour
 from lookdev.materials.errors import LookdevError
 
-from . import contact, ibl, rig, tonemap
+from . import contact, denoise, ibl, rig, tonemap
 from .settings import MAX_SAMPLES, MAX_SIDE, MIN_SIDE, ProofError, Settings
 from .turntable import Frame
 
@@ -187,6 +190,9 @@ def _run_job(job: Job, variant: str) -> dict[str, Any]:
             rendered += 1
     _remove_strays(folder, doc)
     doc["contact_sheet"] = file_entry(_sheet(job, doc))
+    if job.settings.denoise:
+        sheet = _sheet(job, doc, "denoised_png", "contact_denoised.png")
+        doc["contact_sheet_denoised"] = file_entry(sheet)
     write_json(doc, folder / MANIFEST)
     return doc | {"rendered": rendered, "skipped": len(done)}
 
@@ -208,12 +214,23 @@ def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
         pixel_filter=s.pixel_filter,
         clamp=s.clamp,
     )
+    guides = denoise.guide_renderer(table, s.spp) if s.denoise else None
     for frame in todo:
         r = render_frame(table, frame, **s.sampling())
         stem = job.folder / f"frame_{frame.index:03d}"
         exr = contact.write_exr(r.image, stem.with_suffix(".exr"))
         png = contact.write_png(tonemap.view(r.image, s.exposure), stem.with_suffix(".png"))
-        yield frame_entry(r, {"raw": exr, "png": png}, s)
+        images = {"raw": exr, "png": png}
+        timings = None
+        if guides is not None:  # at the pose just rendered: the raw frame stays beside
+            written, timings = denoise.write_denoised(
+                guides, r.image, stem, s.exposure, frame.index
+            )
+            images |= written
+        entry = frame_entry(r, images, s)
+        if timings is not None:
+            entry["denoise"] = timings
+        yield entry
 
 
 def frame_entry(r: Any, images: dict[str, Path], settings: Settings) -> dict[str, Any]:
@@ -251,16 +268,18 @@ def _remove_strays(folder: Path, doc: dict[str, Any]) -> None:
             path.unlink(missing_ok=True)
 
 
-def _sheet(job: Job, doc: dict[str, Any]) -> Path:
+def _sheet(job: Job, doc: dict[str, Any], role: str = "png", name: str = "contact.png") -> Path:
 
     images, labels = [], []
     for entry in doc["frames"]:
-        images.append(contact.read_rgb(job.folder / entry["images"]["png"]))
+        images.append(contact.read_rgb(job.folder / entry["images"][role]))
         labels.append(f"{entry['kind']} {entry['angle']:.0f}°  {entry['spp']} spp")
     title = f"{job.material.name} × {job.ibl}  ({_sampling_label(job.settings)})"
     columns = max(job.settings.element_frames, job.settings.light_frames)
+    if role != "png":
+        title += "  denoised"
     sheet = contact.contact_sheet(images, labels, title, columns)
-    return contact.write_png(sheet, job.folder / "contact.png")
+    return contact.write_png(sheet, job.folder / name)
 
 
 def _sampling_label(s: Settings) -> str:
@@ -503,6 +522,9 @@ def summary(out: Path, jobs: list[Job], results: list[dict[str, Any]], seconds: 
                 "contact_sheet": str(job.folder.relative_to(out) / "contact.png"),
             }
         )
+        if "contact_sheet_denoised" in doc:
+            sheet = job.folder.relative_to(out) / doc["contact_sheet_denoised"]["file"]
+            entries[-1]["contact_sheet_denoised"] = str(sheet)
     entries = merge_entries(out, entries)
     doc = {
         "version": FORMAT_VERSION,

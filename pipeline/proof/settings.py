@@ -92,6 +92,7 @@ class Settings:
     colour: colour.Settings = field(default_factory=colour.pinned)
     """The OCIO config, working space and view the batch was asked in (workers are other
     processes, perhaps on other machines: they enter these, not their own defaults)."""
+    denoise: bool = False  # also write each frame denoised (OIDN, .denoise), the raw kept
 
     def __post_init__(self) -> None:
         if self.spp is not None:

@@ -50,6 +50,7 @@ import numpy as np
 from lookdev.materials.arrays import DrJitOps
 from lookdev.materials.bsdf import Model
 from lookdev.materials.errors import LookdevError
+from lookdev.materials.guides import guide_albedo
 from lookdev.materials.registry import is_color_field
 
 PLUGIN_PREFIX = "lookdev_"
@@ -338,6 +339,15 @@ def _plugin_class(variant: str) -> type:
             value = dr.select(ok, self._scaled(mi.Spectrum(weight)), 0.0)
             bs.pdf = dr.select(ok, bs.pdf, 0.0)
             return bs, value
+
+        def eval_diffuse_reflectance(self, si, active=True):
+            """The albedo guide of Mitsuba's ``aov`` integrator (and so of the denoiser):
+            the model's diffuse-like lobes plus OIDN's rules for its glossy ones
+            (:func:`lookdev.materials.guides.guide_albedo`), not Mitsuba's default
+            π·f(wi = n), which bakes the highlight in and leaves glass black."""
+            prepared = self._prepare(si, active)
+            albedo = guide_albedo(self.xp, self.model, prepared, si.wi)  # si.wi: the viewer
+            return dr.select(active, self._scaled(mi.Spectrum(albedo)), 0.0)
 
         def _refracts(self, prepared: Any) -> bool:
             """Whether a transmitted path changes medium (see :meth:`_eta`)."""

@@ -163,17 +163,14 @@ def referenced_image(hub: BlendedMaterial, name: str, ti: Any, texture_dir: Path
 
 
 def default_colorspace(path: Path, colour: bool) -> str:
-    """The colour space of a file its texture input does not name (DESIGN.md, Colour):
-    an 8-bit colour map is sRGB-encoded, a float colour map is in the working space,
-    everything else is data."""
+    """The colour space of a file its texture input does not name: the one file rule,
+    :func:`lookdev.materials.colour.texture_space`, on the file's stored format."""
     from lookdev.materials import colour as cm
 
-    if not colour:
-        return cm.RAW
-    return cm.SRGB_TEXTURE if _bits(path) == 8 else cm.working_space()
+    return cm.texture_space(_integer_coded(path), colour, None, str(path))
 
 
-def _bits(path: Path) -> int:
+def _integer_coded(path: Path) -> bool:
     import OpenImageIO as oiio
 
     from lookdev.pipeline.blend.surface_maps import udim_tiles
@@ -181,10 +178,10 @@ def _bits(path: Path) -> int:
     first = next(iter(sorted(udim_tiles(path).values())))
     image = oiio.ImageInput.open(str(first))
     if image is None:
-        return 32
-    fmt = str(image.spec().format)
+        return False
+    basetype = image.spec().format.basetype
     image.close()
-    return {"uint8": 8, "int8": 8, "uint16": 16, "half": 16}.get(fmt, 32)
+    return basetype not in (oiio.HALF, oiio.FLOAT, oiio.DOUBLE)
 
 
 def colour_space_of_bake(colour: bool) -> str:
