@@ -17,7 +17,9 @@ w_g = (1 − metallic)·spec_trans:
                 Conty-Kulla lobe of :mod:`.sheen` with ``sheen_model = "conty_kulla"``
 ``specular``    F · D · G / (4 cos θl cos θv), anisotropic GGX (App. B eq. 13) with the
                 un-remapped anisotropic Smith G (2014 addendum); F blends metal, dielectric
-                and the glass's reflection (see :func:`_fresnel_terms`)
+                and the glass's reflection (see :func:`_fresnel_terms`); the expert
+                ``specular_gamma`` ≠ 2 makes D the isotropic GTR of App. B eq. 1, sampled
+                by eqs. 2–3 (Chichi 2018's ``d_gamma``)
 ``clearcoat``   0.25 · clearcoat · D_GTR1 · F(0.04) · G(α = 0.25) / (4 cos θl cos θv)
 ``spec_trans``  w_g · T · Walter et al. 2007 rough dielectric BTDF (solid), or the
                 mirrored-reflection thin sheet with Burley 2015's roughness scale (thin)
@@ -58,8 +60,10 @@ from .disney_interface import (
     pick,
     projected,
     sample_interface,
+    specular_d,
     times,
     transmission,
+    v_cavity_over_cos,
 )
 from .disney_prepare import (
     CLEARCOAT_F0,
@@ -160,11 +164,14 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
     scale = _base_scale(xp, pr, ci, co)
     terms = []
     if "specular" in lobes and "specular" not in pr["delta"]:
-        d = mf.ggx_d(xp, h, pr["ax"], pr["ay"], n2=h2)
-        g = mf.g1_over_cos(xp, ci, projected(pr, wi, zi2), zi2) * mf.g1_over_cos(
-            xp, co, projected(pr, wo, zo2), zo2
-        )
-        dg = _masked(xp, up, 0.25 * d * g)
+        d = specular_d(xp, pr, h, h2)
+        if pr["ggx"]:
+            g = mf.g1_over_cos(xp, ci, projected(pr, wi, zi2), zi2) * mf.g1_over_cos(
+                xp, co, projected(pr, wo, zo2), zo2
+            )
+        else:
+            g = v_cavity_over_cos(xp, h, h2, ci, co)
+        dg = _masked(xp, up, 0.25 * d * g) if pr["ggx"] else xp.select(up, 0.25 * d * g, 0.0)
         a, b, c = pr["spec_a"], pr["spec_b"], pr["spec_c"]
         dg_out = times(dg, front)
         terms += [(a * scale, dg_out), ((b - a) * scale, dg_out * w)]

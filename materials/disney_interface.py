@@ -43,8 +43,10 @@ __all__ = [
     "pick",
     "projected",
     "sample_interface",
+    "specular_d",
     "split",
     "transmission",
+    "v_cavity_over_cos",
 ]
 
 INTERFACE = ("specular", "spec_trans")
@@ -96,6 +98,35 @@ def transmission(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any, pdf:
     return mf.dielectric_btdf(xp, wi, wo, etap(xp, pr, front), ax, ay, pdf)
 
 
+def specular_d(xp: Any, pr: dict[str, Any], h: Any, h2: Any) -> Any:
+    """D of the primary specular lobe at the unnormalised half vector h (|h|² = ``h2``):
+    the anisotropic GGX (eq. 13) at γ = 2, else the isotropic GTR of eq. 1 with α² = αx αy
+    (``specular_gamma``, Burley 2012 App. B).
+
+    The GTR D is ∞ at h = 0 (wi = −wo, never a reflection pair): callers select, not mask.
+    """
+    if pr["ggx"]:
+        return mf.ggx_d(xp, h, pr["ax"], pr["ay"], n2=h2)
+    inv_h2 = 1.0 / xp.maximum(h2, xp.tiny)
+    sin2_h = (h[0] * h[0] + h[1] * h[1]) * inv_h2  # not 1 − cos²: the α = 10⁻³ peak
+    return mf.gtr_d(xp, pr["gamma"], pr["a2"], h[2] * h[2] * inv_h2, sin2_h)
+
+
+def v_cavity_over_cos(xp: Any, h: Any, h2: Any, ci: Any, co: Any) -> Any:
+    """G/(cos θi cos θo) with the Cook–Torrance V-cavity G = min(1, 2 cos θh cos θ/(wo·h))
+    over both directions, written with the unnormalised h (2 cos θh/(wo·h) = 4 h_z/|h|²).
+
+    The shadowing of GTR at γ ≠ 2: Smith's Λ has no closed form for it (App. B closes
+    only GTR2), and GGX's Λ at the same α under GTR's heavier tail gains energy without
+    bound (measured, white metal at cos θo = 10⁻⁴: albedo 1.92 at γ = 1, roughness 0.5;
+    131 at roughness 0), while the V-cavity G is normalised for any D (Heitz 2014 §5.2:
+    ∫ G1 ⟨wo, h⟩ D dh = cos θo), so the lobe never reflects more than the light.
+    """
+    k = 4.0 * xp.maximum(h[2], 0.0) / xp.maximum(h2, xp.tiny)
+    inv = 1.0 / xp.maximum(ci * co, xp.tiny)
+    return xp.minimum(inv, k / xp.maximum(xp.maximum(ci, co), xp.tiny))
+
+
 def _has(pr: dict[str, Any]) -> tuple[bool, bool, bool, bool]:
     """(reflection present, transmission present, reflection delta, transmission delta)."""
     lobes, delta = pr["lobes"], pr["delta"]
@@ -106,7 +137,8 @@ def _has(pr: dict[str, Any]) -> tuple[bool, bool, bool, bool]:
 def per_facet(pr: dict[str, Any]) -> bool:
     """Whether the choice takes F at the sampled microfacet (a solid, rough, both lobes)."""
     r, t, dr, _ = _has(pr)
-    return r and t and not dr and not pr["thin"]
+    # A GTR reflection (γ ≠ 2) and the GGX glass have different micro-normals: no sharing.
+    return r and t and not dr and not pr["thin"] and pr["ggx"]
 
 
 def split(xp: Any, pr: dict[str, Any], cos: Any, front: Any) -> tuple[Any, Any]:
@@ -186,7 +218,10 @@ def sample_interface(
         if d_r:
             wr, ok_r = xp.vec3(-wo[0], -wo[1], co), co > 0.0
         else:
-            h = mf.sample_visible_ggx(xp, wo, pr["ax"], pr["ay"], u1, u2)
+            if pr["ggx"]:
+                h = mf.sample_visible_ggx(xp, wo, pr["ax"], pr["ay"], u1, u2)
+            else:  # visible-normal sampling exists for GGX only: App. B eqs. 2–3
+                h = mf.sample_gtr(xp, pr["gamma"], pr["a2"], u1, u2)
             wr = mf.reflect(xp, wo, h)
             ok_r = wr[2] > 0.0
     if has_t:
@@ -197,7 +232,7 @@ def sample_interface(
             else:
                 wt, ok_t = _snell(xp, wo, e)
         else:
-            ht = h if h is not None and not pr["thin"] else None
+            ht = h if h is not None and not pr["thin"] and pr["ggx"] else None
             if ht is None:
                 ht = mf.sample_visible_ggx(xp, wo, pr["tax"], pr["tay"], u1, u2)
             if pr["thin"]:
@@ -240,11 +275,15 @@ def interface_pdf(
     if not facet:
         p_r, p_t = split(xp, pr, co, front)
     if has_r and not d_r:
-        # Visible normals: D_wo(h)/(4 wo·h) = G1(wo) D(h) / (4 cos θo).
         h = wi + wo
-        zo2 = co * co
-        g1 = mf.g1_over_cos(xp, co, projected(pr, wo, zo2), zo2)
-        vndf = 0.25 * mf.ggx_d(xp, h, pr["ax"], pr["ay"], n2=h2) * g1
+        if pr["ggx"]:
+            # Visible normals: D_wo(h)/(4 wo·h) = G1(wo) D(h) / (4 cos θo).
+            zo2 = co * co
+            g1 = mf.g1_over_cos(xp, co, projected(pr, wo, zo2), zo2)
+            vndf = 0.25 * mf.ggx_d(xp, h, pr["ax"], pr["ay"], n2=h2) * g1
+        else:
+            # GTR (App. B eqs. 2–3): D(h) cos θh / (4 wo·h), cos θh = h_z/|h|, wo·h = |h|/2.
+            vndf = xp.select(up, specular_d(xp, pr, h, h2) * h[2] / (2.0 * h2), 0.0)
         if facet:
             p_r = split(xp, pr, 0.5 * xp.sqrt(h2), front)[0]  # wo·h = |wi + wo|/2
         p = xp.select(up, p_r * vndf, 0.0)

@@ -42,7 +42,7 @@ DISNEY_LOBES = (
         params=("sheen", "sheen_tint", "sheen_model", "sheen_roughness"),
         switches=("sheen",),
     ),
-    Lobe("specular", "glossy", highlight=True),
+    Lobe("specular", "glossy", highlight=True, params=("specular_gamma",)),
     Lobe(
         "clearcoat",
         "glossy",
@@ -162,6 +162,13 @@ def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
         "flatness": p["flatness"] if thin else 0.0,
     }
     pr["ax2"], pr["ay2"] = ax * ax, ay * ay
+    # The GTR shape of the specular lobe: 2 keeps the anisotropic GGX and visible-normal
+    # sampling; any other γ is the isotropic GTR of App. B (eq. 1) with α² = αx αy.
+    # A per-element γ (a blend of layers with different γ) takes the GTR path throughout.
+    gamma = maps.get("specular_gamma", params.specular_gamma)
+    pr["gamma"] = float(gamma) if isinstance(gamma, int | float) else xp.scalar(gamma)
+    pr["ggx"] = isinstance(gamma, int | float) and gamma == 2.0
+    pr["a2"] = ax * ay
     pr["spec_lum_a"] = luminance(a)
     r_t = p["roughness"]
     if thin:
@@ -175,8 +182,8 @@ def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
     pr["delta"] = tuple(
         k
         for k, r in (("specular", p["roughness"]), ("spec_trans", r_t))
-        if mf.is_delta(r, p["anisotropic"])
-    )
+        if mf.is_delta(r, p["anisotropic"]) and (k != "specular" or pr["ggx"])
+    )  # GTR's tails (γ < 2) carry visible energy at any α: γ ≠ 2 stays glossy, as the coat
     pr["tax2"], pr["tay2"] = pr["tax"] * pr["tax"], pr["tay"] * pr["tay"]
     weights = {
         "diffuse": pr["diffuse"],

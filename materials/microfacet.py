@@ -69,32 +69,81 @@ def gtr_norm(xp: Any, gamma: float, a2: Any) -> Any:
     return exprel(xp, log_a2) / (math.pi * exprel(xp, (1.0 - gamma) * log_a2))
 
 
-def gtr_d(xp: Any, gamma: float, a2: Any, cos2_h: Any, sin2_h: Any) -> Any:
+def log_exprel(xp: Any, x: Any) -> Any:
+    """log((eˣ − 1)/x) without overflow: max(x, 0) + log exprel(−|x|) (exprel(−|x|) ∈ (0, 1]).
+
+    exprel(x) = eˣ exprel(−x), so for x > 0 the large factor eˣ is taken as its exponent:
+    at γ = 10, α = 10⁻³ the normalisation's t = (1 − γ) log α² = 124 and e¹²⁴ overflows
+    float32 (its largest exponent is 88.7), while D itself, ≈ (γ − 1)/(π α²), is 3·10⁶.
+    """
+    pos = xp.maximum(x, 0.0)
+    return pos + xp.log(exprel(xp, x - 2.0 * pos))
+
+
+def gtr_d(xp: Any, gamma: Any, a2: Any, cos2_h: Any, sin2_h: Any) -> Any:
     """D_GTR(θh) of eq. 1 from cos²θh and sin²θh (α² cos² + sin² = 1 + (α² − 1) cos²).
 
     Taking sin²θh separately (from the half vector's x, y) keeps the peak accurate: at
     α = 10⁻³ the denominator is 10⁻⁶ and 1 − cos² would lose it in float32.
+    γ = 1 (the clearcoat) multiplies c by the power directly; any other γ forms
+    D = exp(log c − γ log(α² cos² + sin²)) (:func:`log_exprel`), because at large γ the
+    normalisation c → 0 and the power → ∞ overflow separately in float32 (γ = 10, α = 10⁻³:
+    c ≈ 10⁻⁵³, power 10⁶⁰) while their product is finite.
     """
     base = a2 * cos2_h + sin2_h
-    c = gtr_norm(xp, gamma, a2)
-    c = float(c) if isinstance(a2, float) else c  # a constant must not promote float32 arrays
-    return c * xp.exp(-gamma * xp.log(base))
+    if isinstance(gamma, float) and gamma == 1.0:
+        c = gtr_norm(xp, gamma, a2)
+        c = float(c) if isinstance(a2, float) else c  # a constant must not promote float32
+        return c * xp.exp(-gamma * xp.log(base))
+    if isinstance(a2, float) and isinstance(gamma, float):
+        log_c = _log_gtr_norm(gamma, a2)  # a Python float: must not promote float32 arrays
+    else:
+        log_a2 = xp.log(a2)
+        log_c = log_exprel(xp, log_a2) - log_exprel(xp, (1.0 - gamma) * log_a2)
+        log_c = log_c - math.log(math.pi)
+    return xp.exp(log_c - gamma * xp.log(base))
 
 
-def gtr_sample_cos2(xp: Any, gamma: float, a2: Any, xi: Any) -> Any:
+def _log_gtr_norm(gamma: float, a2: float) -> float:
+    """log c of eq. 1 for constants, in double precision (see :func:`log_exprel`)."""
+
+    def log_exprel_f(x: float) -> float:
+        if abs(x) < _SERIES:
+            return math.log1p(0.5 * x)
+        return max(x, 0.0) + math.log(-math.expm1(-abs(x)) / abs(x))
+
+    log_a2 = math.log(a2)
+    return log_exprel_f(log_a2) - log_exprel_f((1.0 - gamma) * log_a2) - math.log(math.pi)
+
+
+def gtr_sample_cos2(xp: Any, gamma: Any, a2: Any, xi: Any) -> Any:
     """cos²θh from a uniform ξ (eq. 3; eq. 5 at γ = 1, eq. 9 at γ = 2), stably.
 
     With u = 1 − ξ, eq. 3's bracket is 1 + u·expm1(t) and its power 1/(1 − γ) = L/t, so
     cos²θh = r·exprel(L r)/exprel(L) with r = log1p(u·expm1(t))/t, whose t → 0 limit is
-    u(1 + ξt/2) (eq. 5 is r = u).
+    u(1 + ξt/2) (eq. 5 is r = u). For t > 1 (γ > 1 on a sharp lobe) expm1(t) overflows
+    float32 near γ = 10 (t = 124 at α = 10⁻³), and r = 1 − s with the s of
+    :func:`gtr_sample_sin2`, which only takes e^{−t}, is used instead.
     """
     log_a2 = xp.log(a2)
     t = (1.0 - gamma) * log_a2
     u = 1.0 - xi
     small = xp.abs(t) < _SERIES
-    safe = xp.select(small, 1.0, t)
+    large = t > 1.0
+    safe = xp.select(small | large, -1.0, t)  # the first form only where it cannot overflow
     r = xp.select(small, u * (1.0 + 0.5 * xi * t), xp.log1p(u * xp.expm1(safe)) / safe)
+    r = xp.select(large, 1.0 - _sin_split(xp, t, xi, u), r)
     return xp.clip(r * exprel(xp, log_a2 * r) / exprel(xp, log_a2), 0.0, 1.0)
+
+
+def _sin_split(xp: Any, t: Any, xi: Any, u: Any) -> Any:
+    """s = 1 − r of eq. 3 (see :func:`gtr_sample_sin2`), stable for t > 0 of any size."""
+    small = xp.abs(t) < _SERIES
+    safe = xp.select(small, 1.0, t)
+    x = xi * xp.expm1(-safe)
+    log_a = xp.select(x >= -0.5, xp.log1p(x), xp.log(u + xi * xp.exp(-safe)))
+    s = xp.select(small, xi * (1.0 - 0.5 * u * t), -log_a / safe)
+    return xp.clip(s, 0.0, 1.0)  # float32 at γ > 1, α → 0: log1p(−1) = −∞ where s → 1
 
 
 def gtr_sample_sin2(xp: Any, gamma: float, a2: Any, xi: Any) -> Any:
@@ -108,14 +157,7 @@ def gtr_sample_sin2(xp: Any, gamma: float, a2: Any, xi: Any) -> Any:
     ξ = 1, 1 + ξ·expm1(−t) would cancel to e^{−t} and lose the digits of s → 1 instead.
     """
     log_a2 = xp.log(a2)
-    t = (1.0 - gamma) * log_a2
-    u = 1.0 - xi
-    small = xp.abs(t) < _SERIES
-    safe = xp.select(small, 1.0, t)
-    x = xi * xp.expm1(-safe)
-    log_a = xp.select(x >= -0.5, xp.log1p(x), xp.log(u + xi * xp.exp(-safe)))
-    s = xp.select(small, xi * (1.0 - 0.5 * u * t), -log_a / safe)
-    s = xp.clip(s, 0.0, 1.0)  # float32 at γ > 1, α → 0: log1p(−1) = −∞ where s → 1
+    s = _sin_split(xp, (1.0 - gamma) * log_a2, xi, 1.0 - xi)
     sin2 = xp.exp(log_a2 * (1.0 - s)) * s * exprel(xp, log_a2 * s) / exprel(xp, log_a2)
     return xp.clip(sin2, 0.0, 1.0)
 
@@ -126,6 +168,34 @@ def sample_gtr(xp: Any, gamma: float, a2: Any, u1: Any, u2: Any) -> Any:
     sin_t = xp.sqrt(gtr_sample_sin2(xp, gamma, a2, u2))
     phi = 2.0 * math.pi * u1
     return xp.vec3(sin_t * xp.cos(phi), sin_t * xp.sin(phi), xp.sqrt(cos2))
+
+
+def gtr_half_max_sin2(gamma: float, alpha: float) -> float:
+    """sin²θh where D_GTR(θh) falls to half its peak: the highlight's half width.
+
+    From eq. 1, D(θh)/D(0) = (α²/(α² + (1 − α²) sin²θh))^γ = ½ at
+    sin²θh = α² (2^{1/γ} − 1)/(1 − α²); infinite at α = 1 (D is flat there).
+    """
+    a2 = max(alpha, ALPHA_MIN) ** 2
+    return math.inf if a2 >= 1.0 else a2 * math.expm1(math.log(2.0) / gamma) / (1.0 - a2)
+
+
+def ggx_roughness_like_gtr(gamma: float, roughness: float) -> float:
+    """The roughness whose GGX (γ = 2) highlight is as wide as GTR γ's at ``roughness``.
+
+    Width = the half-maximum of D in θh (:func:`gtr_half_max_sin2`), the angular size
+    of the highlight seen at normal incidence (tests/materials/test_microfacet.py measures
+    it on the model's own BRDF slice). Solving GGX's half width x = α²(√2 − 1)/(1 − α²)
+    for α² gives α² = x/(√2 − 1 + x); roughness = √α. Identity at γ = 2.
+
+    >>> round(ggx_roughness_like_gtr(2.0, 0.5), 12), round(ggx_roughness_like_gtr(1.0, 0.5), 4)
+    (0.5, 0.6102)
+    """
+    if gamma == 2.0:
+        return roughness
+    x = gtr_half_max_sin2(gamma, roughness * roughness)
+    a2 = 1.0 if math.isinf(x) else x / (math.sqrt(2.0) - 1.0 + x)
+    return min(a2**0.25, 1.0)
 
 
 # -- anisotropic GTR2 = GGX (Burley App. B, eqs. 10–15; 2014 addendum) ------------------

@@ -74,6 +74,10 @@ def _unit(default: float, description: str, *, le: float | None = 1.0, ge: float
 
 SHEEN_MAX = 10.0
 """Ceiling of Disney ``sheen`` (DESIGN.md, Ranges: every parameter has a ceiling)."""
+SPECULAR_GAMMA_MAX = 10.0
+"""Ceiling of Disney ``specular_gamma``. At γ = 10 the GTR lobe is already ≈ 2.3 times narrower
+than GGX at the same roughness, and every float32 value of the lobe is finite up to it
+(``lookdev check`` sweeps it at roughness 0, where D's peak is 2.9·10⁶)."""
 SCATTER_DISTANCE_MIN = 1e-6
 SCATTER_DISTANCE_MAX = 1e6
 """Bounds of a non-zero ``scatter_distance``: σt = 1/(s·d) stays a finite float32."""
@@ -127,6 +131,14 @@ class DisneyParams(Params):
     specular_tint: float = _unit(0.0, "Tints the incident specular towards the base colour.")
     roughness: float = _unit(0.5, "Perceptual roughness; α = roughness².")
     anisotropic: float = _unit(0.0, "Aspect ratio of the specular highlight.")
+    specular_gamma: float = Field(
+        2.0,
+        gt=0.0,
+        le=SPECULAR_GAMMA_MAX,
+        description="Expert: GTR shape γ of the primary specular lobe (Burley 2012 App. B); 2 is "
+        "Burley's GGX, lower gives a longer tail, higher a tighter one. Isotropic when not 2.",
+        json_schema_extra={"texturable": False},  # it picks the lobe's sampling technique
+    )
     sheen: float = _unit(
         0.0,
         "Additional grazing lobe for cloth; may exceed 1 (Burley), up to 10: ten times the "
@@ -174,6 +186,15 @@ class DisneyParams(Params):
                 f"scatter_distance {self.scatter_distance:g} × scatter_distance_scale "
                 f"{min(self.scatter_distance_scale):g} is out of range; allowed 0 or "
                 f"[{SCATTER_DISTANCE_MIN:g}, {SCATTER_DISTANCE_MAX:g}] in every channel"
+            )
+        return self
+
+    @model_validator(mode="after")
+    def _gtr_gamma_is_isotropic(self) -> DisneyParams:
+        # Burley's App. B closes the anisotropic stretch only for γ = 2 (GGX, eq. 13).
+        if self.specular_gamma != 2.0 and self.anisotropic > 0.0:
+            raise ValueError(
+                "specular_gamma other than 2 is isotropic: set anisotropic 0 or specular_gamma 2"
             )
         return self
 

@@ -153,11 +153,14 @@ def texturable(params_type: type[Params]) -> dict[str, int]:
 
     >>> from lookdev.materials.params import DisneyParams
     >>> t = texturable(DisneyParams)
-    >>> t["base_color"], t["roughness"], "thin" in t, "sheen_model" in t
-    (3, 1, False, False)
+    >>> t["base_color"], t["roughness"], "thin" in t, "sheen_model" in t, "specular_gamma" in t
+    (3, 1, False, False, False)
     """
     out = {}
     for name, info in params_type.model_fields.items():
+        extra = info.json_schema_extra if isinstance(info.json_schema_extra, dict) else {}
+        if extra.get("texturable") is False:  # e.g. specular_gamma: a per-material choice
+            continue
         core = _core(info.annotation)
         if core is float:
             out[name] = 1

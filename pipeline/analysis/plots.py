@@ -258,6 +258,28 @@ def draw_sphere(ax: Any, image: np.ndarray, exposure: float, title: str) -> None
     ax.set_title(title, fontsize="small")
 
 
+# -- one parameter varied -------------------------------------------------------------
+def varied(hubs: Sequence[BlendedMaterial], field: str, values: Sequence[float]) -> list:
+    """Each uniform material once per value of one parameter, side by side (the columns
+    of ``lookdev plot --vary specular_gamma=1,1.5,2,3``): how one knob reshapes a lobe."""
+    out = []
+    for hub in hubs:
+        if hub.maps or hub.normal_map is not None:
+            raise PlotError(f"{hub.name} varies across its surface; --vary takes uniform presets")
+        if field not in type(hub.params).model_fields:
+            known = ", ".join(type(hub.params).model_fields)
+            raise PlotError(
+                f"{hub.name} has no parameter {field!r}; known: {known}", field="--vary"
+            )
+        for value in values:
+            try:
+                params = hub.params.replace(**{field: value})
+            except LookdevError as exc:
+                raise PlotError(str(exc), where=hub.name, field="--vary") from None
+            out.append(BlendedMaterial.of_params(params, name=f"{hub.name} {field}={value:g}"))
+    return out
+
+
 # -- figure --------------------------------------------------------------------------
 def at_uv(hub: BlendedMaterial, uv: tuple[float, float]) -> BlendedMaterial:
     """``hub`` as the uniform material it is at ``uv`` (every plot then shows that texel);

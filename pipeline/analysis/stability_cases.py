@@ -69,6 +69,15 @@ COMBINATIONS: tuple[dict[str, Any], ...] = (
     # the tangent
     {"specular": 0.6, "roughness": 0.35, "anisotropic": 0.85, "sheen": 0.5, "sheen_tint": 0.3},
     {"clearcoat": 1.0, "clearcoat_gloss": 1.0},  # α = 0.001 clearcoat
+    # the GTR γ of the specular lobe: its 0/0 at γ = 1 ± 1e-6, Burley's 2, and the ceiling
+    # 10 (whose normalisation and power overflow float32 separately), sharp and rough
+    *(
+        {"specular_gamma": g, "roughness": r, "metallic": 1.0}
+        for g in (1.0 - 1e-6, 1.0 + 1e-6, 1.5, 2.0, 3.0, 10.0)
+        for r in (0.0, 0.5, 1.0)
+    ),
+    {"specular_gamma": 1.0 - 1e-6, "specular": 1.0, "roughness": 0.3},
+    {"specular_gamma": 10.0, "spec_trans": 1.0, "roughness": 0.2},
     {"spec_trans": 1.0, "roughness": 0.0},  # smooth glass
     {"spec_trans": 1.0, "ior": 1.0, "roughness": 0.3},  # η = 1: refraction degenerates
     {"spec_trans": 1.0, "thin": True, "roughness": 0.0},

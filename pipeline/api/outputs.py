@@ -582,6 +582,7 @@ def plot(
     ibl: str | None = None,
     resolution: int = 128,
     library: Any = None,
+    vary: tuple[str, Sequence[float]] | None = None,
     uv: tuple[float, float] | None = None,
 ) -> Plot:
     """Draw materials side by side as one BRDF-explorer view (Burley §3.2) to an image.
@@ -592,6 +593,8 @@ def plot(
     ``view``: ``slice`` (f(θh, θd) at φd = 90°), ``albedo`` (directional albedo per
     channel), ``polar`` (f in the plane of incidence) or ``sphere`` (a lit sphere, also
     under ``ibl`` when given). ``path`` ends in ``.png``, ``.pdf`` or ``.svg``.
+    ``vary`` = (parameter, values) draws each material once per value
+    (``("specular_gamma", [1, 1.5, 2, 3])``).
     """
     from lookdev.pipeline.analysis import plots
 
@@ -613,6 +616,8 @@ def plot(
     hubs = [hub(m, plots.MAP_RESOLUTION, lib) for m in _materials(materials, lib)]
     if uv is not None:
         hubs = [plots.at_uv(h, uv) for h in hubs]
+    if vary is not None:  # after --uv, which makes a textured material uniform
+        hubs = plots.varied(hubs, vary[0], [float(v) for v in vary[1]])
     environment = None
     if ibl is not None:
         if view != "sphere":

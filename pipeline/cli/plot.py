@@ -67,6 +67,15 @@ def plot(
         list[Path] | None,
         typer.Option("--library", "-L", help="Extra preset folders searched before the built-ins."),
     ] = None,
+    vary: Annotated[
+        str | None,
+        typer.Option(
+            "--vary",
+            metavar="PARAM=V1,V2,…",
+            help="Draw each preset once per value of one parameter, e.g. "
+            "specular_gamma=1,1.5,2,3 (uniform presets).",
+        ),
+    ] = None,
     uv: Annotated[
         tuple[float, float] | None,
         typer.Option(
@@ -85,6 +94,7 @@ def plot(
 
       lookdev plot velvet --view sphere --ibl studio -o velvet.png --exposure -1
 
+      lookdev plot gold --vary specular_gamma=1,1.5,2,3 -o gamma.png --exposure -3
       lookdev --view Un-tone-mapped plot gold -o gold.png    # another OCIO view (global)
     """
     from lookdev.pipeline import api
@@ -98,9 +108,26 @@ def plot(
             ibl=ibl,
             resolution=resolution,
             library=library,
+            vary=_vary(vary),
             uv=uv,
         )
     if as_json:
         print_json(result.to_json())
     else:
         console.print(f"wrote {output}")
+
+
+def _vary(text: str | None) -> tuple[str, list[float]] | None:
+    """``PARAM=V1,V2,…`` → (PARAM, [V1, V2, …]); a malformed one is one error line."""
+    if text is None:
+        return None
+    from lookdev.pipeline.analysis.plots import PlotError
+
+    name, _, values = text.partition("=")
+    try:
+        numbers = [float(v) for v in values.split(",") if v.strip()]
+    except ValueError:
+        numbers = []
+    if not name.strip() or not numbers:
+        raise PlotError(f"--vary {text!r}: expected PARAM=V1,V2,… with numbers", field="--vary")
+    return name.strip(), numbers

@@ -224,9 +224,12 @@ def _plugin_class(variant: str) -> type:
             """
             if not self.force_all_lobes:
                 return {}
+            from lookdev.materials.textures import texturable
+
+            weights = texturable(self.model.params_type)  # not choices such as specular_gamma
             forced = {}
             for key, value in self.params.model_dump().items():
-                if key in self.textures or isinstance(value, bool):
+                if key in self.textures or isinstance(value, bool) or key not in weights:
                     continue
                 if isinstance(value, float):
                     forced[key] = dr.opaque(mi.Float, value)

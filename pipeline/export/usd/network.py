@@ -186,6 +186,9 @@ class Source:
     """The preset it came from, as JSON (:mod:`.record`), carried for an exact import."""
     height: Image | None = None
     """Heights in scene units (value · scale + bias of the image), for displacement."""
+    custom: dict[str, Any] = field(default_factory=dict)
+    """Values no target expresses, kept in the Material's ``customData`` (``lookdev``) for
+    the import (the GTR ``specular_gamma`` and the roughness it was authored with)."""
 
     @cached_property
     def lobes(self) -> dict[str, bool]:
@@ -202,7 +205,40 @@ class Source:
 def source_from_params(name: str, model: str, params: Any, description: str = "") -> Source:
     """A constant material's :class:`Source` (no maps)."""
     spelling = "ior" if getattr(params, "ior", None) is not None else DEFAULT_SPELLING[model]
-    return Source(name, model, canonical(params), spelling=spelling, description=description)
+    source = Source(name, model, canonical(params), spelling=spelling, description=description)
+    return gtr_as_ggx(source)
+
+
+def gtr_as_ggx(source: Source) -> Source:
+    """A Disney ``specular_gamma`` ≠ 2 (no DCC target has GTR's γ) written as the GGX
+    roughness whose highlight is as wide (half maximum of the measured slice,
+    :func:`lookdev.materials.highlight.ggx_roughness_like`), with the loss named and
+    γ and the authored roughness kept in ``customData`` for the import.
+    """
+    gamma = source.values.get("specular_gamma", 2.0) if source.model == "disney" else 2.0
+    if gamma == 2.0:
+        return source
+    rough = source.values["roughness"]
+    source.custom["specular_gamma"] = float(gamma)
+    if "roughness" in source.maps:
+        source.notes.append(
+            "its roughness map is written as it is, for GGX (γ is kept in customData)"
+        )
+        return source
+    from lookdev.materials.highlight import ggx_roughness_like
+    from lookdev.materials.params import DisneyParams
+
+    # The other parameters matter to the measured width only through F and G: the
+    # roughness and γ alone, with the Fresnel of a white metal, define the highlight.
+    lobe = DisneyParams(metallic=1.0, base_color=(1.0, 1.0, 1.0), roughness=float(rough))
+    matched = ggx_roughness_like(lobe.replace(specular_gamma=float(gamma)))
+    source.custom["roughness"] = float(rough)
+    source.values["roughness"] = matched
+    source.notes.append(
+        f"its roughness {rough:.4g} is written as the GGX roughness {matched:.4g}, whose "
+        "highlight has the same half-maximum width (γ is kept in customData)"
+    )
+    return source
 
 
 TextureFactory = Callable[[list[Node], Slot, Image], tuple[str, Any]]

@@ -282,6 +282,12 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
             result.loss.append(f"{context}: {surface.custom['loss']}")
     if not result.contexts:
         return None
+    if model == "disney" and "specular_gamma" in spec.custom:
+        # No target has GTR's γ: the writer kept it, and the roughness it was authored
+        # with (the surfaces carry the GGX roughness matched to it), in customData.
+        values["specular_gamma"] = float(spec.custom["specular_gamma"])
+        if "roughness" in spec.custom:
+            values["roughness"] = float(spec.custom["roughness"])
     _to_preset_space(values, space, result)
     result.params = _preset_params(values, model, spelling)
     return result

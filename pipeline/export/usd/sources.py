@@ -22,7 +22,7 @@ from lookdev.pipeline.blend.result import LOBE_WEIGHTS, BlendedMaterial
 
 from .live import live_stack
 from .lobes import DEFAULTS, canonical
-from .network import ExportError, Image, Source, source_from_params
+from .network import ExportError, Image, Source, gtr_as_ggx, source_from_params
 
 SUPPORTED = registry.PRESET_MODELS  # a layered Pixar blend: see weights_source
 
@@ -103,7 +103,7 @@ def baked_source(hub: BlendedMaterial, texture_dir: Path, scratch: Path) -> Sour
     height = referenced.get("height")
     if height is None and hub.height_map is not None:
         height = image("height_map", hub.height_map)
-    return Source(
+    source = Source(
         hub.name,
         hub.model,
         _constants(hub),
@@ -115,6 +115,7 @@ def baked_source(hub: BlendedMaterial, texture_dir: Path, scratch: Path) -> Sour
         live=hub.live_lobes,
         height=height,
     )
+    return gtr_as_ggx(source)
 
 
 CHANNEL_OUTPUTS: dict[Any, str] = {

@@ -55,6 +55,7 @@ def material_spec(
         "preset": source.name,
         "model": source.model,
         "spelling": source.spelling,
+        **source.custom,
     }
     networks = [
         preview.build(source, preview_opacity)

@@ -356,3 +356,24 @@ def test_clear_glass_albedo_adds_the_transmitted_share_compressed_by_eta_squared
     f0 = ((eta - 1) / (eta + 1)) ** 2  # Fresnel at normal incidence, an independent number
     assert total.albedo[0] == pytest.approx(np.full(3, f0 + (1 - f0) / eta**2), rel=0.02)
     assert P.total_curve(_preset("gold")) is None  # an opaque metal transmits nothing
+
+
+# -- one parameter varied (--vary) -------------------------------------------------------
+def test_varied_draws_one_column_per_gamma_and_lower_gamma_has_the_longer_tail():
+    from lookdev.materials.params import DisneyParams
+
+    gold = BlendedMaterial.of_params(DisneyParams(metallic=1.0, roughness=0.3), name="gold")
+    hubs = P.varied([gold], "specular_gamma", [1.0, 1.5, 2.0, 3.0])
+    assert [h.params.specular_gamma for h in hubs] == [1.0, 1.5, 2.0, 3.0]
+    assert [h.name for h in hubs][0] == "gold specular_gamma=1"
+    # the slice's tail (θh = 45°, θd = 0) falls as γ grows: GTR's shape knob (App. B)
+    tails = [P.brdf_slice(h.bsdf_model, h.params, 16)[2][0, 8, 1] for h in hubs]
+    assert tails == sorted(tails, reverse=True) and tails[0] > 3 * tails[-1]
+
+
+def test_varied_rejects_what_the_schema_rejects_in_one_line(cli, tmp_path):
+    res = cli("plot", "gold", "--vary", "specular_gamma=0", "-o", str(tmp_path / "a.png"))
+    assert res.code == 2 and "specular_gamma" in res.err and "Traceback" not in res.err
+    res = cli("plot", "gold", "--vary", "nonsense", "-o", str(tmp_path / "a.png"))
+    assert res.code == 2 and "--vary" in res.err
+    assert not list(tmp_path.iterdir())

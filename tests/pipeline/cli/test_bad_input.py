@@ -78,6 +78,11 @@ def _bounds(info):
     return lo, hi
 
 
+def _opens(info) -> str:
+    """``(`` for an open lower bound (gt, e.g. specular_gamma > 0), ``[`` for a closed one."""
+    return "(" if any(getattr(m, "gt", None) is not None for m in info.metadata) else "["
+
+
 FLOAT_FIELDS = [(s, n) for s in PRESET_SCHEMAS for n, _ in _float_fields(s)]
 
 
@@ -105,7 +110,7 @@ def test_nan_inf_and_huge_values_are_one_line_naming_field_and_range(schema, nam
     assert text.startswith(f"p.toml: {name}: ") and "\n" not in text
     if math.isfinite(bad):
         lo, hi = _bounds(schema.model_fields[name])
-        assert f"allowed [{lo:g}, {hi:g}]" in text
+        assert f"allowed {_opens(schema.model_fields[name])}{lo:g}, {hi:g}]" in text
     else:
         assert "not a finite number" in text
 

@@ -49,6 +49,10 @@ CASES = [
         "disney-ck-sheen",
         0.25,
     ),
+    # the GTR γ of the specular lobe (sampled by App. B eqs. 2–3 where γ ≠ 2)
+    ("disney", {"specular_gamma": 1.0, "roughness": 0.5}, "disney-gamma1", 0.25),
+    ("disney", {"specular_gamma": 1.5, "metallic": 1.0, "roughness": 0.5}, "disney-gamma1.5", 0.25),
+    ("disney", {"specular_gamma": 3.0, "metallic": 1.0, "roughness": 0.3}, "disney-gamma3", 0.09),
     # Pixar: "α" here is the reflection cone's half-angle in radians (10·r degrees).
     ("pixar", {"roughness": 0.0}, "pixar-r0", None),  # a delta reflection over the diffuse
     ("pixar", {"clear": 1.0, "roughness": 0.0, "ior": 1.52}, "pixar-clear-glass", None),
@@ -168,6 +172,7 @@ def test_drjit_eval_equals_numpy_eval(mi, model_name, values):
 FURNACE_CASES = [
     ("disney", {"roughness": 0.5, "base_color": [0.8, 0.4, 0.2]}, "disney-plastic"),
     ("disney", {"metallic": 1.0, "roughness": 0.2}, "disney-metal"),
+    ("disney", {"metallic": 1.0, "roughness": 0.4, "specular_gamma": 1.5}, "disney-gamma1.5"),
     ("disney", {"clearcoat": 1.0, "roughness": 0.7, "base_color": [0.2, 0.3, 0.8]}, "disney-coat"),
     ("disney", {"spec_trans": 1.0, "roughness": 0.0, "ior": 1.5}, "disney-glass"),
     ("sheen", {"roughness": 0.3, "color": [0.9, 0.5, 0.3]}, "sheen"),

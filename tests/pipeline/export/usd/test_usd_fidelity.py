@@ -17,9 +17,11 @@ from pxr import Usd  # noqa: E402
 from lookdev.materials.arrays import NumpyOps  # noqa: E402
 from lookdev.materials.bsdf import evaluate  # noqa: E402
 from lookdev.materials.fresnel import ior_to_f0  # noqa: E402
+from lookdev.materials.params import DisneyParams  # noqa: E402
 from lookdev.materials.preview_surface import MODEL, PreviewParams  # noqa: E402
 from lookdev.pipeline import api  # noqa: E402
 from lookdev.pipeline.analysis.albedo import albedo_monte_carlo  # noqa: E402
+from lookdev.pipeline.blend import BlendedMaterial  # noqa: E402
 from lookdev.pipeline.export.usd.pixar import metallic_workflow  # noqa: E402
 
 
@@ -121,14 +123,21 @@ def test_layered_pixar_metal_keeps_its_reflectance_in_the_metallic_workflow():
 
 def test_subsurface_radius_is_in_scene_units(tmp_path):
     out = tmp_path / "s.usda"
-    result = api.export_usd(["marble"], out, ("mtlx",), meters_per_unit=0.01)
+    # Burley 2012's blend: no distance
+    blend_2012 = BlendedMaterial.of_params(DisneyParams(subsurface=0.5), name="blend_2012")
+    result = api.export_usd(["marble", blend_2012], out, ("mtlx",), meters_per_unit=0.01)
     stage = Usd.Stage.Open(str(out))
     assert stage.GetMetadata("metersPerUnit") == 0.01
-    radius = stage.GetAttributeAtPath(
-        "/Materials/marble/mtlx_surface.inputs:subsurfaceDistance"
-    ).Get()
-    assert tuple(radius) == pytest.approx((0.1, 0.1, 0.1))  # 1 mm in centimetres
-    assert "1 mm" in result.losses["marble"]["mtlx"]
+
+    def radius(name):
+        path = f"/Materials/{name}/mtlx_surface.inputs:subsurfaceDistance"
+        return tuple(stage.GetAttributeAtPath(path).Get())
+
+    # marble's 0.439 mm (Jensen 2001) in centimetres
+    assert radius("marble") == pytest.approx((0.0439,) * 3, rel=1e-6)
+    assert radius("blend_2012") == pytest.approx((0.1,) * 3)  # 1 mm, named as a loss
+    assert "1 mm" in result.losses["blend_2012"]["mtlx"]
+    assert "1 mm" not in result.losses["marble"].get("mtlx", "")
 
 
 def test_frosted_glass_is_a_named_loss_in_materialx(tmp_path):

@@ -275,3 +275,18 @@ def test_foreign_specular_workflow_reads_f0_as_specular(tmp_path):
     assert "metallic" not in found.params
     got = DisneyParams.parse(found.params)
     assert got.effective_specular == pytest.approx(0.5, rel=1e-6)
+
+
+def test_specular_gamma_round_trips_through_custom_data(tmp_path):
+    # No target has GTR's γ: each surface gets the GGX roughness of the same highlight
+    # width, the loss is named, and the import gives back γ and the authored roughness.
+    params = DisneyParams(metallic=1.0, roughness=0.4, specular_gamma=3.0)
+    out = tmp_path / "gamma.usda"
+    export_usd([source_from_params("m", "disney", params)], out)
+    (found,) = import_usd(out)
+    assert found.params == {"metallic": 1.0, "roughness": 0.4, "specular_gamma": 3.0}
+    assert all("specular_gamma=3" in line and "GGX roughness" in line for line in found.loss)
+    stage = Usd.Stage.Open(str(out))
+    for node in ("preview_surface", "mtlx_surface", "ri_surface"):
+        written = stage.GetPrimAtPath(f"/Materials/m/{node}").GetAttribute("inputs:roughness")
+        assert written.Get() == pytest.approx(0.35677, abs=1e-4)  # lookdev.materials.highlight
