@@ -162,7 +162,8 @@ def split(xp: Any, pr: dict[str, Any], cos: Any, front: Any) -> tuple[Any, Any]:
             w = fr.schlick_weight(xp, cos)
             r = r + times(lum_a + (pr["spec_b"] - lum_a) * w, front)
     total = r + t
-    ok = total > 0.0
+    # A subnormal total (spec_trans = 1e-45 in float32) has no finite reciprocal: r·∞ is NaN
+    ok = total > xp.tiny
     inv = xp.select(ok, 1.0 / xp.select(ok, total, 1.0), 0.0)
     return r * inv, t * inv
 

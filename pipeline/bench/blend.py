@@ -334,7 +334,10 @@ def write_mask(path: Path, values: np.ndarray, fmt: Any = oiio.FLOAT) -> Path:
 def _random_disney(name: str, rng: np.random.Generator):
     from lookdev.library import Material
 
-    values: dict[str, Any] = {k: float(rng.uniform(0.05, 0.95)) for k in SCALARS}
+    # γ stays Burley's 2: other values are isotropic only, and anisotropic is drawn here
+    values: dict[str, Any] = {
+        k: float(rng.uniform(0.05, 0.95)) for k in SCALARS if k != "specular_gamma"
+    }
     values["base_color"] = tuple(float(x) for x in rng.uniform(0.05, 0.95, 3))
     params = DisneyParams.parse(values)
     return Material(name=name, model="disney", params=params)

@@ -611,3 +611,15 @@ def test_saturated_conty_kulla_sheen_gains_no_energy():
         wo = np.broadcast_to([np.sqrt(1 - mu * mu), 0.0, mu], (100_000, 3))
         _, weight, _ = disney.sample(p, wo, rng.random((100_000, 3)))
         assert np.all(weight.mean(axis=0) < 1.0)
+
+
+@pytest.mark.parametrize("trans", [1.4e-45, 1e-40, float(np.finfo(np.float32).tiny)])
+@pytest.mark.parametrize("thin", [False, True])
+def test_subnormal_spec_trans_samples_finite_float32(trans, thin):
+    """A subnormal glass weight: the reflect/refract odds must not divide by it (r·∞)."""
+    p = DisneyParams(roughness=0.5, spec_trans=trans, thin=thin, sheen=0.5, diff_trans=0.3)
+    rng = np.random.default_rng(0)
+    wo = rng.normal(size=(256, 3))
+    wo /= np.linalg.norm(wo, axis=1, keepdims=True)
+    _, w, pdf = disney.sample(p, wo, rng.random((256, 3)), dtype=np.float32)
+    assert np.all(np.isfinite(w)) and np.all(np.isfinite(pdf)) and np.all(pdf >= 0)

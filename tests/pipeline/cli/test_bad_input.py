@@ -511,6 +511,7 @@ def stubbed(monkeypatch, tmp_path):
 
     class Exported:
         output, materials, contexts, textures, files = Path("x.usda"), [], ["universal"], [], []
+        fidelity: dict = {}
 
         def to_json(self):
             return {}
