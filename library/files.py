@@ -309,12 +309,15 @@ class Transaction:
         final = Path(os.path.realpath(asked)) if asked.is_symlink() else asked
         sweep_temporaries(final.parent, final.name)
         tmp = _temp_name(final)
+        # Registered before it exists: a signal between the create and the registration
+        # would otherwise leave a temporary that abort() does not know of.
+        self.moves.append((tmp, final, asked))
         try:
             fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
             os.close(fd)
         except OSError as exc:
+            self.moves.pop()
             raise write_error(asked, exc) from None
-        self.moves.append((tmp, final, asked))
         return tmp
 
     def commit(self) -> None:
