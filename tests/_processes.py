@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -19,7 +20,14 @@ def spawn(code: str, *args: str, env_extra: dict[str, str] | None = None) -> sub
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=_default_sigint,
     )
+
+
+def _default_sigint() -> None:
+    # A test run started in the background (`cmd &`, nohup) ignores SIGINT, and a child
+    # inherits that: Python then installs no KeyboardInterrupt, and a Ctrl-C test is void.
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def wait_for(predicate, proc: subprocess.Popen, timeout: float) -> None:
