@@ -46,6 +46,7 @@ True
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import math
 from typing import Any
@@ -433,17 +434,7 @@ def lobe_model(*names: str) -> Model:
     def prepare_only(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
         return restrict(xp, prepare(xp, params, **maps), names)
 
-    return Model(
-        "disney[" + ",".join(names) + "]",
-        DisneyParams,
-        prepare_only,
-        eval_core,
-        pdf_core,
-        sample_core,
-        restrict,
-        DISNEY_LOBES,
-        guide_core,
-    )
+    return dataclasses.replace(MODEL, name="disney[" + ",".join(names) + "]", prepare=prepare_only)
 
 
 # -- the interior of a solid ---------------------------------------------------------------
