@@ -10,6 +10,8 @@ lambda     the Conty-Kulla Λ fit against numerical integration
 precision  float32 against float64 evaluation of every model
 denoise    equal-time curves of raw and OIDN-denoised proof frames (plastic, glass
            under sky, box filter) against a converged reference (:mod:`.denoise`)
+mainjob    the main job's old and new default frame against converged references, and
+           each frame's noise estimate against its measured error (:mod:`.quality`)
 ========== ==============================================================================
 
 Outputs: a Rich table, ``error_bench.json`` (every row, the settings and the machine)
@@ -34,10 +36,10 @@ from lookdev.materials.bsdf import Model
 from lookdev.materials.errors import LookdevError
 
 from . import denoise as denoise_bench
-from . import measure
+from . import measure, quality
 from .measure import Row
 
-ITEMS = ("render", "albedo", "lambda", "precision", "denoise")
+ITEMS = ("render", "albedo", "lambda", "precision", "denoise", "mainjob")
 
 RENDER_IBL = "studio"
 # Proof-render cases: label → built-in preset name.
@@ -65,6 +67,7 @@ class Settings:
     lambda_reference_nodes: int = 2048
     precision_pairs: int = 20000
     denoise: denoise_bench.DenoiseSettings = field(default_factory=denoise_bench.DenoiseSettings)
+    mainjob: quality.ErrorSettings = field(default_factory=quality.ErrorSettings)
 
     @classmethod
     def quick(cls) -> Settings:
@@ -80,6 +83,7 @@ class Settings:
             lambda_reference_nodes=512,
             precision_pairs=2000,
             denoise=denoise_bench.DenoiseSettings.quick(),
+            mainjob=quality.ErrorSettings.quick(),
         )
 
 
@@ -88,6 +92,7 @@ class Report:
     rows: list[Row] = field(default_factory=list)
     skipped: dict[str, str] = field(default_factory=dict)  # "item: case" → reason
     denoise: list[denoise_bench.Case] = field(default_factory=list)
+    mainjob: list[dict[str, Any]] = field(default_factory=list)  # quality.error_case each
 
     def to_json(self, settings: Settings) -> dict[str, Any]:
         return {
@@ -103,6 +108,7 @@ class Report:
             ],
             "skipped": self.skipped,
             "denoise": [case.as_json() for case in self.denoise],
+            "mainjob": self.mainjob,
         }
 
 
@@ -251,6 +257,8 @@ def run(
             )
     if "denoise" in items:
         tasks += _denoise_tasks(settings.denoise, report)
+    if "mainjob" in items:
+        tasks += quality.tasks(settings.mainjob, report)
     for done, (name, task) in enumerate(tasks):
         progress(name, done, len(tasks))
         try:
@@ -298,6 +306,8 @@ MARKERS = {
     "float32": "v",
     "raw": "o",
     "denoised": "*",
+    "old default": "s",
+    "new default": "*",
 }
 
 
@@ -363,4 +373,5 @@ ERROR_NAMES = {
     "lambda": "relative RMS error",
     "precision": "max relative error of float32",
     "denoise": "relative MSE (mean over seeds)",
+    "mainjob": "relative MSE of the frame as shown",
 }

@@ -23,6 +23,7 @@ from lookdev.pipeline.bench import (
     library,
     noise,
     proof,
+    quality,
     subsurface,
     usd,
 )
@@ -233,6 +234,15 @@ def error_(
                 f"reference {case.reference_spp} spp, its own relMSE {case.reference_floor:.2g}",
                 highlight=False,
             )
+    if report.mainjob:
+        console.print(
+            table(
+                "mainjob: old (before issue 16) and new default frames against converged "
+                "references; noise estimate vs measured: relative RMS of the raw frame",
+                quality.TABLE_COLUMNS,
+                quality.table_rows(report.mainjob),
+            )
+        )
     for what, why in report.skipped.items():
         console.print(f"[yellow]skipped[/] {what}: {why}")
     console.print(
@@ -541,6 +551,48 @@ def noise_(
     console.print(f"load average {report['load_average']}", highlight=False)
 
 
+def mainjob_(
+    presets: Annotated[
+        list[str] | None,
+        typer.Argument(help="Presets (default: the main job's seven)."),
+    ] = None,
+    ibl: Annotated[str, typer.Option("--ibl", "-i", help="IBL to time jobs under.")] = "sky",
+    quick: Annotated[bool, typer.Option("--quick", help="Tiny frames (CI, tests).")] = False,
+    as_json: JsonOut = False,
+) -> None:
+    """What each knob of the main job costs: frames, sample cap, denoising.
+
+    Each preset's proof job is replayed under --ibl (scene load, a 4 + 4 turntable at
+    480×240 rendered to the default noise target under each cap, frames written and
+    denoised, every step timed); from these, every candidate default's cost over the
+    whole main job (× 4 IBLs) as a ratio to today's (16 frames, cap 8, raw).
+    """
+    s = quality.CostSettings.quick() if quick else quality.CostSettings()
+    s = dataclasses.replace(s, presets=tuple(presets or s.presets), ibl=ibl)
+    with console.status("replaying proof jobs", spinner="dots"):
+        rows = quality.cost(s)
+    report = {
+        "settings": dataclasses.asdict(s),
+        "load_average": list(noise._load()),
+        "jobs": rows,
+        "candidates": quality.project(rows, s),
+    }
+    if as_json:
+        print_json(report)
+        return
+    cols = ["preset", "max spp", "set-up CPU s", "first frame CPU s", "steady frame CPU s",
+            "denoise CPU s/frame"]  # fmt: skip
+    console.print(table("a proof job, step by step", cols, quality.job_rows(rows)))
+    cols = ["frames", "max spp", "denoise", "wall s", "CPU s", "× today wall", "× today CPU"]
+    rows_ = [
+        [c["frames"], c["max_spp"], "on" if c["denoise"] else "off", c["wall_s"], c["cpu_s"],
+         c["over_today_wall"], c["over_today_cpu"]]
+        for c in report["candidates"]
+    ]  # fmt: skip
+    console.print(table("the main job's proofs, per candidate default", cols, rows_))
+    console.print(f"load average {report['load_average']}", highlight=False)
+
+
 def usd_(
     materials: Annotated[
         int, typer.Option("--materials", "-n", min=1, max=100_000, help="Materials per stage.")
@@ -613,6 +665,7 @@ app.command("error")(error_)
 app.command("eval")(eval_)
 app.command("glass")(glass_)
 app.command("library")(library_)
+app.command("mainjob")(mainjob_)
 app.command("noise")(noise_)
 app.command("proof")(proof_)
 app.command("subsurface")(subsurface_)
