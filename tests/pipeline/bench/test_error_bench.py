@@ -11,6 +11,7 @@ from _lambert import LAMBERT, PHONG
 
 from lookdev.pipeline.bench import error as E
 from lookdev.pipeline.bench import measure as M
+from lookdev.pipeline.bench import quality as Q
 
 TINY = E.Settings(
     render_ladder=(1, 4, 16),
@@ -23,6 +24,7 @@ TINY = E.Settings(
     lambda_nodes=(4, 16),
     lambda_reference_nodes=512,
     precision_pairs=500,
+    mainjob=Q.ErrorSettings.quick(),
 )
 
 
