@@ -366,8 +366,8 @@ def proof(
     ibls: Sequence[PathLike] | PathLike | None = None,
     out: PathLike = "proofs",
     *,
-    frames: int = 8,
-    light_frames: int = 8,
+    frames: int | None = None,
+    light_frames: int | None = None,
     spp: int | None = None,
     noise: float | None = None,
     max_spp: int | None = None,
@@ -386,7 +386,7 @@ def proof(
     progress: Callable[[Any], None] | None = None,
     context: str | None = None,
     geometry: PathLike | None = None,
-    denoise: bool = False,
+    denoise: bool | None = None,
 ) -> dict[str, Any]:
     """Render turntable proofs (Burley §6.1): every material under every IBL.
 
@@ -406,7 +406,8 @@ def proof(
     out
         The batch folder (shared with the workers when on a cluster).
     frames, light_frames, resolution, exposure
-        Element-rotation frames, lighting-rotation frames, frame size ``(width, height)``
+        Element-rotation frames, lighting-rotation frames (default
+        ``DEFAULT_FRAMES`` and ``DEFAULT_LIGHT_FRAMES``), frame size ``(width, height)``
         (default :data:`~lookdev.pipeline.proof.settings.DEFAULT_RESOLUTION`), and stops
         applied by the PNG view transform.
     spp
@@ -445,7 +446,7 @@ def proof(
         Also write every frame denoised by Intel Open Image Denoise (``pyoidn``), guided
         by albedo and normal images rendered with it, beside the raw frame
         (:mod:`lookdev.pipeline.proof.denoise`); a :class:`DenoiseError` when ``pyoidn``
-        is not installed.
+        is not installed. None: ``DEFAULT_DENOISE`` (on); False for raw frames only.
     progress
         Called with a :class:`lookdev.pipeline.proof.batch.Progress` about twice a second
         and as each proof finishes (``frames_done``, ``frames_total``, ``finished``).
@@ -469,6 +470,12 @@ def proof(
     from lookdev.pipeline.proof import ibl as ibl_module
     from lookdev.pipeline.proof import settings as proof_settings
 
+    if denoise is None:
+        denoise = proof_settings.DEFAULT_DENOISE
+    if frames is None:
+        frames = proof_settings.DEFAULT_FRAMES
+    if light_frames is None:
+        light_frames = proof_settings.DEFAULT_LIGHT_FRAMES
     settings = proof_settings.check(
         proof_settings.Settings(
             element_frames=frames,

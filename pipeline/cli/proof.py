@@ -17,7 +17,14 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
-from lookdev.pipeline.proof.settings import DEFAULT_MAX_SPP, DEFAULT_NOISE, DEFAULT_RESOLUTION
+from lookdev.pipeline.proof.settings import (
+    DEFAULT_DENOISE,
+    DEFAULT_FRAMES,
+    DEFAULT_LIGHT_FRAMES,
+    DEFAULT_MAX_SPP,
+    DEFAULT_NOISE,
+    DEFAULT_RESOLUTION,
+)
 
 from .common import console, err_console, print_json, table
 
@@ -55,10 +62,10 @@ def proof(
     ] = None,
     frames: Annotated[
         int, typer.Option("--frames", "-n", min=1, max=360, help="Element-rotation frames.")
-    ] = 8,
+    ] = DEFAULT_FRAMES,
     light_frames: Annotated[
         int, typer.Option("--light-frames", "-m", min=0, max=360, help="Lighting-rotation frames.")
-    ] = 8,
+    ] = DEFAULT_LIGHT_FRAMES,
     spp: Annotated[
         int | None,
         typer.Option(
@@ -189,12 +196,12 @@ def proof(
     denoise: Annotated[
         bool,
         typer.Option(
-            "--denoise",
+            "--denoise/--no-denoise",
             help="Also write each frame denoised by Intel Open Image Denoise (CPU, guided by "
             "albedo and normal images rendered with it): frame_NNN_denoised.exr/.png beside "
-            "the raw frame, which is kept.",
+            "the raw frame, which is kept. --no-denoise: raw frames only.",
         ),
-    ] = False,
+    ] = DEFAULT_DENOISE,
     report: Annotated[
         bool,
         typer.Option(

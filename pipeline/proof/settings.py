@@ -23,6 +23,9 @@ from .rig import DEFAULT_RIG, RIGS
 from .turntable import Frame, frames
 
 __all__ = [
+    "DEFAULT_DENOISE",
+    "DEFAULT_FRAMES",
+    "DEFAULT_LIGHT_FRAMES",
     "DEFAULT_MAX_SPP",
     "DEFAULT_NOISE",
     "DEFAULT_RESOLUTION",
@@ -36,12 +39,22 @@ __all__ = [
 
 DEFAULT_NOISE = 0.05
 """The relative-noise target of a proof when no ``spp`` is given: 5 % RMS, clean grain."""
-DEFAULT_MAX_SPP = 8
+DEFAULT_MAX_SPP = 4
 """The sample cap of a frame rendered to a noise target, unless ``max_spp`` is given.
-Chosen by measurement (README, "Noise target"; ``lookdev bench noise``): at 480×240 a cap
-of 8 keeps the main job at ≈ 1.2× the old default's time (192×96, 32 spp, Gaussian);
-16 would be ≈ 2.3×. Few frames of the main job reach 5 % within 8 spp, and their
-manifests say so (``stop: "max_spp"``); ``--max-spp`` buys the rest."""
+Chosen by measurement with the frames and denoising below (README, "How the defaults
+were chosen"; ``lookdev bench mainjob`` and ``lookdev bench error --item mainjob``).
+No frame of the main job reaches 5 % within it (their manifests say ``stop:
+"max_spp"``); ``--max-spp`` buys more."""
+DEFAULT_FRAMES = 4
+"""Element-rotation frames of a turntable (90° apart), unless ``--frames`` is given."""
+DEFAULT_LIGHT_FRAMES = 4
+"""Lighting-rotation frames (90° apart), unless ``--light-frames`` is given: with
+:data:`DEFAULT_FRAMES`, both of Burley's rotations (2012, §6.1) at the fewest frames that
+still show each quarter of the turn."""
+DEFAULT_DENOISE = True
+"""Also write every frame denoised (:mod:`.denoise`, the raw kept), unless
+``--no-denoise``: at the main job's sample counts the denoised frame's error against a
+converged reference is far lower than the raw one's at the same time (README)."""
 DEFAULT_RESOLUTION = (480, 240)
 """Frame width and height of a proof: big enough to judge a texture."""
 MIN_SIDE, MAX_SIDE = 8, 8192
@@ -75,8 +88,8 @@ class Settings:
     defaults, so a manifest always spells out what ran.
     """
 
-    element_frames: int = 8
-    light_frames: int = 8
+    element_frames: int = DEFAULT_FRAMES
+    light_frames: int = DEFAULT_LIGHT_FRAMES
     spp: int | None = None
     resolution: tuple[int, int] = DEFAULT_RESOLUTION
     exposure: float = 0.0  # display only: applied by the view transform, not the render
@@ -92,7 +105,7 @@ class Settings:
     colour: colour.Settings = field(default_factory=colour.pinned)
     """The OCIO config, working space and view the batch was asked in (workers are other
     processes, perhaps on other machines: they enter these, not their own defaults)."""
-    denoise: bool = False  # also write each frame denoised (OIDN, .denoise), the raw kept
+    denoise: bool = DEFAULT_DENOISE  # also write each frame denoised (OIDN, .denoise), raw kept
 
     def __post_init__(self) -> None:
         if self.spp is not None:

@@ -15,7 +15,7 @@ from lookdev.pipeline.proof import batch, ibl, passes, turntable
 pytestmark = pytest.mark.render
 
 NOISY = batch.Settings(
-    element_frames=1, light_frames=1, resolution=(16, 8), noise=1e-4, max_spp=4
+    element_frames=1, light_frames=1, resolution=(16, 8), noise=1e-4, max_spp=4, denoise=False
 )  # unreachable: every frame stops at max_spp
 
 
