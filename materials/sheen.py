@@ -49,14 +49,14 @@ default stays ``"fit"``: the paper's model, which MaterialX's ``sheen_bsdf``
 from __future__ import annotations
 
 import math
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 from pydantic import Field
 
 from .arrays import NumpyOps
 from .bsdf import Lobe, Model, density, draw, evaluate
-from .params import Color, Params, register_schema
+from .params import Color, Params, SheenLambda, register_schema
 from .sheen_albedo import N_MU as _N_MU
 from .sheen_albedo import N_R as _N_R
 from .sheen_albedo import VALUES as _TABLE_VALUES
@@ -71,7 +71,6 @@ R_MIN = 0.08
 """Roughness floor of the fitted Λ (below it Table 1's fit gains energy)."""
 R_MIN_EXACT = 0.01
 """Roughness floor of the exact (tabulated) Λ."""
-SheenLambda = Literal["fit", "exact"]
 COS_MIN = 1e-5
 INV_TWO_PI = 1.0 / (2.0 * math.pi)
 
