@@ -215,6 +215,42 @@ def bench_lambda(
     return rows
 
 
+SHEEN_LAMBDA_ROUGHNESS = (0.01, 0.03, 0.08, 0.3, 1.0)
+"""Down to the exact mode's floor; the fit reads r < 0.08 as 0.08 (its rows show that)."""
+
+
+def bench_sheen_lambda(
+    *, roughness: Sequence[float] = SHEEN_LAMBDA_ROUGHNESS, reference_nodes: int = 2048
+) -> list[Row]:
+    """Both modes of ``sheen_lambda``, Λ as the lobe evaluates it (the fit of eq. 3 with
+    its floor 0.08, the exact mode's table with its floor 0.01), against the converged
+    projected-area integral at the roughness asked for, and each one's run time."""
+    from lookdev.materials import sheen
+    from lookdev.pipeline.analysis.sheen_fit import lambda_integrated
+
+    modes = {"fit (eq. 3)": sheen.lambda_fit, "table": sheen.lambda_table}
+    settings = {"fit (eq. 3)": "Table 1, r ≥ 0.08", "table": "exact, r ≥ 0.01"}
+    rows = []
+    for r in roughness:
+        ref, t_ref = timed(lambda r=r: lambda_integrated(LAMBDA_COS, r, reference_nodes))
+        for method, fn in modes.items():
+            value, t = timed(lambda fn=fn, r=r: np.asarray(fn(LAMBDA_COS, r), dtype=np.float64))
+            rows.append(
+                Row(
+                    "sheen_lambda",
+                    f"r = {r:g}",
+                    method,
+                    settings[method],
+                    relative_rms(value, ref),
+                    t,
+                    len(LAMBDA_COS),
+                    f"integral {reference_nodes} nodes",
+                    t_ref,
+                )
+            )
+    return rows
+
+
 # -- float32 against float64 -----------------------------------------------------------
 def direction_pairs(n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Random (wi, wo) pairs over both hemispheres, plus the edge cases DESIGN.md lists:
