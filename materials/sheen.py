@@ -165,7 +165,18 @@ _LOG_R_SPAN = math.log(1.0 / R_MIN_EXACT)
 def area_nodes(n_theta: int, n_r: int) -> tuple[np.ndarray, np.ndarray]:
     """(cos θ, r) of the projected-area table: θ uniform in [0, π/2], log r uniform."""
     theta = np.linspace(0.0, 0.5 * math.pi, n_theta)
-    return np.cos(theta), R_MIN_EXACT * np.exp(_LOG_R_SPAN * np.linspace(0.0, 1.0, n_r))
+    return np.cos(theta), exact_roughness_nodes(n_r)
+
+
+def exact_roughness_nodes(n_r: int) -> np.ndarray:
+    """r uniform in log r from :data:`R_MIN_EXACT` to 1: the exact mode's r axis."""
+    return R_MIN_EXACT * np.exp(_LOG_R_SPAN * np.linspace(0.0, 1.0, n_r))
+
+
+def _log_r_index(xp: Any, r: Any, n_r: int) -> Any:
+    """Fractional index of r on :func:`exact_roughness_nodes` (``n_r`` of them)."""
+    r = clamp_roughness(xp, r, R_MIN_EXACT)
+    return xp.log(r * (1.0 / R_MIN_EXACT)) * ((n_r - 1) / _LOG_R_SPAN)
 
 
 def projected_area(xp: Any, cos_theta: Any, r: Any, table: np.ndarray | None = None) -> Any:
@@ -174,12 +185,7 @@ def projected_area(xp: Any, cos_theta: Any, r: Any, table: np.ndarray | None = N
     n_r, n_theta = table.shape
     theta = xp.acos(xp.clip(cos_theta, 0.0, 1.0))
     x = theta * ((n_theta - 1) / (0.5 * math.pi))
-    y = (
-        xp.log(clamp_roughness(xp, r, R_MIN_EXACT) * (1.0 / R_MIN_EXACT))
-        * ((n_r - 1) / _LOG_R_SPAN)
-        + 0.0 * x
-    )
-    return _bilinear(xp, table, x, y)
+    return _bilinear(xp, table, x, _log_r_index(xp, r, n_r) + 0.0 * x)
 
 
 def lambda_exact(xp: Any, cos_theta: Any, r: Any) -> Any:
@@ -240,10 +246,18 @@ _EXP = 0.125
 _T0 = COS_MIN**_EXP
 
 
-def table_nodes(n_mu: int, n_r: int, r_min: float = R_MIN) -> tuple[np.ndarray, np.ndarray]:
-    """(μ, r) at which an albedo table is sampled (r from ``r_min``, the mode's floor)."""
+def table_nodes(n_mu: int, n_r: int, exact: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """(μ, r) at which an albedo table is sampled.
+
+    The exact mode's r nodes are the projected-area table's (:func:`area_nodes`, log r):
+    its lobe is bilinear in log r between those nodes, with a kink at each, and an albedo
+    table whose cells straddle a kink underestimated E by 1e-3 (a gain) at 64 × 32 sqrt-r
+    nodes, against 8e-5 at 64 × 24 aligned ones (measured at the cells' midpoints).
+    """
     t = np.linspace(_T0, 1.0, n_mu)
-    return t ** (1.0 / _EXP), r_min + (1.0 - r_min) * np.linspace(0.0, 1.0, n_r) ** 2
+    if exact:
+        return t ** (1.0 / _EXP), exact_roughness_nodes(n_r)
+    return t ** (1.0 / _EXP), R_MIN + (1.0 - R_MIN) * np.linspace(0.0, 1.0, n_r) ** 2
 
 
 def _gather(xp: Any, flat: np.ndarray, index: Any) -> Any:
@@ -271,12 +285,14 @@ def _on_device(float_type: type, flat: np.ndarray) -> Any:
     return _DEVICE_TABLES[key]
 
 
-def interpolate(xp: Any, table: np.ndarray, cos_theta: Any, r: Any, r_min: float = R_MIN) -> Any:
+def interpolate(xp: Any, table: np.ndarray, cos_theta: Any, r: Any, exact: bool = False) -> Any:
     """Bilinear read of ``table`` (shape (n_r, n_mu), nodes :func:`table_nodes`)."""
     n_r, n_mu = table.shape
     mu = xp.clip(cos_theta, COS_MIN, 1.0)
     x = (xp.power(mu, _EXP) - _T0) * ((n_mu - 1) / (1.0 - _T0))
-    y = xp.sqrt((clamp_roughness(xp, r, r_min) - r_min) / (1.0 - r_min)) * (n_r - 1) + 0.0 * x
+    if exact:
+        return _bilinear(xp, table, x, _log_r_index(xp, r, n_r) + 0.0 * x)
+    y = xp.sqrt((clamp_roughness(xp, r) - R_MIN) / (1.0 - R_MIN)) * (n_r - 1) + 0.0 * x
     return _bilinear(xp, table, x, y)
 
 
@@ -297,7 +313,7 @@ def albedo_lookup(xp: Any, cos_theta: Any, r: Any, soften: bool = True, exact: b
     """E(μ, r) = ∫ f(ωi, ωo) cos θi dωi for a view at cos θo = μ (F = 1), from the table
     of the Λ mode in use (each tabulates its own lobe, from its own roughness floor)."""
     if exact:
-        return interpolate(xp, _EXACT_TABLES[int(soften)], cos_theta, r, R_MIN_EXACT)
+        return interpolate(xp, _EXACT_TABLES[int(soften)], cos_theta, r, exact=True)
     return interpolate(xp, _TABLES[int(soften)], cos_theta, r)
 
 

@@ -151,7 +151,7 @@ def build_albedo_table(
 ) -> np.ndarray:
     """E at the table's nodes (:func:`~lookdev.materials.sheen.table_nodes`), (n_r, n_mu),
     of the lobe with the fitted Λ or (``exact``) the tabulated one, from its floor."""
-    mu, r = sheen.table_nodes(n_mu, n_r, sheen.roughness_floor(exact))
+    mu, r = sheen.table_nodes(n_mu, n_r, exact)
     return np.stack([albedo_integrated(mu, rr, n=n, soften=soften, exact=exact) for rr in r])
 
 
@@ -170,12 +170,13 @@ def albedo_table_error(
     floor = sheen.roughness_floor(exact)
     mu = np.sort(np.concatenate([rng.random(n_mu - 4) ** 4, [0.0, 1e-5, 1e-3, 1.0]]))
     r = np.sort(rng.uniform(floor, 1.0, n_r))
-    if exact:  # the new floor itself, where the lobe is sharpest
-        r = np.sort(np.append(r, floor))
+    if exact:  # the floor itself, where the lobe is sharpest, and every cell's middle
+        nodes = np.log(sheen.exact_roughness_nodes(table.shape[0]))
+        r = np.sort(np.concatenate([r, [floor], np.exp(0.5 * (nodes[1:] + nodes[:-1]))]))
     mu_ref = np.maximum(mu, sheen.COS_MIN)
     ref = np.stack([albedo_integrated(mu_ref, rr, n=n, soften=soften, exact=exact) for rr in r])
     xp = NumpyOps()
-    got = sheen.interpolate(xp, table, mu[None, :], r[:, None], floor)
+    got = sheen.interpolate(xp, table, mu[None, :], r[:, None], exact)
     err = np.abs(got - ref)
     return _worst(err, err / np.maximum(ref, 1e-3), mu, r)
 
@@ -232,7 +233,7 @@ def lambda_table_error(cos_theta: Any = None, roughness: Any = None) -> FitError
 
 
 AREA_SHAPE = (64, 24)  # (θ, r) nodes of the exact Λ: chosen by area_table_error
-EXACT_TABLE_SHAPE = (64, 32)  # (μ, r) nodes of the exact mode's albedo
+EXACT_TABLE_SHAPE = (64, AREA_SHAPE[1])  # (μ, r) of the exact albedo: r nodes the area's
 
 
 def _values(a: np.ndarray) -> str:
@@ -256,7 +257,7 @@ def write_exact_module(
         "  :func:`lookdev.materials.sheen.area_nodes`; interpolated against the integral:\n"
         f"  {_indent(errors[0])}.\n"
         f"* ALBEDO: E(μ, r) without and with softening, (2, {n_r} r, {n_mu} μ) at\n"
-        "  :func:`lookdev.materials.sheen.table_nodes` from r = 0.01; against quadrature,\n"
+        "  :func:`lookdev.materials.sheen.table_nodes` (exact); against quadrature,\n"
         f"  without softening: {_indent(errors[1])};\n"
         f"  with softening: {_indent(errors[2])}.\n"
         '"""\n\n'
