@@ -206,7 +206,9 @@ def source_from_params(name: str, model: str, params: Any, description: str = ""
     """A constant material's :class:`Source` (no maps)."""
     spelling = "ior" if getattr(params, "ior", None) is not None else DEFAULT_SPELLING[model]
     source = Source(name, model, canonical(params), spelling=spelling, description=description)
-    return gtr_as_ggx(source)
+    from .sheen_lambda import exact_sheen  # it builds on this module
+
+    return exact_sheen(gtr_as_ggx(source))
 
 
 def gtr_as_ggx(source: Source) -> Source:
