@@ -232,26 +232,59 @@ def bench_sheen_lambda(
     modes = {"fit (eq. 3)": sheen.lambda_fit, "table": sheen.lambda_table}
     settings = {"fit (eq. 3)": "Table 1, r ≥ 0.08", "table": "exact, r ≥ 0.01"}
     batch = np.tile(LAMBDA_COS, 2000)
+    backends = {"numpy": modes, **_drjit_lambdas(batch)}
     rows = []
     for r in roughness:
         ref, t_ref = timed(lambda r=r: lambda_integrated(LAMBDA_COS, r, reference_nodes))
-        for method, fn in modes.items():
-            value, t = timed(lambda fn=fn, r=r: np.asarray(fn(batch, r), dtype=np.float64))
-            value = value[: len(LAMBDA_COS)]
-            rows.append(
-                Row(
-                    "sheen_lambda",
-                    f"r = {r:g}",
-                    method,
-                    settings[method],
-                    relative_rms(value, ref),
-                    t,
-                    len(batch),
-                    f"integral {reference_nodes} nodes",
-                    t_ref,
+        for backend, fns in backends.items():
+            for method, fn in fns.items():
+                value, t = timed(lambda fn=fn, r=r: np.asarray(fn(batch, r), dtype=np.float64))
+                rows.append(
+                    Row(
+                        "sheen_lambda",
+                        f"r = {r:g}",
+                        method,
+                        f"{settings[method]}, {backend}",
+                        relative_rms(value[: len(LAMBDA_COS)], ref),
+                        t,
+                        len(batch),
+                        f"integral {reference_nodes} nodes",
+                        t_ref,
+                    )
                 )
-            )
     return rows
+
+
+def _drjit_lambdas(batch: np.ndarray) -> dict[str, dict[str, Callable[..., Any]]]:
+    """Both Λ modes on the renderer's backend (Dr.Jit, float32, forced and waited for),
+    or nothing where Mitsuba is not installed."""
+    try:
+        from lookdev.pipeline.variant import use_mitsuba
+
+        use_mitsuba()
+        import drjit as dr
+    except ImportError:
+        return {}
+    from lookdev.materials import sheen
+    from lookdev.materials.arrays import DrJitOps
+
+    xp = DrJitOps.for_mitsuba()
+    cos = xp.Float(batch)
+
+    def run(fn: Callable[..., Any]) -> Callable[[np.ndarray, float], np.ndarray]:
+        def call(_: np.ndarray, r: float) -> np.ndarray:
+            out = fn(xp, cos, xp.Float(r))
+            dr.eval(out)
+            dr.sync_thread()
+            return np.asarray(out)
+
+        return call
+
+    def fit(xp: Any, c: Any, r: Any) -> Any:
+        coeffs = sheen.fit_coefficients(xp, sheen.clamp_roughness(xp, r))
+        return xp.exp(sheen.log_lambda(xp, c, coeffs))
+
+    return {"Dr.Jit": {"fit (eq. 3)": run(fit), "table": run(sheen.lambda_exact)}}
 
 
 # -- float32 against float64 -----------------------------------------------------------
