@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from lookdev.library import files
-from lookdev.materials import sheen
+from lookdev.materials import sheen, sheen_tables
 from lookdev.materials.arrays import NumpyOps
 
 
@@ -275,7 +275,7 @@ def build_exact(n: int = 96) -> tuple[np.ndarray, np.ndarray, list[FitError]]:
     """
     area = build_area_table(*AREA_SHAPE)
     errors = [area_table_error(area)]
-    shipped, sheen._AREA_TABLE = sheen._AREA_TABLE, area
+    shipped, sheen_tables._AREA_TABLE = sheen_tables._AREA_TABLE, area
     try:
         n_mu, n_r = EXACT_TABLE_SHAPE
         albedo = np.stack(
@@ -286,7 +286,7 @@ def build_exact(n: int = 96) -> tuple[np.ndarray, np.ndarray, list[FitError]]:
             for t, s in zip(albedo, (False, True), strict=True)
         ]
     finally:
-        sheen._AREA_TABLE = shipped
+        sheen_tables._AREA_TABLE = shipped
     return area, albedo, errors
 
 
