@@ -11,11 +11,11 @@ and the roughness in the Material's ``customData`` so that the import gives them
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from lookdev.materials import sheen
-
-from .network import Source
 
 __all__ = ["CARRIED", "albedo_difference", "exact_sheen"]
 
@@ -43,8 +43,10 @@ def albedo_difference(r: float | None = None) -> tuple[float, float, float]:
     return float(d[j, i]), float(_MU[i]), float(rs[j])
 
 
-def exact_sheen(source: Source) -> Source:
-    """Name the loss of a live exact-Λ sheen and carry its mode for the import."""
+def exact_sheen(source: Any) -> Any:
+    """Name the loss of a live exact-Λ sheen and carry its mode for the import.
+
+    ``source`` is a :class:`.network.Source` (not imported: network calls this)."""
     if source.model != "disney" or not source.lobes.get("conty_kulla"):
         return source
     values = source.live_values
