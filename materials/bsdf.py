@@ -65,6 +65,12 @@ class Lobe:
     switches: tuple[str, ...] = ()
     """The parameters that switch the lobe on (its own weight); none for a base lobe that
     any material has unless others take its energy (the Disney diffuse and specular)."""
+    reciprocal: bool = True
+    """f(light, viewer) = f(viewer, light), apart from the (η_viewer/η_light)² of a
+    refraction into a solid (Veach 1997 §5.2), which the model's ``prepared["eta"]``
+    carries. False for a lobe built around the view (Smits' transmitted highlights are
+    centred on the *refracted view*): a light tracer must evaluate it with the roles as
+    they are, and Mitsuba flags it ``NonSymmetric``."""
 
     @property
     def mitsuba_flag(self) -> str:

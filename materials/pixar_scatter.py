@@ -47,6 +47,7 @@ PIXAR_LOBES = (
         family="specular",
         params=("specular_t_scale", "transmission_tint", "ior"),
         switches=("clear",),
+        reciprocal=False,
     ),
     Lobe(
         "reflection_t",
@@ -56,6 +57,7 @@ PIXAR_LOBES = (
         family="reflection",
         params=("reflection_t_scale", "transmission_tint", "ior"),
         switches=("clear",),
+        reciprocal=False,
     ),
 )
 """Smits' three lobes and their transmitted twins; a lobe's ``family`` is its type in

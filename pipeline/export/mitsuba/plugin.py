@@ -201,14 +201,25 @@ def _plugin_class(variant: str) -> type:
                 extra |= flag.Anisotropic
             self.refracts = self._refracts(prepared)
             """Transmission bends the path (η ≠ 1 through a solid): non-symmetric."""
-            ns = flag.NonSymmetric if self.refracts else flag.Empty
-            non_symmetric = [flag.Empty, ns, flag.Empty, ns]
+            self.non_symmetric = self._non_symmetric(delta_lobes(prepared))
+            """Per component (0–3 as ``components``): f(l, v) ≠ f(v, l) somewhere in it."""
             self.m_components = [
-                c | extra | ns
-                for c, ns in zip(self.components, non_symmetric, strict=True)
+                c | extra | (flag.NonSymmetric if ns else flag.Empty)
+                for c, ns in zip(self.components, self.non_symmetric, strict=True)
                 if c != flag.Empty
             ]
             self.m_flags = functools.reduce(lambda a, b: a | b, self.m_components, flag.Empty)
+
+        def _non_symmetric(self, delta: tuple[str, ...]) -> list[bool]:
+            """Which of the four components is not reciprocal: the transmission of a
+            refracting solid (its η²) and any component holding a lobe the registry
+            declares non-reciprocal (:attr:`~lookdev.materials.bsdf.Lobe.reciprocal`)."""
+            out = [False, self.refracts, False, self.refracts]
+            for name in self.lobes:
+                lobe = self.model.lobe(name)
+                if not lobe.reciprocal:
+                    out[int(lobe.transmits) + 2 * (name in delta)] = True
+            return out
 
         def _placeholder(self, field: str) -> Any:
             # A texture may be non-zero somewhere: an opaque value keeps its lobe alive.
@@ -278,10 +289,22 @@ def _plugin_class(variant: str) -> type:
             # select, not ~: on scalar variants the mask is a Python bool, and ~True is -2.
             return dr.select(same_side, want_r, want_t)
 
+        def _f(self, ctx: mi.BSDFContext, prepared: Any, si_wi: Any, wo: Any) -> Any:
+            """The model's f for Mitsuba's (si.wi, wo) in the context's transport mode.
+
+            Ours is ``eval(light, viewer)``. Radiance: si.wi is the viewer, wo the light.
+            Importance (a light tracer): si.wi is where the light came from and wo leads to
+            the sensor, and Mitsuba asks for the adjoint f*(si.wi, wo) = f(light = si.wi,
+            viewer = wo) — the model evaluated with the roles as they physically are. For a
+            reciprocal model that is the same number, so only a non-symmetric BSDF pays.
+            """
+            if ctx.mode == mi.TransportMode.Importance and any(self.non_symmetric):
+                return self.model.eval(self.xp, prepared, si_wi, wo)
+            return self.model.eval(self.xp, prepared, wo, si_wi)
+
         def eval(self, ctx, si, wo, active=True):
             prepared = self._prepare(si, active)
-            f = self.model.eval(self.xp, prepared, wo, si.wi)  # ours: wi = light, wo = viewer
-            f = self._transport(ctx, prepared, si.wi.z, wo.z, f)
+            f = self._f(ctx, prepared, si.wi, wo)
             ok = active & self._hemisphere_mask(ctx, si.wi.z, wo.z)
             return dr.select(ok, self._scaled(mi.Spectrum(f) * dr.abs(wo.z)), 0.0)
 
@@ -293,8 +316,7 @@ def _plugin_class(variant: str) -> type:
 
         def eval_pdf(self, ctx, si, wo, active=True):
             prepared = self._prepare(si, active)
-            f = self.model.eval(self.xp, prepared, wo, si.wi)
-            f = self._transport(ctx, prepared, si.wi.z, wo.z, f)
+            f = self._f(ctx, prepared, si.wi, wo)
             pdf = self.model.pdf(self.xp, prepared, wo, si.wi)
             ok = active & self._hemisphere_mask(ctx, si.wi.z, wo.z)
             return (
@@ -334,8 +356,8 @@ def _plugin_class(variant: str) -> type:
             bs.sampled_component = mi.UInt32(dr.select(delta, index[1], index[0]))
             bs.sampled_type = mi.UInt32(dr.select(delta, kind[1], kind[0]))
             ok = active & (bs.pdf > 0) & dr.select(delta, enabled[1], enabled[0])
-            if self.refracts and ctx.mode == mi.TransportMode.Importance:
-                weight = self.xp.Array3(weight) * (bs.eta * bs.eta)  # see _transport
+            if ctx.mode == mi.TransportMode.Importance and any(self.non_symmetric):
+                weight = self._adjoint_weight(ctx, prepared, si, bs, weight, delta)
             value = dr.select(ok, self._scaled(mi.Spectrum(weight)), 0.0)
             bs.pdf = dr.select(ok, bs.pdf, 0.0)
             return bs, value
@@ -362,16 +384,28 @@ def _plugin_class(variant: str) -> type:
             except (TypeError, RuntimeError):
                 return True  # a texture or an opaque value: it may
 
-        def _transport(
-            self, ctx: mi.BSDFContext, prepared: Any, cos_view: mi.Float, cos_light: mi.Float, f
-        ) -> Any:
-            """f for the context's transport mode: the model's radiance f, or under
-            ``Importance`` that f times η² on a refracting pair (η = η_light/η_view side,
-            Mitsuba's ``roughdielectric``: it drops its ``sqr(inv_eta)``)."""
-            if not self.refracts or ctx.mode != mi.TransportMode.Importance:
-                return f
-            eta = self._eta(prepared, cos_view, cos_view * cos_light > 0)
-            return self.xp.Array3(f) * (eta * eta)
+        def _adjoint_weight(self, ctx, prepared, si, bs, weight, delta) -> Any:
+            """The sampled value f*(si.wi, wo)·|cos θo|/pdf of a light tracer.
+
+            The direction is drawn by the model's own sampler with si.wi in the viewer's
+            place, so its pdf is unchanged. A sample with a density takes the adjoint f of
+            :meth:`_f` over that pdf (what ``eval``/``pdf`` say, so MIS stays consistent).
+            A delta has no f to evaluate: its radiance weight times (η_wo/η_si.wi)² =
+            ``bs.eta²`` on a refraction through a solid — Mitsuba's ``dielectric`` drops
+            its ``sqr(eta_ti)`` in Importance mode — and unchanged otherwise (a mirror pair
+            has θi = θo, so every Fresnel or albedo factor of it is symmetric).
+            """
+            delta_weight = self.xp.Array3(weight)
+            if self.refracts:
+                delta_weight = delta_weight * (bs.eta * bs.eta)
+            if delta is True:
+                return delta_weight
+            f = self.xp.Array3(self._f(ctx, prepared, si.wi, bs.wo))
+            inv_pdf = dr.select(bs.pdf > 0, dr.rcp(bs.pdf), 0.0)
+            dense = f * (dr.abs(bs.wo.z) * inv_pdf)
+            if delta is False:
+                return dense
+            return dr.select(delta, delta_weight, dense)
 
         def _eta(self, prepared: Any, cos_view: mi.Float, reflected: mi.Bool) -> mi.Float:
             """Relative IOR along a sampled path (Mitsuba's Russian roulette tracks it).
