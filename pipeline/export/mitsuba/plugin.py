@@ -12,15 +12,36 @@ Conventions at the boundary, and only here (DESIGN.md, Conventions):
 * Mitsuba's ``sample`` draws the light side from ``sample1`` (lobe choice) and ``sample2``
   (direction): ``u = (sample1, sample2.x, sample2.y)``, and our sample weight
   ``f·|cos θi|/pdf`` is exactly Mitsuba's sample value.
-* Transport mode. The models describe radiance: a refraction into a medium of relative
-  index η carries the 1/η² of the solid angle's compression (Veach 1997 §5.2, the
-  non-symmetric BSDF). Under ``TransportMode.Importance`` (a light tracer such as
-  ``ptracer``) that factor is taken out again: ``eval`` and the sampled weight of a
-  refracting pair are multiplied by η², η = η(wo side)/η(si.wi side) — the ``bs.eta`` of
-  the sample. This is Mitsuba's own convention (mitsuba3 ``src/bsdfs/roughdielectric.cpp``:
-  ``scale = Radiance ? sqr(inv_eta) : 1`` in ``eval``, ``factor = Radiance ? sqr(eta_ti)
-  : 1`` in ``sample``), and like it the refracting component is flagged ``NonSymmetric``.
-  Reflection, thin sheets and η = 1 do not refract and are symmetric in both modes.
+* Transport mode. Our models describe radiance: f(light, viewer), a refraction into a
+  medium of relative index η carrying the 1/η² of the solid angle's compression (Veach 1997
+  §5.2, the non-symmetric BSDF). Under ``TransportMode.Importance`` (a light tracer such
+  as ``ptracer``) si.wi is where the light came from and wo leads to the sensor, and
+  Mitsuba asks for the adjoint f*(si.wi, wo) = f(light = si.wi, viewer = wo): the plugin
+  evaluates the model with the roles as they physically are, and a sampled direction
+  (drawn by the model's sampler with si.wi as the viewer, so the pdf is unchanged) is
+  worth that f·|cos θo|/pdf. For a radiance-form refraction this is f·η², η = η(wo
+  side)/η(si.wi side), exactly Mitsuba's convention (mitsuba3 ``roughdielectric.cpp``:
+  ``scale = Radiance ? sqr(inv_eta) : 1`` in ``eval``; ``dielectric.cpp``: ``factor =
+  Radiance ? sqr(eta_ti) : 1`` in ``sample``), but it is also right for lobes that are not
+  of that form: a Lambertian ``diff_trans`` beside the glass has no η², and Smits'
+  transmitted highlights (:mod:`lookdev.materials.pixar`) are centred on the refracted
+  view, so f(l, v) ≠ f(v, l) at any IOR (:attr:`~lookdev.materials.bsdf.Lobe.reciprocal`).
+  A delta sample has no f to evaluate: its weight takes ``bs.eta²`` on a refraction
+  through a solid, as ``dielectric`` does. A reciprocal BSDF is untouched in both modes
+  (same kernel, bit-identical values). The components holding a refraction or a
+  non-reciprocal lobe are flagged ``NonSymmetric``.
+
+  Measured (``tests/_transport_furnace.py``, which ``python tests/_transport_furnace.py``
+  prints; test ``test_mitsuba_transport.py``): white glass, η = 1.5, seen by a camera
+  *inside* it (the radiance in the glass, η² = 2.25 if lossless), ``path`` / ``ptracer``:
+  smooth 2.250 / 2.232 (``dielectric`` the same), rough 0.3 2.213 / 2.205
+  (``roughdielectric`` 2.213 / 2.206), thin 1.000 / 1.000; spec_trans 0.6 + diff_trans 0.3
+  1.415 / 1.406 (1.588 before, +12 %: the η² was applied to the Lambertian part too); the
+  Pixar glass (clear, back 1) 0.476 / 0.474 (1.265 before). Seen from outside, where
+  ``ptracer`` connects by the Importance ``eval`` of the rough transmission: 0.497 / 0.503
+  (``roughdielectric`` 0.498 / 0.498). ``ptracer`` noise there ≈ 1.1 % (32768 spp, 8×8).
+  Not exact: a *delta* transmitted Pixar lobe (cone ≤ ``CONE_MIN_DEG``) keeps its
+  radiance direction and takes η²; its true adjoint is a delta elsewhere.
 
 Delta lobes. A model may sample some lobes as Dirac deltas (smooth glass, mirrors:
 ``prepared["delta"]``, :mod:`lookdev.materials.disney_interface`). They form their own
