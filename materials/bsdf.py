@@ -68,8 +68,9 @@ class Lobe:
     reciprocal: bool = True
     """f(light, viewer) = f(viewer, light), apart from the (η_viewer/η_light)² of a
     refraction into a solid (Veach 1997 §5.2), which the model's ``prepared["eta"]``
-    carries. False for a lobe built around the view (Smits' transmitted highlights are
-    centred on the *refracted view*): a light tracer must evaluate it with the roles as
+    carries. False for a lobe that is not, for some of its parameters: Smits' transmitted
+    highlights are centred on the *refracted view*, Conty–Kulla's terminator softening
+    acts on the light side only. A light tracer evaluates such a lobe with the roles as
     they are, and Mitsuba flags it ``NonSymmetric``."""
 
     @property

@@ -317,6 +317,35 @@ def test_importance_transport_evaluates_the_adjoint(mi, model_name, values, ior)
     np.testing.assert_allclose(np.array(w_r).T[ok], weight_np[ok], rtol=2e-3, atol=2e-5)
 
 
+@pytest.mark.parametrize(
+    ("model_name", "values"),
+    [
+        ("sheen", {"color": (1.0, 1.0, 1.0), "roughness": 0.3}),
+        ("disney", {"sheen": 1.0, "sheen_model": "conty_kulla", "roughness": 0.5}),
+    ],
+    ids=["sheen", "disney-conty-kulla"],
+)
+def test_importance_transport_softens_the_sheen_terminator_on_the_light_side(
+    mi, model_name, values
+):
+    """Conty–Kulla eq. 4 softens Λ of the light direction only: not reciprocal."""
+    model, params = _case_params(model_name, values)
+    bsdf = mi.load_dict(_plugin(mi, params))
+    assert bsdf.flags(0) & mi.BSDFFlags.NonSymmetric
+    view, light, u = _both_sides(4096, 14)
+    view[:, 2], light[:, 2] = np.abs(view[:, 2]), np.abs(light[:, 2])  # reflection pairs
+    si = _interaction(mi, view)
+    wo = mi.Vector3f(light.astype(np.float32).T)
+    view32, light32 = np.array(si.wi).T, np.array(wo).T
+    cos = np.abs(light32[:, 2:3])
+    want_i = evaluate(model, params, view32, light32) * cos
+    f_i = np.array(bsdf.eval(mi.BSDFContext(mi.TransportMode.Importance), si, wo)).T
+    f_r = np.array(bsdf.eval(mi.BSDFContext(), si, wo)).T
+    scale = float(np.max(np.abs(want_i)))
+    np.testing.assert_allclose(f_i, want_i, rtol=2e-4, atol=2e-5 * scale)
+    assert np.abs(f_i - f_r).max() > 1e-2 * scale  # the softening shows at grazing light
+
+
 def test_importance_transport_weights_a_smooth_refraction_by_eta_squared(mi):
     """A delta has no f to evaluate: Mitsuba's dielectric weight, T(1 − F), in both."""
     from lookdev.pipeline.bench.glass import builtin_dict
