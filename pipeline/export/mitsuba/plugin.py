@@ -23,9 +23,11 @@ Conventions at the boundary, and only here (DESIGN.md, Conventions):
   side)/η(si.wi side), exactly Mitsuba's convention (mitsuba3 ``roughdielectric.cpp``:
   ``scale = Radiance ? sqr(inv_eta) : 1`` in ``eval``; ``dielectric.cpp``: ``factor =
   Radiance ? sqr(eta_ti) : 1`` in ``sample``), but it is also right for lobes that are not
-  of that form: a Lambertian ``diff_trans`` beside the glass has no η², and Smits'
+  of that form: a Lambertian ``diff_trans`` beside the glass has no η², Smits'
   transmitted highlights (:mod:`lookdev.materials.pixar`) are centred on the refracted
-  view, so f(l, v) ≠ f(v, l) at any IOR (:attr:`~lookdev.materials.bsdf.Lobe.reciprocal`).
+  view, so f(l, v) ≠ f(v, l) at any IOR, and Conty–Kulla's terminator softening
+  (:mod:`lookdev.materials.sheen`) acts on the light side only
+  (:attr:`~lookdev.materials.bsdf.Lobe.reciprocal`).
   A delta sample has no f to evaluate: its weight takes ``bs.eta²`` on a refraction
   through a solid, as ``dielectric`` does. A reciprocal BSDF is untouched in both modes
   (same kernel, bit-identical values). The components holding a refraction or a
@@ -40,6 +42,8 @@ Conventions at the boundary, and only here (DESIGN.md, Conventions):
   Pixar glass (clear, back 1) 0.476 / 0.474 (1.265 before). Seen from outside, where
   ``ptracer`` connects by the Importance ``eval`` of the rough transmission: 0.497 / 0.503
   (``roughdielectric`` 0.498 / 0.498). ``ptracer`` noise there ≈ 1.1 % (32768 spp, 8×8).
+  The sheen's softening changes only grazing light: a white sheen ball agrees either way
+  (0.078 / 0.078), which is why its test is on ``eval`` (``test_mitsuba_models.py``).
   Not exact: a *delta* transmitted Pixar lobe (cone ≤ ``CONE_MIN_DEG``) keeps its
   radiance direction and takes η²; its true adjoint is a delta elsewhere.
 
