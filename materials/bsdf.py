@@ -39,6 +39,9 @@ import numpy as np
 
 from .arrays import NumpyOps, from_channel_first, to_channel_first
 
+ADJOINT = "adjoint"
+"""Key of a prepared material: sample the delta lobes' adjoint (see :class:`Model`)."""
+
 
 @dataclass(frozen=True)
 class Lobe:
@@ -93,6 +96,13 @@ class Model:
     ``restrict(xp, prepared, names)`` limits a prepared material to some of its lobes:
     a material whose lobe groups have their own shading normals renders as two
     restricted halves (:mod:`lookdev.pipeline.export.mitsuba.normals`).
+
+    ``prepared[ADJOINT]`` (set by a light tracer's adapter, Mitsuba's Importance mode)
+    asks ``sample`` for the *adjoint* of its delta lobes: given where the light comes
+    from (in the viewer's argument), the direction towards the viewer and the weight
+    f(light, viewer)·|cos|/pdf (Veach 1997 §3.7). A delta has no f the adapter could
+    evaluate, so only the model knows it; lobes with a density are unchanged (the
+    adapter weights them by ``eval`` with the roles swapped).
     """
 
     name: str

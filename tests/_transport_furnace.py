@@ -44,6 +44,9 @@ def cases() -> dict[str, tuple[Any, str]]:
     pixar = model_named("pixar").params_type.parse(
         {"clear": 1.0, "back": 1.0, "roughness": 0.6, "ior": 1.5}
     )
+    pixar_clear = model_named("pixar").params_type.parse(
+        {"surface_color": (1.0, 1.0, 1.0), "roughness": 0.0, "clear": 1.0, "ior": 1.52}
+    )  # the preset pixar_clear_glass: a delta transmitted lobe
     mixed = glass.replace(spec_trans=0.6, diff_trans=0.3, roughness=0.3)
     return {
         "smooth": (glass, "inside"),
@@ -54,6 +57,7 @@ def cases() -> dict[str, tuple[Any, str]]:
         "mixed-outside": (mixed, "outside"),
         "pixar": (pixar, "inside"),
         "pixar-outside": (pixar, "outside"),
+        "pixar-clear": (pixar_clear, "inside"),
     }
 
 

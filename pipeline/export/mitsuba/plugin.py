@@ -73,7 +73,7 @@ from typing import Any
 import numpy as np
 
 from lookdev.materials.arrays import DrJitOps
-from lookdev.materials.bsdf import Model
+from lookdev.materials.bsdf import ADJOINT, Model
 from lookdev.materials.errors import LookdevError
 from lookdev.materials.guides import guide_albedo
 from lookdev.materials.registry import is_color_field
@@ -351,6 +351,9 @@ def _plugin_class(variant: str) -> type:
 
         def sample(self, ctx, si, sample1, sample2, active=True):
             prepared = self._prepare(si, active)
+            adjoint = ctx.mode == mi.TransportMode.Importance and any(self.non_symmetric)
+            if adjoint and isinstance(prepared, dict):
+                prepared = {**prepared, ADJOINT: True}  # the model's deltas, adjoint
             u = self.xp.vec3(sample1, sample2.x, sample2.y)
             wi, weight, pdf, delta = self.model.sample(self.xp, prepared, si.wi, u)
             bs = dr.zeros(mi.BSDFSample3f)
@@ -381,7 +384,7 @@ def _plugin_class(variant: str) -> type:
             bs.sampled_component = mi.UInt32(dr.select(delta, index[1], index[0]))
             bs.sampled_type = mi.UInt32(dr.select(delta, kind[1], kind[0]))
             ok = active & (bs.pdf > 0) & dr.select(delta, enabled[1], enabled[0])
-            if ctx.mode == mi.TransportMode.Importance and any(self.non_symmetric):
+            if adjoint:
                 weight = self._adjoint_weight(ctx, prepared, si, bs, weight, delta)
             value = dr.select(ok, self._scaled(mi.Spectrum(weight)), 0.0)
             bs.pdf = dr.select(ok, bs.pdf, 0.0)
@@ -413,24 +416,19 @@ def _plugin_class(variant: str) -> type:
             """The sampled value f*(si.wi, wo)·|cos θo|/pdf of a light tracer.
 
             The direction is drawn by the model's own sampler with si.wi in the viewer's
-            place, so its pdf is unchanged. A sample with a density takes the adjoint f of
-            :meth:`_f` over that pdf (what ``eval``/``pdf`` say, so MIS stays consistent).
-            A delta has no f to evaluate: its radiance weight times (η_wo/η_si.wi)² =
-            ``bs.eta²`` on a refraction through a solid — Mitsuba's ``dielectric`` drops
-            its ``sqr(eta_ti)`` in Importance mode — and unchanged otherwise (a mirror pair
-            has θi = θo, so every Fresnel or albedo factor of it is symmetric).
+            place, so the pdf of a sample with a density is unchanged, and its value is
+            the adjoint f of :meth:`_f` over that pdf (what ``eval``/``pdf`` say, so MIS
+            stays consistent). A delta has no f to evaluate: the model, asked through
+            ``prepared[ADJOINT]``, returned its adjoint direction and weight itself.
             """
-            delta_weight = self.xp.Array3(weight)
-            if self.refracts:
-                delta_weight = delta_weight * (bs.eta * bs.eta)
             if delta is True:
-                return delta_weight
+                return weight
             f = self.xp.Array3(self._f(ctx, prepared, si.wi, bs.wo))
             inv_pdf = dr.select(bs.pdf > 0, dr.rcp(bs.pdf), 0.0)
             dense = f * (dr.abs(bs.wo.z) * inv_pdf)
             if delta is False:
                 return dense
-            return dr.select(delta, delta_weight, dense)
+            return dr.select(delta, self.xp.Array3(weight), dense)
 
         def _eta(self, prepared: Any, cos_view: mi.Float, reflected: mi.Bool) -> mi.Float:
             """Relative IOR along a sampled path (Mitsuba's Russian roulette tracks it).
