@@ -303,6 +303,7 @@ SHEEN_LOBES = (
         "sheen",
         "glossy",
         params=("color", "roughness", "terminator_softening", "sheen_lambda"),
+        reciprocal=False,  # with terminator_softening (eq. 4, the default)
     ),
 )
 
