@@ -46,6 +46,7 @@ __all__ = [
     "has_interior",
     "interior",
     "scatter_distances",
+    "split_distances",
 ]
 
 MM = 1e-3
@@ -78,6 +79,21 @@ def has_interior(params: Any) -> bool:
 def scatter_distances(params: Any) -> np.ndarray:
     """d per channel (scene units): ``scatter_distance · scatter_distance_scale``."""
     return params.scatter_distance * np.asarray(params.scatter_distance_scale, dtype=np.float64)
+
+
+def split_distances(rgb: Any) -> tuple[float, tuple[float, float, float]]:
+    """(``scatter_distance``, ``scatter_distance_scale``) of a per-channel distance: the
+    inverse of :func:`scatter_distances` (the largest channel, and each over it), as a DCC's
+    RGB radius is read back. All-zero is no distance, scale white.
+
+    >>> split_distances((0.002, 0.001, 0.0005))
+    (0.002, (1.0, 0.5, 0.25))
+    """
+    d = np.broadcast_to(np.asarray(rgb, dtype=np.float64), (3,))
+    top = float(d.max())
+    if not top > 0.0:
+        return 0.0, (1.0, 1.0, 1.0)
+    return top, tuple(float(x) for x in np.clip(d / top, 0.0, 1.0))
 
 
 def interior(params: Any, meters_per_unit: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
