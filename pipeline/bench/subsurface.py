@@ -3,8 +3,8 @@
 * :func:`slab` — a thick slab of a solid subsurface material (a 100 × 100 × 2 box of
   scatter distance 0.02, so ≥ 50 σt⁻¹ deep and wide) under a uniform white sky, seen
   straight down by an orthographic camera: the radiance it sends up is its directional
-  albedo at normal incidence, to be compared with its base colour (the claim of Chiang,
-  Kutz & Burley 2016's albedo inversion, :mod:`lookdev.materials.subsurface`). Specular
+  albedo at normal incidence, to be compared with its base colour (the claim of the
+  slab albedo table, :data:`lookdev.materials.subsurface.SLAB_TABLE`). Specular
   and roughness 0, so the surface adds nothing but the entry into the medium.
 * :func:`furnace` — a white solid subsurface sphere in a uniform white sky (≤ 1).
 * :func:`rim_glow` — the proof cup lit from behind: the radiance of its thin rim with
@@ -20,7 +20,16 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["COLOURS", "cost", "furnace", "rim_glow", "run", "slab"]
+__all__ = [
+    "COLOURS",
+    "albedo_table",
+    "cost",
+    "furnace",
+    "rim_glow",
+    "run",
+    "slab",
+    "slab_of_albedo",
+]
 
 COLOURS = {"grey": (0.5, 0.5, 0.5), "skin": (0.8, 0.5, 0.35), "jade": (0.3, 0.6, 0.4)}
 """The three colours whose slabs are measured (a grey, a warm and a cool one)."""
@@ -56,15 +65,24 @@ def slab(
 ) -> tuple[np.ndarray, np.ndarray]:
     """The thick slab's rendered directional albedo (RGB) at normal incidence, and the
     standard error of that mean (from the spread of its independent pixels)."""
-    mi = _variant()
+    _variant()
 
     from lookdev.materials.params import DisneyParams
     from lookdev.pipeline.export.mitsuba import bsdf_dict
-    from lookdev.pipeline.export.mitsuba.medium import integrator, interior_dict
+    from lookdev.pipeline.export.mitsuba.medium import interior_dict
 
     p = DisneyParams(base_color=colour, specular=0.0, roughness=0.0, scatter_distance=SLAB_DISTANCE)
     medium = interior_dict(p)
-    scene = {
+    return _mean_and_error(
+        _render(_slab_scene(bsdf_dict(p), medium, spp, size), spp).reshape(-1, 3)
+    )
+
+
+def _slab_scene(bsdf: dict, medium: dict, spp: int, size: int) -> dict[str, Any]:
+    mi = _variant()
+    from lookdev.pipeline.export.mitsuba.medium import integrator
+
+    return {
         "type": "scene",
         "integrator": integrator(SLAB_DEPTH, medium),
         "sensor": {
@@ -79,11 +97,50 @@ def slab(
         "slab": {
             "type": "cube",
             "to_world": mi.ScalarTransform4f().scale([50, 50, 1]),
-            "bsdf": bsdf_dict(p),
+            "bsdf": bsdf,
             "interior": medium,
         },
     }
+
+
+def slab_of_albedo(
+    albedo: tuple[float, float, float], *, spp: int = 256, size: int = 16
+) -> tuple[np.ndarray, np.ndarray]:
+    """The thick slab's rendered reflectance (RGB) and its standard error for a medium of
+    single-scattering ``albedo`` per channel: the slab of :func:`slab` with its medium's
+    albedo set directly and σt that of a grey 0.5 in every channel (the slab is hundreds
+    of mean free paths deep whatever σt, so the reflectance depends on the albedo alone)."""
+    from lookdev.materials.params import DisneyParams
+    from lookdev.pipeline.export.mitsuba import bsdf_dict
+    from lookdev.pipeline.export.mitsuba.medium import interior_dict
+
+    grey = (0.5, 0.5, 0.5)  # one σt for all channels: no channel's free flight reweighted
+    p = DisneyParams(base_color=grey, specular=0.0, roughness=0.0, scatter_distance=SLAB_DISTANCE)
+    medium = interior_dict(p)
+    medium["albedo"] = {"type": "rgb", "value": [float(a) for a in albedo]}
+    scene = _slab_scene(bsdf_dict(p), medium, spp, size)
     return _mean_and_error(_render(scene, spp).reshape(-1, 3))
+
+
+def albedo_table(
+    roots: Any = None, *, spp: int = 256, size: int = 32
+) -> tuple[tuple[float, float], ...]:
+    """(rendered slab reflectance A, albedo α) rows of our own thick slab, for the table
+    :data:`lookdev.materials.subsurface.SLAB_TABLE`: α = 1 − u² over ``roots`` u (three
+    per render, one per channel), plus the exact ends (0, 0). Rows sorted by α; a noisy
+    non-increasing A is kept as rendered (the test bounds it by the standard error).
+    """
+    if roots is None:
+        roots = (*np.linspace(1.0, 0.1, 28)[1:], 0.08, 0.06, 0.045, 0.03, 0.02, 0.014, 0.01)
+        roots = (*roots, 0.005, 0.0)
+    u = np.asarray(roots, dtype=np.float64)
+    u = np.concatenate([u, np.full((-len(u)) % 3, u[-1])])  # whole renders of three
+    rows = {0.0: 0.0}
+    for chunk in u.reshape(-1, 3):
+        alpha = 1.0 - chunk * chunk
+        got, _ = slab_of_albedo(tuple(alpha), spp=spp, size=size)
+        rows.update({float(a): float(r) for a, r in zip(alpha, got, strict=True)})
+    return tuple((rows[a], a) for a in sorted(rows))
 
 
 def furnace(
@@ -208,7 +265,7 @@ def run(*, spp: int = 64, presets: tuple[str, ...] = ("skin", "jade")) -> dict[s
                        "error": (got - np.asarray(colour)).tolist(),
                        "standard_error": std.tolist()}  # fmt: skip
     return {
-        "mapping": "Chiang, Kutz & Burley 2016 albedo inversion, s of Christensen-Burley 2015",
+        "mapping": "albedo from our own slab table (SLAB_TABLE), s of Christensen-Burley 2015",
         "slab": slabs,
         "furnace": dict(zip(("mean", "standard_error"), furnace(spp=2 * spp), strict=True)),
         "rim": {name: rim_glow(name, spp=spp) for name in presets},
