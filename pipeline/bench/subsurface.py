@@ -6,7 +6,9 @@
   albedo at normal incidence, to be compared with its base colour (the claim of the
   slab albedo table, :data:`lookdev.materials.subsurface.SLAB_TABLE`). Specular
   and roughness 0, so the surface adds nothing but the entry into the medium.
-* :func:`furnace` — a white solid subsurface sphere in a uniform white sky (≤ 1).
+* :func:`furnace` — a white solid subsurface sphere in a uniform white sky (≤ 1 at
+  roughness 0; rougher, Burley's retro-reflection adds energy on the surface by design,
+  less than it adds to the same sphere without a distance).
 * :func:`rim_glow` — the proof cup lit from behind: the radiance of its thin rim with
   the material's scatter distance against the same preset without one.
 * :func:`cost` — a proof's render time and noise with the medium against the same preset
@@ -292,7 +294,15 @@ def run(
     return {
         "mapping": "albedo from our own slab table (SLAB_TABLE), s of Christensen-Burley 2015",
         "slab": slabs,
-        "furnace": dict(zip(("mean", "standard_error"), furnace(spp=2 * spp), strict=True)),
+        # roughness 0: the medium and its boundary alone (≤ 1); 0.5: with Burley's
+        # retro-reflection on the surface, which adds energy by design (see the opaque)
+        "furnace": dict(
+            zip(("mean", "standard_error"), furnace(roughness=0.0, spp=2 * spp), strict=True)
+        ),
+        "furnace_rough": {
+            "with": furnace(roughness=0.5, spp=2 * spp)[0],
+            "without": furnace(scatter_distance=0.0, roughness=0.5, spp=2 * spp)[0],
+        },
         "rim": {name: rim_glow(name, spp=spp) for name in rims},
         "cost": {name: cost(name, spp=max(spp // 4, 4)) for name in presets},
     }
