@@ -14,6 +14,7 @@ import pytest
 pytest.importorskip("pxr")
 from pxr import Usd  # noqa: E402
 
+import lookdev  # noqa: E402
 from lookdev.materials.arrays import NumpyOps  # noqa: E402
 from lookdev.materials.bsdf import evaluate  # noqa: E402
 from lookdev.materials.fresnel import ior_to_f0  # noqa: E402
@@ -133,9 +134,8 @@ def test_subsurface_radius_is_in_scene_units(tmp_path):
         path = f"/Materials/{name}/mtlx_surface.inputs:subsurfaceDistance"
         return tuple(stage.GetAttributeAtPath(path).Get())
 
-    # marble's 0.439 mm (Jensen 2001) in centimetres, per channel (× its scale)
-    scale = (1.0, 0.842, 0.737)
-    assert radius("marble") == pytest.approx([0.0439 * s for s in scale], rel=1e-6)
+    # marble's distance (Jensen 2001, ≈ 0.42 mm) in centimetres, per channel (× its scale)
+    assert radius("marble") == pytest.approx(_radius_cm("marble"), rel=1e-6)
     assert radius("blend_2012") == pytest.approx((0.1,) * 3)  # 1 mm, named as a loss
     assert "1 mm" in result.losses["blend_2012"]["mtlx"]
     assert "1 mm" not in result.losses["marble"].get("mtlx", "")
@@ -192,6 +192,11 @@ def test_proof_context_universal_renders_both(cli, tmp_path):
     assert names == {"gold", "gold-universal"}
 
 
+def _radius_cm(name: str) -> list[float]:
+    params = lookdev.load(name).params
+    return [100.0 * params.scatter_distance * s for s in params.scatter_distance_scale]
+
+
 def _inputs(stage, name, shader):
     prim = stage.GetPrimAtPath(f"/Materials/{name}/{shader}")
     return {a.GetName().split(":", 1)[1]: a.Get() for a in prim.GetAttributes()
@@ -205,14 +210,15 @@ def test_a_solid_with_a_distance_exports_a_scattering_subsurface(tmp_path):
     out = tmp_path / "s.usda"
     result = api.export_usd(["skin"], out, ("universal", "mtlx", "ri"), meters_per_unit=0.01)
     stage = Usd.Stage.Open(str(out))
-    radius = [0.093 * s for s in (1.0, 0.484, 0.262)]  # 0.93 mm × scale, in centimetres
+    radius = _radius_cm("skin")  # ≈ 0.86 mm × (1, 0.49, 0.27), in centimetres
     mtlx = _inputs(stage, "skin", "mtlx_surface")
     assert mtlx["subsurface"] == 1.0
     assert tuple(mtlx["subsurfaceDistance"]) == pytest.approx(radius, rel=1e-6)
     ri = _inputs(stage, "skin", "ri_surface")
     assert ri["subsurface"] == 1.0
     assert tuple(ri["scatterDistances"]) == pytest.approx(radius, rel=1e-6)
-    assert tuple(ri["subsurfaceColor"]) == pytest.approx((0.62, 0.385, 0.24), rel=1e-6)
+    skin = lookdev.load("skin").params
+    assert tuple(ri["subsurfaceColor"]) == pytest.approx(skin.base_color, rel=1e-6)
     # The per-channel distance is expressed: no loss names it, but the preview has none.
     for context in ("mtlx", "ri"):
         assert "scatter_distance" not in result.losses["skin"].get(context, "")
