@@ -439,27 +439,6 @@ def lobe_model(*names: str) -> Model:
     return dataclasses.replace(MODEL, name="disney[" + ",".join(names) + "]", prepare=prepare_only)
 
 
-# -- the interior of a solid ---------------------------------------------------------------
-def medium_coefficients(xp: Any, color: Any, scatter_distance: Any) -> tuple[Any, Any]:
-    """(σt, single-scattering albedo) of the isotropic medium inside a solid transmissive
-    material whose apparent colour ``color`` appears at mean free path ``scatter_distance``.
-
-    Burley 2015 (after Christensen & Burley's fit, as in Schutte's CalculateExtinction):
-    s = 1.9 − A + 3.5 (A − 0.8)², σt = 1 / (s·d), albedo = 1 − exp(−5.09406 A
-    + 2.61188 A² − 4.31805 A³). ``scatter_distance`` 0 means no medium (σt = ∞): the BSDF
-    itself never needs it; the renderer's interior medium does.
-
-    >>> from .arrays import NumpyOps
-    >>> sigma_t, albedo = medium_coefficients(NumpyOps(), (0.8, 0.8, 0.8), 0.5)
-    >>> [round(float(v), 4) for v in sigma_t[:, 0]], round(float(albedo[0, 0]), 4)
-    ([1.8182, 1.8182, 1.8182], 0.9901)
-    """
-    a = xp.color(color)
-    s = 1.9 - a + 3.5 * (a - 0.8) * (a - 0.8)
-    albedo = 1.0 - xp.exp(a * (-5.09406 + a * (2.61188 - 4.31805 * a)))
-    return 1.0 / (s * scatter_distance), albedo
-
-
 # -- public numpy API --------------------------------------------------------------------
 def eval(params: DisneyParams, wi: Any, wo: Any, **kw: Any) -> Any:  # noqa: A001
     """f(wi, wo) without the cosine, shape (..., 3); wi towards the light, wo the viewer."""

@@ -599,7 +599,12 @@ def subsurface_(
     cols = ["slab", "R", "G", "B", "ΔR", "ΔG", "ΔB", "± (1σ)"]
     console.print(table(f"thick slab ({r['mapping']})", cols, rows))
     f = r["furnace"]
-    console.print(f"white furnace: {f['mean']:.4f} ± {f['standard_error']:.4f} (≤ 1)")
+    console.print(f"white furnace, roughness 0: {f['mean']:.4f} ± {f['standard_error']:.4f} (≤ 1)")
+    f = r["furnace_rough"]
+    console.print(
+        f"white furnace, roughness 0.5: {f['with']:.4f}, without a distance {f['without']:.4f}"
+        " (Burley's retro-reflection adds energy by design)"
+    )
     rows = [[k, v["with"], v["without"], v["ratio"]] for k, v in r["rim"].items()]
     console.print(table("cup rim under back light", ["preset", "with", "without", "×"], rows))
     rows = [[k, v["time_ratio"], v["equal_noise_ratio"]] for k, v in r["cost"].items()]

@@ -15,6 +15,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -23,7 +24,7 @@ from lookdev.materials import registry
 from lookdev.materials.errors import LookdevError
 
 from .lobes import DEFAULTS, REGISTRY_MODEL, active_lobes, canonical, effective
-from .names import Slot
+from .names import SUBSURFACE_WEIGHT, Slot
 from .sheen_lambda import exact_sheen
 
 CONTEXT_OUTPUT = {"universal": "surface", "mtlx": "mtlx:surface", "ri": "ri:surface"}
@@ -303,24 +304,48 @@ def local_subsurface(source: Source) -> bool:
 def subsurface_radius(
     source: Source, inputs: dict[str, tuple[str, Any]], name: str, meters_per_unit: float
 ) -> str:
-    """Write the subsurface/scatter radius input ``name`` in the stage's units; the
-    sentence naming what that changes, or ``""``.
+    """Write a Disney target's subsurface: the radius input ``name`` in the stage's units
+    and, for a solid's interior, the weight; the sentence naming what that loses, or ``""``.
 
-    ``scatter_distance`` (metres, :data:`UNIT`) ÷ ``metersPerUnit``; where only the 2012
-    subsurface is live (no distance given), :data:`LOCAL_SUBSURFACE_M` instead.
+    A solid with a scatter distance (Burley 2015, :mod:`lookdev.materials.subsurface`)
+    sends its whole diffuse into its interior medium, as ND_disney_principled and
+    PxrDisneyBsdf do at ``subsurface`` 1 (they mix diffuse and subsurface by it), so the
+    weight is written 1 whatever the preset's 2012 ``subsurface`` (which the model then
+    ignores); the radius is ``scatter_distance · scatter_distance_scale`` per channel
+    (metres, :data:`UNIT`) ÷ ``metersPerUnit``. Where only the 2012 subsurface is live
+    (no distance given), :data:`LOCAL_SUBSURFACE_M` instead.
     """
+    from lookdev.materials.subsurface import scatter_distances
+
     lobes = source.lobes
+    lost = []
+    if lobes.get("scatter"):
+        inputs[SUBSURFACE_WEIGHT] = ("float", 1.0)
+        if lobes.get("spec_trans"):
+            lost.append(
+                f"the glass (spec_trans) enters no medium there: {name} scatters the diffuse only"
+            )
     if "scatter_distance" in source.maps:
         if meters_per_unit != 1.0:
-            return (
+            lost.append(
                 f"{name} is the scatter_distance map in metres, not scaled to "
                 f"metersPerUnit {meters_per_unit:g}"
             )
-        return ""
+        scale = source.live_values["scatter_distance_scale"]
+        if "scatter_distance_scale" in source.maps or len(set(scale)) > 1:
+            lost.append(f"{name} is the scatter_distance map, grey: no scatter_distance_scale")
+        return "; ".join(lost)
     if lobes.get("scatter"):
-        d = source.live_values["scatter_distance"] / meters_per_unit
-        inputs[name] = ("color3f", (d, d, d))
-        return ""
+        values = source.live_values
+        if "scatter_distance_scale" in source.maps:
+            lost.append(f"{name} takes the mean of the scatter_distance_scale map")
+        params = SimpleNamespace(
+            scatter_distance=values["scatter_distance"],
+            scatter_distance_scale=values["scatter_distance_scale"],
+        )
+        radius = scatter_distances(params) / meters_per_unit
+        inputs[name] = ("color3f", tuple(float(x) for x in radius))
+        return "; ".join(lost)
     if local_subsurface(source):
         d = LOCAL_SUBSURFACE_M / meters_per_unit
         inputs[name] = ("color3f", (d, d, d))
