@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from . import energy
 from . import fresnel as fr
 from . import microfacet as mf
 from .bsdf import Lobe
@@ -42,7 +43,7 @@ DISNEY_LOBES = (
         params=("sheen", "sheen_tint", "sheen_model", "sheen_roughness"),
         switches=("sheen",),
     ),
-    Lobe("specular", "glossy", highlight=True, params=("specular_gamma",)),
+    Lobe("specular", "glossy", highlight=True, params=("specular_gamma", "energy_compensation")),
     Lobe(
         "clearcoat",
         "glossy",
@@ -169,6 +170,11 @@ def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
     pr["gamma"] = float(gamma) if isinstance(gamma, int | float) else xp.scalar(gamma)
     pr["ggx"] = isinstance(gamma, int | float) and gamma == 2.0
     pr["a2"] = ax * ay
+    # Turquin 2019 multiple-scattering factor of the specular lobe (:mod:`.energy`).
+    pr["energy"] = energy.compensated(params, pr["ggx"])
+    if pr["energy"]:
+        pr["energy_r"] = energy.table_roughness(xp, ax, ay)
+        pr["energy_f0"] = energy.f0_of(xp, pr)
     pr["spec_lum_a"] = luminance(a)
     r_t = p["roughness"]
     if thin:

@@ -53,6 +53,7 @@ from .params import Color, Params, register_schema
 from .sheen_albedo import N_MU as _N_MU
 from .sheen_albedo import N_R as _N_R
 from .sheen_albedo import VALUES as _TABLE_VALUES
+from .tables import bilinear
 
 R_MIN = 0.08
 COS_MIN = 1e-5
@@ -168,45 +169,13 @@ def table_nodes(n_mu: int, n_r: int) -> tuple[np.ndarray, np.ndarray]:
     return t ** (1.0 / _EXP), R_MIN + (1.0 - R_MIN) * np.linspace(0.0, 1.0, n_r) ** 2
 
 
-def _gather(xp: Any, flat: np.ndarray, index: Any) -> Any:
-    """``flat[index]`` for an index of any backend (integral values held as floats)."""
-    if xp.name == "numpy":
-        return flat[np.asarray(index, dtype=np.int64)]
-    if isinstance(index, int | float):  # Mitsuba's scalar_rgb: its Float is Python's float
-        return float(flat[int(index)])
-    dr = xp.dr
-    return dr.gather(xp.Float, _on_device(xp.Float, flat), dr.uint32_array_t(xp.Float)(index))
-
-
-_DEVICE_TABLES: dict[tuple[type, int], Any] = {}
-
-
-def _on_device(float_type: type, flat: np.ndarray) -> Any:
-    """``flat`` as a Dr.Jit array, copied once per array type and table.
-
-    Copying in the render (4 copies a lookup) cost a host-to-device transfer per call and
-    made renders impossible to freeze (``dr.freeze`` cannot record a host copy).
-    """
-    key = (float_type, hash(flat.tobytes()))
-    if key not in _DEVICE_TABLES:
-        _DEVICE_TABLES[key] = float_type(flat)
-    return _DEVICE_TABLES[key]
-
-
 def interpolate(xp: Any, table: np.ndarray, cos_theta: Any, r: Any) -> Any:
     """Bilinear read of ``table`` (shape (n_r, n_mu), nodes :func:`table_nodes`)."""
     n_r, n_mu = table.shape
     mu = xp.clip(cos_theta, COS_MIN, 1.0)
     x = (xp.power(mu, _EXP) - _T0) * ((n_mu - 1) / (1.0 - _T0))
-    y = xp.sqrt((clamp_roughness(xp, r) - R_MIN) / (1.0 - R_MIN)) * (n_r - 1) + 0.0 * x
-    i = xp.clip(xp.floor(x), 0.0, n_mu - 2.0)
-    j = xp.clip(xp.floor(y), 0.0, n_r - 2.0)
-    fx, fy = x - i, y - j
-    flat = np.ascontiguousarray(table, dtype=np.float64).reshape(-1)
-    k = j * n_mu + i
-    e0 = xp.lerp(_gather(xp, flat, k), _gather(xp, flat, k + 1.0), fx)
-    e1 = xp.lerp(_gather(xp, flat, k + n_mu), _gather(xp, flat, k + n_mu + 1.0), fx)
-    return xp.lerp(e0, e1, fy)
+    y = xp.sqrt((clamp_roughness(xp, r) - R_MIN) / (1.0 - R_MIN)) * (n_r - 1)
+    return bilinear(xp, table, x, y)
 
 
 def albedo_lookup(xp: Any, cos_theta: Any, r: Any, soften: bool = True) -> Any:

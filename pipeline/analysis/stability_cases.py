@@ -78,6 +78,25 @@ COMBINATIONS: tuple[dict[str, Any], ...] = (
     ),
     {"specular_gamma": 1.0 - 1e-6, "specular": 1.0, "roughness": 0.3},
     {"specular_gamma": 10.0, "spec_trans": 1.0, "roughness": 0.2},
+    # Turquin's energy compensation (materials/energy.py): a white metal at 1 from every
+    # view, the table's ends (R_MIN, 1), anisotropic, the most energetic plastic, glass,
+    # and γ ≠ 2 (left uncompensated)
+    *(
+        {"energy_compensation": True, "metallic": 1.0, "roughness": r}
+        for r in (0.0, 0.02, 0.0317, 0.5, 1.0)
+    ),
+    {"energy_compensation": True, "metallic": 1.0, "roughness": 1.0, "anisotropic": 1.0},
+    {
+        "energy_compensation": True,
+        "roughness": 1.0,
+        "sheen": 1.0,
+        "clearcoat": 1.0,
+        "clearcoat_gloss": 0.0,
+        "specular": 1.0,
+        "anisotropic": 1.0,
+    },
+    {"energy_compensation": True, "spec_trans": 1.0, "roughness": 0.5},
+    {"energy_compensation": True, "specular_gamma": 1.5, "metallic": 1.0, "roughness": 0.5},
     {"spec_trans": 1.0, "roughness": 0.0},  # smooth glass
     {"spec_trans": 1.0, "ior": 1.0, "roughness": 0.3},  # η = 1: refraction degenerates
     {"spec_trans": 1.0, "thin": True, "roughness": 0.0},

@@ -10,6 +10,8 @@ lambda     the Conty-Kulla Λ fit against numerical integration
 precision  float32 against float64 evaluation of every model
 denoise    equal-time curves of raw and OIDN-denoised proof frames (plastic, glass
            under sky, box filter) against a converged reference (:mod:`.denoise`)
+energy     a white rough metal's furnace |1 − E| with ``energy_compensation`` off and on,
+           by roughness, against the eval time the table look-up costs (:mod:`.energy`)
 ========== ==============================================================================
 
 Outputs: a Rich table, ``error_bench.json`` (every row, the settings and the machine)
@@ -37,7 +39,7 @@ from . import denoise as denoise_bench
 from . import measure
 from .measure import Row
 
-ITEMS = ("render", "albedo", "lambda", "precision", "denoise")
+ITEMS = ("render", "albedo", "lambda", "precision", "denoise", "energy")
 
 RENDER_IBL = "studio"
 # Proof-render cases: label → built-in preset name.
@@ -64,6 +66,7 @@ class Settings:
     lambda_nodes: tuple[int, ...] = (8, 16, 32, 64, 128)
     lambda_reference_nodes: int = 2048
     precision_pairs: int = 20000
+    energy_samples: int = 16384
     denoise: denoise_bench.DenoiseSettings = field(default_factory=denoise_bench.DenoiseSettings)
 
     @classmethod
@@ -79,6 +82,7 @@ class Settings:
             lambda_nodes=(4, 16),
             lambda_reference_nodes=512,
             precision_pairs=2000,
+            energy_samples=2048,
             denoise=denoise_bench.DenoiseSettings.quick(),
         )
 
@@ -251,6 +255,11 @@ def run(
             )
     if "denoise" in items:
         tasks += _denoise_tasks(settings.denoise, report)
+    if "energy" in items:
+        from . import energy
+
+        n = settings.energy_samples
+        tasks.append(("energy", lambda: energy.bench_energy(samples=n)))
     for done, (name, task) in enumerate(tasks):
         progress(name, done, len(tasks))
         try:
@@ -363,4 +372,5 @@ ERROR_NAMES = {
     "lambda": "relative RMS error",
     "precision": "max relative error of float32",
     "denoise": "relative MSE (mean over seeds)",
+    "energy": "white furnace max |1 − E|",
 }

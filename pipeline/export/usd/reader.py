@@ -288,6 +288,8 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
         values["specular_gamma"] = float(spec.custom["specular_gamma"])
         if "roughness" in spec.custom:
             values["roughness"] = float(spec.custom["roughness"])
+    if model == "disney" and spec.custom.get("energy_compensation"):
+        values["energy_compensation"] = True  # no target has the switch (network.untargeted)
     _to_preset_space(values, space, result)
     result.params = _preset_params(values, model, spelling)
     return result

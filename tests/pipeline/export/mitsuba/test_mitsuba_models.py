@@ -53,6 +53,15 @@ CASES = [
     ("disney", {"specular_gamma": 1.0, "roughness": 0.5}, "disney-gamma1", 0.25),
     ("disney", {"specular_gamma": 1.5, "metallic": 1.0, "roughness": 0.5}, "disney-gamma1.5", 0.25),
     ("disney", {"specular_gamma": 3.0, "metallic": 1.0, "roughness": 0.3}, "disney-gamma3", 0.09),
+    # Turquin's multiple-scattering factor on the specular lobe (sampling unchanged)
+    ("disney", {"metallic": 1.0, "roughness": 0.7, "energy_compensation": True}, "disney-ms-metal", 0.49),
+    ("disney", {"roughness": 0.6, "energy_compensation": True}, "disney-ms-plastic", 0.36),
+    (
+        "disney",
+        {"spec_trans": 1.0, "roughness": 0.5, "ior": 1.5, "energy_compensation": True},
+        "disney-ms-glass",
+        0.25,
+    ),
     # Pixar: "α" here is the reflection cone's half-angle in radians (10·r degrees).
     ("pixar", {"roughness": 0.0}, "pixar-r0", None),  # a delta reflection over the diffuse
     ("pixar", {"clear": 1.0, "roughness": 0.0, "ior": 1.52}, "pixar-clear-glass", None),
@@ -173,6 +182,7 @@ FURNACE_CASES = [
     ("disney", {"roughness": 0.5, "base_color": [0.8, 0.4, 0.2]}, "disney-plastic"),
     ("disney", {"metallic": 1.0, "roughness": 0.2}, "disney-metal"),
     ("disney", {"metallic": 1.0, "roughness": 0.4, "specular_gamma": 1.5}, "disney-gamma1.5"),
+    ("disney", {"metallic": 1.0, "roughness": 0.8, "energy_compensation": True}, "disney-ms-metal"),
     ("disney", {"clearcoat": 1.0, "roughness": 0.7, "base_color": [0.2, 0.3, 0.8]}, "disney-coat"),
     ("disney", {"spec_trans": 1.0, "roughness": 0.0, "ior": 1.5}, "disney-glass"),
     ("sheen", {"roughness": 0.3, "color": [0.9, 0.5, 0.3]}, "sheen"),

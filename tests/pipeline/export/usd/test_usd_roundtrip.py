@@ -290,3 +290,19 @@ def test_specular_gamma_round_trips_through_custom_data(tmp_path):
     for node in ("preview_surface", "mtlx_surface", "ri_surface"):
         written = stage.GetPrimAtPath(f"/Materials/m/{node}").GetAttribute("inputs:roughness")
         assert written.Get() == pytest.approx(0.35677, abs=1e-4)  # lookdev.materials.highlight
+
+
+def test_energy_compensation_is_a_named_loss_carried_through_custom_data(tmp_path):
+    # No target has the switch (MaterialX's pbrlib has energy_compensation on the
+    # Oren-Nayar diffuse only): every context names the loss, customData carries it back.
+    params = DisneyParams(metallic=1.0, roughness=0.6, energy_compensation=True)
+    out = tmp_path / "ms.usda"
+    export_usd([source_from_params("m", "disney", params)], out)
+    (found,) = import_usd(out)
+    assert found.params == {"metallic": 1.0, "roughness": 0.6, "energy_compensation": True}
+    assert len(found.loss) == 3
+    assert all("energy_compensation=True" in line for line in found.loss)
+    off = tmp_path / "off.usda"
+    export_usd([source_from_params("m", "disney", params.replace(energy_compensation=False))], off)
+    (plain,) = import_usd(off)
+    assert "energy_compensation" not in plain.params and not plain.loss
