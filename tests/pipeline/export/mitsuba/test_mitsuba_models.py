@@ -54,7 +54,12 @@ CASES = [
     ("disney", {"specular_gamma": 1.5, "metallic": 1.0, "roughness": 0.5}, "disney-gamma1.5", 0.25),
     ("disney", {"specular_gamma": 3.0, "metallic": 1.0, "roughness": 0.3}, "disney-gamma3", 0.09),
     # Turquin's multiple-scattering factor on the specular lobe (sampling unchanged)
-    ("disney", {"metallic": 1.0, "roughness": 0.7, "energy_compensation": True}, "disney-ms-metal", 0.49),
+    (
+        "disney",
+        {"metallic": 1.0, "roughness": 0.7, "energy_compensation": True},
+        "disney-ms-metal",
+        0.49,
+    ),
     ("disney", {"roughness": 0.6, "energy_compensation": True}, "disney-ms-plastic", 0.36),
     (
         "disney",
