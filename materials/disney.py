@@ -182,16 +182,18 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
         dg = _masked(xp, up, 0.25 * d * g) if pr["ggx"] else xp.select(up, 0.25 * d * g, 0.0)
         a, b, c = pr["spec_a"], pr["spec_b"], pr["spec_c"]
         dg_out = times(dg, front)
+        spec_scale = scale
         if pr["energy"]:
-            # Turquin 2019 eq. 10, seen from outside only (:mod:`.energy`): a colour factor.
+            # Turquin 2019 eq. 10, seen from outside only (:mod:`.energy`): a colour factor
+            # on this lobe alone (the layers under it keep ``scale``).
             ms = _energy_factor(xp, pr, co, front)
-            scale = ms if isinstance(scale, float) else scale * ms
-        terms += [(a * scale, dg_out), ((b - a) * scale, dg_out * w)]
+            spec_scale = ms if isinstance(scale, float) else scale * ms
+        terms += [(a * spec_scale, dg_out), ((b - a) * spec_scale, dg_out * w)]
         if not xp.known_zero(c):
             # The glass reflects the exact Fresnel on either side; inside, nothing else does.
             f_exact = fr.dielectric(xp, cos_d, pick(xp, front, pr["eta"], 1.0 / pr["eta"]))
             k = f_exact * dg * pick(xp, front, c, pr["glass"])
-            terms.append((None if isinstance(scale, float) else scale, k))
+            terms.append((None if isinstance(spec_scale, float) else spec_scale, k))
     if "diffuse" in lobes:
         shape = _diffuse_shape(xp, pr, ci, co, cos2_d)
         k = times(pr["diffuse"] * INV_PI * shape, front)

@@ -25,8 +25,9 @@ What it covers, and what not (each one a choice measured in tests/materials/test
 * **a smooth (delta) specular**: E = 1, nothing to compensate.
 * **not compensated**: the glass's transmission (Turquin's dielectric needs E over
   (μ, α, η) on both sides, and with the reflection a 3D table per side), the reflection seen
-  from inside a solid, and the clearcoat (F0 0.04: at most +0.03 of albedo measured at
-  clearcoat_gloss 0, below the lobe's own ±0.05 allowance).
+  from inside a solid, and the clearcoat (its G has Burley's fixed α = 0.25, whose E this
+  table does not hold, and with F0 = 0.04 the factor would add at most 4 % of (1/E − 1)
+  of a lobe weighted 0.25).
 
 The table is E(μ, r) over r = √α ∈ [√ALPHA_MIN, 1] (α below ALPHA_MIN is clamped, so is
 its E) and μ = cos θo, integrated from the model's own lobe by
