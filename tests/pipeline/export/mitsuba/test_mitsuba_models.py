@@ -65,7 +65,7 @@ CASES = [
         "disney",
         {"spec_trans": 1.0, "roughness": 0.5, "ior": 1.5, "energy_compensation": True},
         "disney-ms-glass",
-        0.25,
+        0.08,  # refracted: α 0.25 narrows by (η − 1)/η, as the frosted glass's
     ),
     # Pixar: "α" here is the reflection cone's half-angle in radians (10·r degrees).
     ("pixar", {"roughness": 0.0}, "pixar-r0", None),  # a delta reflection over the diffuse
