@@ -72,7 +72,7 @@ def table_nodes(n_mu: int, n_r: int) -> tuple[np.ndarray, np.ndarray]:
 def interpolate(xp: Any, table: np.ndarray, cos_theta: Any, r: Any) -> Any:
     """Bilinear read of ``table`` (shape (n_r, n_mu), nodes :func:`table_nodes`)."""
     n_r, n_mu = table.shape
-    x = xp.power(xp.clip(cos_theta, 0.0, 1.0), _EXP) * (n_mu - 1.0)
+    x = xp.sqrt(xp.sqrt(xp.clip(cos_theta, 0.0, 1.0))) * (n_mu - 1.0)  # μ^_EXP
     y = (xp.clip(r, R_MIN, 1.0) - R_MIN) * ((n_r - 1.0) / (1.0 - R_MIN))
     return bilinear(xp, table, x, y)
 
