@@ -184,7 +184,7 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
         dg_out = times(dg, front)
         spec_scale = scale
         if pr["energy"]:
-            # Turquin 2019 eq. 10, seen from outside only (:mod:`.energy`): a colour factor
+            # Turquin 2019, seen from outside only (:mod:`.energy`): a colour factor
             # on this lobe alone (the layers under it keep ``scale``).
             ms = _energy_factor(xp, pr, co, front)
             spec_scale = ms if isinstance(scale, float) else scale * ms

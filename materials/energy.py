@@ -5,20 +5,23 @@ microfacets: a white GGX metal keeps 31 % of the light at normal incidence at ro
 (E(1, α = 1) = 0.307, :mod:`.energy_albedo`). With ``energy_compensation`` on (default off:
 Burley's look is unchanged) the Disney ``specular`` lobe is scaled as
 
-    f_ms(ωi, ωo) = f_ss(ωi, ωo) · (1 + F0 · (1 − E(μo, α)) / E(μo, α))      (Turquin 2019, eq. 10)
+    f_ms(ωi, ωo) = f_ss(ωi, ωo) · (1 + F0 · (1 − E(μo, α)) / E(μo, α))      (Turquin et al. 2019)
 
 with E(μ, α) the directional albedo of the lobe with F = 1 and F0 the lobe's Fresnel at
 normal incidence (the metal's base colour, 0.08·specular, or the exact dielectric F0).
 Turquin, not Kulla–Conty 2017: one factor on the existing lobe (no second lobe, so the
 sampling and pdf are unchanged and chi-square holds by construction), exact for a white
-metal (∫ f_ss (1/E) cos = 1 at every view), a 2D table instead of Kulla–Conty's E, E_avg
+metal (∫ f_ss (1/E) cos = 1 at every view; MaterialX's GLSL ``mx_ggx_energy_compensation``
+is the same factor), a 2D table instead of Kulla–Conty's E, E_avg
 and the Fresnel average, and it fits our GGX with Schlick's Fresnel as it stands; the price
 is a factor read at the view only, "reciprocal enough" (Turquin §4) rather than exactly.
 
 What it covers, and what not (each one a choice measured in tests/materials/test_energy.py):
 
 * **anisotropic**: E is read at the isotropic α = √(αx αy) (the geometric mean, the α the
-  GTR path already uses); measured white-metal furnace with ``anisotropic`` 1 in the README.
+  GTR path already uses, and MaterialX's ``mx_average_alpha``): an approximation, measured
+  on a white metal at 0.84 … 1.023 with ``anisotropic`` 0.5 and only partial at 1, where
+  αx reaches 3.2, beyond the table (0.29 … 0.47 at roughness 1, 0.11 off).
 * **specular_gamma ≠ 2**: the table is the GGX lobe's; the GTR lobe (V-cavity G) has
   another E, so compensation is off there (``compensated`` is False), named in the
   parameter's description.
@@ -93,7 +96,7 @@ def compensated(params: Any, ggx: bool) -> bool:
 
 
 def factor(xp: Any, f0: Any, cos_o: Any, r: Any) -> Any:
-    """Turquin 2019 eq. 10's 1 + F0 (1 − E)/E at the view cos θo (E ≥ 0.05 at every node)."""
+    """Turquin 2019's 1 + F0 (1 − E)/E at the view cos θo (E ≥ 0.05 at every node)."""
     e = albedo_lookup(xp, cos_o, r)
     return 1.0 + f0 * (1.0 / e - 1.0)
 

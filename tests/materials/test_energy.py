@@ -164,3 +164,15 @@ def test_table_nodes_span_the_glossy_range():
     assert mu[0] == 0.0 and mu[-1] == 1.0 and r[0] == energy.R_MIN and r[-1] == 1.0
     assert energy.N_MU * energy.N_R == len(energy.VALUES)
     assert min(energy.VALUES) > 0.05  # 1/E stays finite and modest everywhere
+
+
+def test_per_element_maps_give_the_constants_values():
+    """A textured roughness and colour (the array path the plugin's textures take)."""
+    wi, wo = _grid(8), _grid(8)[::-1]
+    rough = np.linspace(0.0, 1.0, 8)
+    base = np.random.default_rng(4).random((8, 3))
+    p = DisneyParams(metallic=1.0, energy_compensation=True)
+    mapped = disney.eval(p, wi, wo, roughness=rough, base_color=base)
+    for k in range(1, 8):  # roughness 0: a delta as a constant, the clamped lobe as a map
+        q = p.replace(roughness=float(rough[k]), base_color=tuple(base[k]))
+        np.testing.assert_allclose(mapped[k], disney.eval(q, wi[k], wo[k]), rtol=1e-9)
