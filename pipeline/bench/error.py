@@ -10,6 +10,8 @@ lambda     the Conty-Kulla Λ fit against numerical integration
 precision  float32 against float64 evaluation of every model
 denoise    equal-time curves of raw and OIDN-denoised proof frames (plastic, glass
            under sky, box filter) against a converged reference (:mod:`.denoise`)
+sheen_     both modes of the Conty-Kulla ``sheen_lambda`` (Table 1's fit, the exact
+lambda     table) against numerical integration, r from 0.01 to 1
 energy     a white rough metal's furnace |1 − E| with ``energy_compensation`` off and on,
            by roughness, against the eval time the table look-up costs (:mod:`.energy`)
 ========== ==============================================================================
@@ -39,7 +41,7 @@ from . import denoise as denoise_bench
 from . import measure
 from .measure import Row
 
-ITEMS = ("render", "albedo", "lambda", "precision", "denoise", "energy")
+ITEMS = ("render", "albedo", "lambda", "precision", "denoise", "sheen_lambda", "energy")
 
 RENDER_IBL = "studio"
 # Proof-render cases: label → built-in preset name.
@@ -243,6 +245,13 @@ def run(
                 ),
             )
         )
+    if "sheen_lambda" in items:
+        tasks.append(
+            (
+                "sheen_lambda",
+                lambda: measure.bench_sheen_lambda(reference_nodes=settings.lambda_reference_nodes),
+            )
+        )
     if "precision" in items:
         for label, model, params in model_cases(models):
             tasks.append(
@@ -372,5 +381,6 @@ ERROR_NAMES = {
     "lambda": "relative RMS error",
     "precision": "max relative error of float32",
     "denoise": "relative MSE (mean over seeds)",
+    "sheen_lambda": "relative RMS error of Λ",
     "energy": "white furnace max |1 − E|",
 }

@@ -24,6 +24,7 @@ from lookdev.materials.errors import LookdevError
 
 from .lobes import DEFAULTS, REGISTRY_MODEL, active_lobes, canonical, effective
 from .names import Slot
+from .sheen_lambda import exact_sheen
 
 CONTEXT_OUTPUT = {"universal": "surface", "mtlx": "mtlx:surface", "ri": "ri:surface"}
 """render context → the Material's terminal output name (UsdShade convention)."""
@@ -211,7 +212,8 @@ def source_from_params(name: str, model: str, params: Any, description: str = ""
 
 def untargeted(source: Source) -> Source:
     """``source`` with the values no DCC target has carried in ``customData`` for the
-    import: the GTR γ (:func:`gtr_as_ggx`) and ``energy_compensation``.
+    import: the GTR γ (:func:`gtr_as_ggx`), the exact-Λ sheen (:func:`.sheen_lambda.exact_sheen`)
+    and ``energy_compensation``.
 
     No target has a switch for the specular's multiple scattering: UsdPreviewSurface and
     PxrDisneyBsdf have none, and MaterialX's ``ND_disney_principled`` (its
@@ -222,7 +224,7 @@ def untargeted(source: Source) -> Source:
     """
     if source.model == "disney" and source.values.get("energy_compensation", False):
         source.custom["energy_compensation"] = True
-    return gtr_as_ggx(source)
+    return exact_sheen(gtr_as_ggx(source))
 
 
 def gtr_as_ggx(source: Source) -> Source:

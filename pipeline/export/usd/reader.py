@@ -290,6 +290,11 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
             values["roughness"] = float(spec.custom["roughness"])
     if model == "disney" and spec.custom.get("energy_compensation"):
         values["energy_compensation"] = True  # no target has the switch (network.untargeted)
+    if model == "disney" and "sheen_lambda" in spec.custom:
+        # The exact-Λ sheen: no target has it; the writer kept it (sheen_lambda module).
+        from .sheen_lambda import CARRIED
+
+        values.update({k: spec.custom[k] for k in CARRIED if k in spec.custom})
     _to_preset_space(values, space, result)
     result.params = _preset_params(values, model, spelling)
     return result
