@@ -44,7 +44,13 @@ DISNEY_LOBES = (
         switches=("sheen",),
         reciprocal=False,  # with sheen_model = "conty_kulla": its terminator softening
     ),
-    Lobe("specular", "glossy", highlight=True, params=("specular_gamma", "energy_compensation")),
+    Lobe(
+        "specular",
+        "glossy",
+        highlight=True,
+        params=("specular_gamma", "energy_compensation"),
+        reciprocal_unless=("energy_compensation",),  # Turquin's factor is read at the view
+    ),
     Lobe(
         "clearcoat",
         "glossy",

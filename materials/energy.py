@@ -14,7 +14,9 @@ sampling and pdf are unchanged and chi-square holds by construction), exact for 
 metal (∫ f_ss (1/E) cos = 1 at every view; MaterialX's GLSL ``mx_ggx_energy_compensation``
 is the same factor), a 2D table instead of Kulla–Conty's E, E_avg
 and the Fresnel average, and it fits our GGX with Schlick's Fresnel as it stands; the price
-is a factor read at the view only, "reciprocal enough" (Turquin §4) rather than exactly.
+is a factor read at the view only, "reciprocal enough" rather than exactly: the lobe
+declares itself non-reciprocal when the switch is on (``Lobe.reciprocal_unless``), so a
+light tracer evaluates it with the roles as they are (Mitsuba ``NonSymmetric``).
 
 What it covers, and what not (each one a choice measured in tests/materials/test_energy.py):
 

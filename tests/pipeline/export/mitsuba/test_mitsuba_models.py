@@ -451,3 +451,29 @@ def test_energy_compensation_reads_a_roughness_texture_at_the_hit(mi):
         )
         assert np.all(want > off * light[2])  # the factor is there to see
         np.testing.assert_allclose(got, want.ravel(), rtol=2e-4)
+
+
+def test_energy_compensation_is_non_symmetric_and_a_light_tracer_sees_the_adjoint(mi):
+    """Turquin's factor is read at the viewer: f(l, v) ≠ f(v, l). With the switch on the
+    reflection is flagged NonSymmetric and Importance mode evaluates the model with the
+    roles as they physically are; off, the plain metal stays symmetric."""
+    model, params = _case_params(
+        "disney", {"metallic": 1.0, "roughness": 0.8, "energy_compensation": True}
+    )
+    plain = mi.load_dict(_plugin(mi, params.replace(energy_compensation=False)))
+    assert not plain.flags() & mi.BSDFFlags.NonSymmetric
+    bsdf = mi.load_dict(_plugin(mi, params))
+    assert bsdf.flags() & mi.BSDFFlags.NonSymmetric
+    rng = np.random.default_rng(8)
+    view = _unit(np.abs(rng.normal(size=(256, 3))))
+    light = _unit(np.abs(rng.normal(size=(256, 3))))
+    si = _interaction(mi, view)
+    wo = mi.Vector3f(light.astype(np.float32).T)
+    importance = mi.BSDFContext(mi.TransportMode.Importance)
+    got = np.array(bsdf.eval(importance, si, wo)).T
+    view32, light32 = np.array(si.wi).T.astype(np.float64), light.astype(np.float32)
+    # adjoint: light arrives along si.wi, leaves towards wo (the sensor side)
+    want = evaluate(model, params, view32, light32.astype(np.float64)) * light32[:, 2:3]
+    np.testing.assert_allclose(got, want, rtol=2e-4, atol=1e-6)
+    radiance = np.array(bsdf.eval(mi.BSDFContext(), si, wo)).T
+    assert np.max(np.abs(radiance - got)) > 1e-3  # the two modes differ
