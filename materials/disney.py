@@ -51,6 +51,7 @@ import importlib
 import math
 from typing import Any
 
+from . import energy
 from . import fresnel as fr
 from . import microfacet as mf
 from .arrays import NumpyOps
@@ -135,6 +136,12 @@ def _base_scale(xp: Any, pr: dict[str, Any], ci: Any, co: Any) -> Any:
     return xp.maximum(scale, 0.0)
 
 
+def _energy_factor(xp: Any, pr: dict[str, Any], co: Any, front: Any) -> Any:
+    """1 + F0 (1 − E(μo))/E(μo) outside, 1 inside a solid (the glass's own reflection)."""
+    extra = energy.factor(xp, pr["energy_f0"], co, pr["energy_r"]) - 1.0
+    return 1.0 + times(extra, front)
+
+
 def _masked(xp: Any, cond: Any, x: Any) -> Any:
     """x where cond, else 0, for an ``x`` that is finite everywhere.
 
@@ -176,12 +183,18 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
         dg = _masked(xp, up, 0.25 * d * g) if pr["ggx"] else xp.select(up, 0.25 * d * g, 0.0)
         a, b, c = pr["spec_a"], pr["spec_b"], pr["spec_c"]
         dg_out = times(dg, front)
-        terms += [(a * scale, dg_out), ((b - a) * scale, dg_out * w)]
+        spec_scale = scale
+        if pr["energy"]:
+            # Turquin 2019, seen from outside only (:mod:`.energy`): a colour factor
+            # on this lobe alone (the layers under it keep ``scale``).
+            ms = _energy_factor(xp, pr, co, front)
+            spec_scale = ms if isinstance(scale, float) else scale * ms
+        terms += [(a * spec_scale, dg_out), ((b - a) * spec_scale, dg_out * w)]
         if not xp.known_zero(c):
             # The glass reflects the exact Fresnel on either side; inside, nothing else does.
             f_exact = fr.dielectric(xp, cos_d, pick(xp, front, pr["eta"], 1.0 / pr["eta"]))
             k = f_exact * dg * pick(xp, front, c, pr["glass"])
-            terms.append((None if isinstance(scale, float) else scale, k))
+            terms.append((None if isinstance(spec_scale, float) else spec_scale, k))
     if "diffuse" in lobes:
         shape = _diffuse_shape(xp, pr, ci, co, cos2_d)
         k = times(pr["diffuse"] * INV_PI * shape, front)

@@ -29,7 +29,11 @@ The maximum is along the bitangent of an anisotropic lobe: with ``anisotropic`` 
 (roughness 1, sheen 1, clearcoat 1, clearcoat_gloss 0, specular 1), at θo = 89.9999° it is
 1.718 ± 0.001 at φo = 0, 1.722 ± 0.001 at 45° and **1.783 ± 0.0014 at 90°** (2.6·10⁵
 samples each, float64); 1.783 + 4σ < 1.79, hence 0.79. (White satin, the preset, reaches
-1.41 along the bitangent against 1.11 along the tangent.) Parameters pushed past their
+1.41 along the bitangent against 1.11 along the tangent.) ``energy_compensation``
+(Turquin's factor on the specular, :mod:`lookdev.materials.energy`) adds F0 (1/E − 1) of
+the specular lobe on top: ≤ 0.0011 on a white plastic at specular 0.5 (1.5648 → 1.5659 at
+89°), ≤ 0.0044 at specular 1, and the maximum above becomes 1.787 ± 0.0014 (same samples),
+1.787 − 4σ < 1.79 (tests/materials/test_energy.py). Parameters pushed past their
 plausible range (sheen 10, specular 12.5, clearcoat 4) are checked for NaN, infinity and
 sign only: Burley allows them precisely to add energy.
 """
@@ -106,6 +110,25 @@ COMBINATIONS: tuple[dict[str, Any], ...] = (
     {"scatter_distance": 0.01, "spec_trans": 1.0, "roughness": 0.0},
     {"scatter_distance": 0.01, "spec_trans": 0.5, "roughness": 0.3, "diff_trans": 1.0},
     {"scatter_distance": 0.01, "roughness": 1.0, "sheen": 1.0, "clearcoat": 1.0, "specular": 1.0},
+    # Turquin's energy compensation (materials/energy.py): a white metal at 1 from every
+    # view, the table's ends (R_MIN, 1), anisotropic, the most energetic plastic, glass,
+    # and γ ≠ 2 (left uncompensated)
+    *(
+        {"energy_compensation": True, "metallic": 1.0, "roughness": r}
+        for r in (0.0, 0.02, 0.0317, 0.5, 1.0)
+    ),
+    {"energy_compensation": True, "metallic": 1.0, "roughness": 1.0, "anisotropic": 1.0},
+    {
+        "energy_compensation": True,
+        "roughness": 1.0,
+        "sheen": 1.0,
+        "clearcoat": 1.0,
+        "clearcoat_gloss": 0.0,
+        "specular": 1.0,
+        "anisotropic": 1.0,
+    },
+    {"energy_compensation": True, "spec_trans": 1.0, "roughness": 0.5},
+    {"energy_compensation": True, "specular_gamma": 1.5, "metallic": 1.0, "roughness": 0.5},
     {"spec_trans": 1.0, "roughness": 0.0},  # smooth glass
     {"spec_trans": 1.0, "ior": 1.0, "roughness": 0.3},  # η = 1: refraction degenerates
     {"spec_trans": 1.0, "thin": True, "roughness": 0.0},

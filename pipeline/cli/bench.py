@@ -174,8 +174,9 @@ def error_(
     """Error against run time of every approximation lookdev makes, measured now.
 
     Proof renders (relMSE vs spp and time), directional albedo (quadrature, Monte Carlo,
-    table), the Conty-Kulla Λ fit vs numerical integration, and float32 vs float64
-    evaluation of every model. Writes a table, error_bench.json and a log-log plot.
+    table), the Conty-Kulla Λ fit vs numerical integration, float32 vs float64
+    evaluation of every model, and the white furnace of a rough metal with
+    energy_compensation off and on. Writes a table, error_bench.json and a log-log plot.
     """
     items = tuple(item or error.ITEMS)
     unknown = [i for i in items if i not in error.ITEMS]

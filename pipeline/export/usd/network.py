@@ -208,6 +208,23 @@ def source_from_params(name: str, model: str, params: Any, description: str = ""
     """A constant material's :class:`Source` (no maps)."""
     spelling = "ior" if getattr(params, "ior", None) is not None else DEFAULT_SPELLING[model]
     source = Source(name, model, canonical(params), spelling=spelling, description=description)
+    return untargeted(source)
+
+
+def untargeted(source: Source) -> Source:
+    """``source`` with the values no DCC target has carried in ``customData`` for the
+    import: the GTR γ (:func:`gtr_as_ggx`), the exact-Λ sheen (:func:`.sheen_lambda.exact_sheen`)
+    and ``energy_compensation``.
+
+    No target has a switch for the specular's multiple scattering: UsdPreviewSurface and
+    PxrDisneyBsdf have none, and MaterialX's ``ND_disney_principled`` (its
+    ``generalized_schlick_bsdf`` and ``dielectric_bsdf``, pbrlib_defs.mtlx) neither; its
+    GLSL reference always applies Turquin's factor (``mx_ggx_energy_compensation``), its
+    OSL leaves it to the renderer's closures. So the switch is a named loss
+    (:func:`loss_note`) in every context, and kept here so the import gives it back.
+    """
+    if source.model == "disney" and source.values.get("energy_compensation", False):
+        source.custom["energy_compensation"] = True
     return exact_sheen(gtr_as_ggx(source))
 
 

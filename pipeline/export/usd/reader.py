@@ -289,6 +289,8 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
         values["specular_gamma"] = float(spec.custom["specular_gamma"])
         if "roughness" in spec.custom:
             values["roughness"] = float(spec.custom["roughness"])
+    if model == "disney" and spec.custom.get("energy_compensation"):
+        values["energy_compensation"] = True  # no target has the switch (network.untargeted)
     if model == "disney" and "sheen_lambda" in spec.custom:
         # The exact-Λ sheen: no target has it; the writer kept it (sheen_lambda module).
         from .sheen_lambda import CARRIED

@@ -73,6 +73,16 @@ def test_parameter_cases_cover_every_extreme_and_the_named_combinations():
     assert not any("metallic=1, roughness" in label for label in labels)  # Disney-only combo
 
 
+def test_the_sweep_switches_energy_compensation_on_alone_and_in_the_stiff_cases():
+    from lookdev.materials.params import DisneyParams
+
+    cases = dict(stability_cases.parameter_cases(DisneyParams))
+    assert cases["energy_compensation=True"].energy_compensation
+    on = [label for label in cases if label.startswith("energy_compensation=True, ")]
+    assert len(on) >= 8  # white metal by roughness, anisotropic, every lobe, glass, γ ≠ 2
+    assert all(cases[label].energy_compensation for label in on)
+
+
 def test_directions_hold_the_stiff_pairs():
     d = stability_cases.directions()
     np.testing.assert_allclose(np.linalg.norm(d, axis=1), 1.0, rtol=1e-12)

@@ -315,3 +315,19 @@ def test_exact_sheen_lambda_names_its_loss_and_round_trips(tmp_path):
     (found,) = import_usd(fit)
     assert "sheen_lambda" not in found.params
     assert not any("sheen_lambda" in line for line in found.loss)
+
+
+def test_energy_compensation_is_a_named_loss_carried_through_custom_data(tmp_path):
+    # No target has the switch (MaterialX's pbrlib has energy_compensation on the
+    # Oren-Nayar diffuse only): every context names the loss, customData carries it back.
+    params = DisneyParams(metallic=1.0, roughness=0.6, energy_compensation=True)
+    out = tmp_path / "ms.usda"
+    export_usd([source_from_params("m", "disney", params)], out)
+    (found,) = import_usd(out)
+    assert found.params == {"metallic": 1.0, "roughness": 0.6, "energy_compensation": True}
+    assert len(found.loss) == 3
+    assert all("energy_compensation=True" in line for line in found.loss)
+    off = tmp_path / "off.usda"
+    export_usd([source_from_params("m", "disney", params.replace(energy_compensation=False))], off)
+    (plain,) = import_usd(off)
+    assert "energy_compensation" not in plain.params and not plain.loss
