@@ -72,6 +72,9 @@ def _unit(default: float, description: str, *, le: float | None = 1.0, ge: float
     return Field(default, ge=ge, le=le, description=description)
 
 
+SheenLambda = Literal["fit", "exact"]
+"""Conty-Kulla's Smith Λ: Table 1's fit (r ≥ 0.08) or the integrated one (r ≥ 0.01),
+:mod:`lookdev.materials.sheen`."""
 SHEEN_MAX = 10.0
 """Ceiling of Disney ``sheen`` (DESIGN.md, Ranges: every parameter has a ceiling)."""
 SPECULAR_GAMMA_MAX = 10.0
@@ -139,6 +142,13 @@ class DisneyParams(Params):
         "Burley's GGX, lower gives a longer tail, higher a tighter one. Isotropic when not 2.",
         json_schema_extra={"texturable": False},  # it picks the lobe's sampling technique
     )
+    energy_compensation: bool = Field(
+        False,
+        description="Scale the primary specular lobe by Turquin 2019's multiple-scattering "
+        "factor 1 + F0 (1 − E)/E (lookdev.materials.energy), so a white rough metal reflects "
+        "all the light; off keeps Burley's single-scattering look. GGX only: no effect where "
+        "specular_gamma is not 2; the glass's transmission and the clearcoat stay uncompensated.",
+    )
     sheen: float = _unit(
         0.0,
         "Additional grazing lobe for cloth; may exceed 1 (Burley), up to 10: ten times the "
@@ -150,7 +160,16 @@ class DisneyParams(Params):
     sheen_model: Literal["disney", "conty_kulla"] = Field(
         "disney", description="Burley's Fresnel-shaped sheen or the Conty-Kulla microfacet sheen."
     )
-    sheen_roughness: float = _unit(0.3, "Conty-Kulla sheen roughness r (sheen_model only).")
+    sheen_roughness: float = _unit(
+        0.3,
+        "Conty-Kulla sheen roughness r (sheen_model only); clamped to 0.08 with the fitted "
+        "Λ, to 0.01 with sheen_lambda 'exact'.",
+    )
+    sheen_lambda: SheenLambda = Field(
+        "fit",
+        description="Conty-Kulla Smith Λ: 'fit' is the paper's Table 1 (what MaterialX's "
+        "sheen_bsdf renders), 'exact' the integrated Λ, tabulated (sheen_model only).",
+    )
     clearcoat: float = _unit(
         0.0, "Second specular lobe; 0..1 ↦ weight 0..0.25, up to 4 (weight 1).", le=4.0
     )

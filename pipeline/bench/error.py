@@ -12,6 +12,10 @@ denoise    equal-time curves of raw and OIDN-denoised proof frames (plastic, gla
            under sky, box filter) against a converged reference (:mod:`.denoise`)
 mainjob    the main job's old and new default frame against converged references, and
            each frame's noise estimate against its measured error (:mod:`.quality`)
+sheen_     both modes of the Conty-Kulla ``sheen_lambda`` (Table 1's fit, the exact
+lambda     table) against numerical integration, r from 0.01 to 1
+energy     a white rough metal's furnace |1 − E| with ``energy_compensation`` off and on,
+           by roughness, against the eval time the table look-up costs (:mod:`.energy`)
 ========== ==============================================================================
 
 Outputs: a Rich table, ``error_bench.json`` (every row, the settings and the machine)
@@ -39,7 +43,7 @@ from . import denoise as denoise_bench
 from . import measure, quality
 from .measure import Row
 
-ITEMS = ("render", "albedo", "lambda", "precision", "denoise", "mainjob")
+ITEMS = ("render", "albedo", "lambda", "precision", "denoise", "sheen_lambda", "energy", "mainjob")
 
 RENDER_IBL = "studio"
 # Proof-render cases: label → built-in preset name.
@@ -66,6 +70,7 @@ class Settings:
     lambda_nodes: tuple[int, ...] = (8, 16, 32, 64, 128)
     lambda_reference_nodes: int = 2048
     precision_pairs: int = 20000
+    energy_samples: int = 16384
     denoise: denoise_bench.DenoiseSettings = field(default_factory=denoise_bench.DenoiseSettings)
     mainjob: quality.ErrorSettings = field(default_factory=quality.ErrorSettings)
 
@@ -82,6 +87,7 @@ class Settings:
             lambda_nodes=(4, 16),
             lambda_reference_nodes=512,
             precision_pairs=2000,
+            energy_samples=2048,
             denoise=denoise_bench.DenoiseSettings.quick(),
             mainjob=quality.ErrorSettings.quick(),
         )
@@ -245,6 +251,13 @@ def run(
                 ),
             )
         )
+    if "sheen_lambda" in items:
+        tasks.append(
+            (
+                "sheen_lambda",
+                lambda: measure.bench_sheen_lambda(reference_nodes=settings.lambda_reference_nodes),
+            )
+        )
     if "precision" in items:
         for label, model, params in model_cases(models):
             tasks.append(
@@ -257,6 +270,11 @@ def run(
             )
     if "denoise" in items:
         tasks += _denoise_tasks(settings.denoise, report)
+    if "energy" in items:
+        from . import energy
+
+        n = settings.energy_samples
+        tasks.append(("energy", lambda: energy.bench_energy(samples=n)))
     if "mainjob" in items:
         tasks += quality.tasks(settings.mainjob, report)
     for done, (name, task) in enumerate(tasks):
@@ -373,5 +391,7 @@ ERROR_NAMES = {
     "lambda": "relative RMS error",
     "precision": "max relative error of float32",
     "denoise": "relative MSE (mean over seeds)",
+    "sheen_lambda": "relative RMS error of Λ",
+    "energy": "white furnace max |1 − E|",
     "mainjob": "relative MSE of the frame as shown",
 }

@@ -175,8 +175,9 @@ def error_(
     """Error against run time of every approximation lookdev makes, measured now.
 
     Proof renders (relMSE vs spp and time), directional albedo (quadrature, Monte Carlo,
-    table), the Conty-Kulla Λ fit vs numerical integration, and float32 vs float64
-    evaluation of every model. Writes a table, error_bench.json and a log-log plot.
+    table), the Conty-Kulla Λ fit vs numerical integration, float32 vs float64
+    evaluation of every model, and the white furnace of a rough metal with
+    energy_compensation off and on. Writes a table, error_bench.json and a log-log plot.
     """
     items = tuple(item or error.ITEMS)
     unknown = [i for i in items if i not in error.ITEMS]
@@ -651,7 +652,12 @@ def subsurface_(
     cols = ["slab", "R", "G", "B", "ΔR", "ΔG", "ΔB", "± (1σ)"]
     console.print(table(f"thick slab ({r['mapping']})", cols, rows))
     f = r["furnace"]
-    console.print(f"white furnace: {f['mean']:.4f} ± {f['standard_error']:.4f} (≤ 1)")
+    console.print(f"white furnace, roughness 0: {f['mean']:.4f} ± {f['standard_error']:.4f} (≤ 1)")
+    f = r["furnace_rough"]
+    console.print(
+        f"white furnace, roughness 0.5: {f['with']:.4f}, without a distance {f['without']:.4f}"
+        " (Burley's retro-reflection adds energy by design)"
+    )
     rows = [[k, v["with"], v["without"], v["ratio"]] for k, v in r["rim"].items()]
     console.print(table("cup rim under back light", ["preset", "with", "without", "×"], rows))
     rows = [[k, v["time_ratio"], v["equal_noise_ratio"]] for k, v in r["cost"].items()]
