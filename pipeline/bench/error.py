@@ -10,12 +10,12 @@ lambda     the Conty-Kulla Λ fit against numerical integration
 precision  float32 against float64 evaluation of every model
 denoise    equal-time curves of raw and OIDN-denoised proof frames (plastic, glass
            under sky, box filter) against a converged reference (:mod:`.denoise`)
-mainjob    the main job's old and new default frame against converged references, and
-           each frame's noise estimate against its measured error (:mod:`.quality`)
 sheen_     both modes of the Conty-Kulla ``sheen_lambda`` (Table 1's fit, the exact
 lambda     table) against numerical integration, r from 0.01 to 1
 energy     a white rough metal's furnace |1 − E| with ``energy_compensation`` off and on,
            by roughness, against the eval time the table look-up costs (:mod:`.energy`)
+mainjob    the main job's old and new default frame against converged references, and
+           each frame's noise estimate against its measured error (:mod:`.quality`)
 ========== ==============================================================================
 
 Outputs: a Rich table, ``error_bench.json`` (every row, the settings and the machine)
