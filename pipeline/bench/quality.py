@@ -9,7 +9,7 @@ each written (EXR, and PNG through the view) and denoised (guides rendered, OIDN
 denoised EXR and PNG written). The caps are measured preset by preset, one after the
 other, so load on a shared machine falls on both alike. From these timings,
 :func:`project` prices each candidate default (frames per turntable, cap, denoise on or
-off) over the whole main job, as a ratio to today's (16 frames, cap 8, raw): a job costs
+off) over the whole main job, as a ratio to the previous default's (16 frames, cap 8, raw): a job costs
 its set-up and first frame, plus its other frames at the steady per-frame cost.
 
 **Error of the defaults** (:func:`error`): for a sampled subset of the main job (a glossy
@@ -179,7 +179,7 @@ def project(
 ) -> list[dict[str, Any]]:
     """Each candidate (frames per turntable, cap, denoise): the main job's proofs
     (presets × ``s.ibls_in_job``) in wall and CPU seconds as measured here, and as a
-    ratio to ``baseline`` measured in the same run: by default today's (16 frames, cap
+    ratio to ``baseline`` measured in the same run: by default the previous default (16 frames, cap
     8, raw; the largest cap measured when 8 was not)."""
     baseline = baseline or (16, 8 if 8 in s.caps else max(s.caps), False)
 

@@ -566,7 +566,7 @@ def mainjob_(
     Each preset's proof job is replayed under --ibl (scene load, a 4 + 4 turntable at
     480×240 rendered to the default noise target under each cap, frames written and
     denoised, every step timed); from these, every candidate default's cost over the
-    whole main job (× 4 IBLs) as a ratio to today's (16 frames, cap 8, raw).
+    whole main job (× 4 IBLs) as a ratio to the previous default's (16 frames, cap 8, raw).
     """
     s = quality.CostSettings.quick() if quick else quality.CostSettings()
     s = dataclasses.replace(s, presets=tuple(presets or s.presets), ibl=ibl)
@@ -584,7 +584,7 @@ def mainjob_(
     cols = ["preset", "max spp", "set-up CPU s", "first frame CPU s", "steady frame CPU s",
             "denoise CPU s/frame"]  # fmt: skip
     console.print(table("a proof job, step by step", cols, quality.job_rows(rows)))
-    cols = ["frames", "max spp", "denoise", "wall s", "CPU s", "× today wall", "× today CPU"]
+    cols = ["frames", "max spp", "denoise", "wall s", "CPU s", "× previous wall", "× previous CPU"]
     rows_ = [
         [c["frames"], c["max_spp"], "on" if c["denoise"] else "off", c["wall_s"], c["cpu_s"],
          c["over_today_wall"], c["over_today_cpu"]]
