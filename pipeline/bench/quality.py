@@ -9,8 +9,8 @@ each written (EXR, and PNG through the view) and denoised (guides rendered, OIDN
 denoised EXR and PNG written). The caps are measured preset by preset, one after the
 other, so load on a shared machine falls on both alike. From these timings,
 :func:`project` prices each candidate default (frames per turntable, cap, denoise on or
-off) over the whole main job, as a ratio to the previous default's (16 frames, cap 8, raw): a job costs
-its set-up and first frame, plus its other frames at the steady per-frame cost.
+off) over the whole main job, as a ratio to the previous default (16 frames, cap 8, raw):
+a job costs its set-up and first frame, plus its other frames at the steady cost.
 
 **Error of the defaults** (:func:`error`): for a sampled subset of the main job (a glossy
 plastic, a metal, glass and skin, one IBL each, the turntable's first pose), a converged
