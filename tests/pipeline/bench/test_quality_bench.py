@@ -78,13 +78,17 @@ def test_tables_show_the_frame_as_each_default_shows_it():
 
 @pytest.mark.slow
 def test_a_tiny_error_case_measures_both_defaults_against_references():
+    from lookdev.pipeline.proof.settings import DEFAULT_MAX_SPP
+
     case = Q.error_case("plastic_glossy", "sky", Q.ErrorSettings.quick())
-    for which, spp in (("old", 8), ("new", 8)):
+    for which, spp in (("old", 8), ("new", DEFAULT_MAX_SPP)):
         m = case[which]
         assert m["spp"] == spp and m["rel_mse"] > 0 and 0 < m["reference_floor"] < m["rel_mse"]
         assert m["estimate"] > 0 and m["measured"] > 0
     assert case["old"]["filter"] == "gaussian" and case["new"]["filter"] == "box"
-    assert case["new"]["stop"] in ("target", "max_spp")
+    assert case["new"]["stop"] in ("target", "max_spp") and case["new"]["denoise"]
+    assert case["new"]["denoised_rel_mse"] < case["new"]["rel_mse"]
+    assert case["new_caps"]["8"]["spp"] == 8
     json.dumps(case)
 
 
