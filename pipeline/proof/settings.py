@@ -45,8 +45,8 @@ Chosen by measurement with the frames and denoising below (README, "How the defa
 were chosen"; ``lookdev bench mainjob`` and ``lookdev bench error --item mainjob``):
 denoised, a frame's relMSE × CPU time was lowest at 4 of caps 4, 8, 16 in all four
 sampled cases, since the denoised error falls slowly with samples (8 bought 1.3× lower
-error for 1.4× the time). No frame of the main job reaches 5 % within it (their manifests say ``stop:
-"max_spp"``); ``--max-spp`` buys more."""
+error for 1.4× the time). No frame of the main job reaches 5 % within it (their
+manifests say ``stop: "max_spp"``); ``--max-spp`` buys more."""
 DEFAULT_FRAMES = 4
 """Element-rotation frames of a turntable (90° apart), unless ``--frames`` is given."""
 DEFAULT_LIGHT_FRAMES = 4
