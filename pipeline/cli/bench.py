@@ -20,6 +20,7 @@ from lookdev.pipeline.bench import (
     depth,
     error,
     glass,
+    knobs,
     library,
     noise,
     proof,
@@ -568,22 +569,22 @@ def mainjob_(
     denoised, every step timed); from these, every candidate default's cost over the
     whole main job (× 4 IBLs) as a ratio to the previous default's (16 frames, cap 8, raw).
     """
-    s = quality.CostSettings.quick() if quick else quality.CostSettings()
+    s = knobs.CostSettings.quick() if quick else knobs.CostSettings()
     s = dataclasses.replace(s, presets=tuple(presets or s.presets), ibl=ibl)
     with console.status("replaying proof jobs", spinner="dots"):
-        rows = quality.cost(s)
+        rows = knobs.cost(s)
     report = {
         "settings": dataclasses.asdict(s),
         "load_average": list(noise._load()),
         "jobs": rows,
-        "candidates": quality.project(rows, s),
+        "candidates": knobs.project(rows, s),
     }
     if as_json:
         print_json(report)
         return
     cols = ["preset", "max spp", "set-up CPU s", "first frame CPU s", "steady frame CPU s",
             "denoise CPU s/frame"]  # fmt: skip
-    console.print(table("a proof job, step by step", cols, quality.job_rows(rows)))
+    console.print(table("a proof job, step by step", cols, knobs.job_rows(rows)))
     cols = ["frames", "max spp", "denoise", "wall s", "CPU s", "× previous wall", "× previous CPU"]
     rows_ = [
         [c["frames"], c["max_spp"], "on" if c["denoise"] else "off", c["wall_s"], c["cpu_s"],

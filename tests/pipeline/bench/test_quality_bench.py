@@ -1,5 +1,5 @@
-"""The main job's bench (:mod:`lookdev.pipeline.bench.quality`): the cost projection from
-timed jobs, the tables, and tiny runs of both measurements."""
+"""The main job's benches (:mod:`lookdev.pipeline.bench.knobs` and ``.quality``): the
+cost projection from timed jobs, the tables, and tiny runs of both measurements."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ import json
 
 import pytest
 
+from lookdev.pipeline.bench import knobs as K
 from lookdev.pipeline.bench import quality as Q
 
 
@@ -24,30 +25,30 @@ def _job(preset: str, cap: int, setup: float, first: float, steady: float) -> di
 
 
 ROWS = [_job("a", 4, 1.0, 3.0, 0.5), _job("a", 8, 1.0, 4.0, 1.0)]
-S = Q.CostSettings(presets=("a",), ibls_in_job=4)
+S = K.CostSettings(presets=("a",), ibls_in_job=4)
 
 
 def test_a_job_is_its_setup_its_timed_frames_and_steady_frames_beyond_them():
     row = ROWS[1]  # setup 1, first 4 + 0.1, second 1.5 + 0.1, then 1.1 each
-    assert Q._job_seconds(row, 8, False, "cpu_s") == pytest.approx(1 + 4.1 + 1.6 + 6 * 1.1)
-    sixteen = Q._job_seconds(row, 16, False, "cpu_s")
+    assert K._job_seconds(row, 8, False, "cpu_s") == pytest.approx(1 + 4.1 + 1.6 + 6 * 1.1)
+    sixteen = K._job_seconds(row, 16, False, "cpu_s")
     assert sixteen == pytest.approx(1 + 4.1 + 1.6 + 6 * 1.1 + 8 * 1.1)
-    assert Q._job_seconds(row, 8, True, "cpu_s") == pytest.approx(1 + 4.1 + 1.6 + 6 * 1.1 + 4)
-    assert Q._job_seconds(row, 2, False, "cpu_s") == pytest.approx(1 + 4.1 + 1.6)
+    assert K._job_seconds(row, 8, True, "cpu_s") == pytest.approx(1 + 4.1 + 1.6 + 6 * 1.1 + 4)
+    assert K._job_seconds(row, 2, False, "cpu_s") == pytest.approx(1 + 4.1 + 1.6)
 
 
 def test_candidates_are_priced_against_today_in_the_same_run():
-    out = Q.project(ROWS, S)
+    out = K.project(ROWS, S)
     assert len(out) == 2 * 2 * 2  # frames × caps × denoise
     today = next(c for c in out if (c["frames"], c["max_spp"], c["denoise"]) == (16, 8, False))
     assert today["over_today_cpu"] == pytest.approx(1.0)
     assert today["over_today_wall"] == pytest.approx(1.0)
-    assert today["cpu_s"] == pytest.approx(4 * Q._job_seconds(ROWS[1], 16, False, "cpu_s"))
+    assert today["cpu_s"] == pytest.approx(4 * K._job_seconds(ROWS[1], 16, False, "cpu_s"))
     cheap = next(c for c in out if (c["frames"], c["max_spp"], c["denoise"]) == (8, 4, False))
     assert 0 < cheap["over_today_cpu"] < 0.5
     dearer = next(c for c in out if (c["frames"], c["max_spp"], c["denoise"]) == (8, 4, True))
     assert dearer["cpu_s"] > cheap["cpu_s"]
-    rows = Q.job_rows(ROWS)
+    rows = K.job_rows(ROWS)
     assert rows[0][:4] == ["a", 4, 1.0, pytest.approx(3.1)]
 
 
