@@ -169,6 +169,24 @@ def error_(
             "plastic_glossy:sky and glass_clear:sky.",
         ),
     ] = None,
+    denoise_resolution: Annotated[
+        tuple[int, int] | None,
+        typer.Option(
+            "--resolution",
+            metavar="W H",
+            help="Item denoise: the frame's size (default 192 96; a 4096-spp reference "
+            "at 480 240 costs 6.25× as much).",
+        ),
+    ] = None,
+    guide_spp: Annotated[
+        int | None,
+        typer.Option(
+            "--guide-spp",
+            min=1,
+            help="Item denoise: samples of the albedo/normal guides, at most the frame's "
+            "(default: the proofs' GUIDE_SPP).",
+        ),
+    ] = None,
     as_json: JsonOut = False,
 ) -> None:
     """Error against run time of every approximation lookdev makes, measured now.
@@ -190,6 +208,20 @@ def error_(
             raise error.BenchError("expected PRESET:IBL", field="--denoise-case")
         settings = dataclasses.replace(
             settings, denoise=dataclasses.replace(settings.denoise, cases=cases)
+        )
+    if denoise_resolution is not None:
+        if min(denoise_resolution) < 8:
+            raise error.BenchError(
+                f"{denoise_resolution[0]} {denoise_resolution[1]}: at least 8",
+                field="--resolution",
+            )
+        settings = dataclasses.replace(
+            settings,
+            denoise=dataclasses.replace(settings.denoise, resolution=tuple(denoise_resolution)),
+        )
+    if guide_spp is not None:
+        settings = dataclasses.replace(
+            settings, denoise=dataclasses.replace(settings.denoise, guide_spp=guide_spp)
         )
     start = time.perf_counter()
     with Progress(console=console, transient=True, disable=as_json) as bar:
@@ -230,7 +262,9 @@ def error_(
             verdict = "met" if case.summary["claim_met"] else "NOT met"
             console.print(
                 f"{case.preset} × {case.ibl}: {case.summary['claim']}: {verdict}; "
-                f"reference {case.reference_spp} spp, its own relMSE {case.reference_floor:.2g}",
+                f"reference {case.reference_spp} spp, its own relMSE {case.reference_floor:.2g}; "
+                f"{case.resolution[0]}×{case.resolution[1]}, guides ≤ {case.guide_spp} spp, "
+                f"load average {case.load_average[0]:g} → {case.load_average[1]:g}",
                 highlight=False,
             )
     for what, why in report.skipped.items():
