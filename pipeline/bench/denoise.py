@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from lookdev.pipeline.proof.denoise import GUIDE_SPP
+from lookdev.pipeline.proof.rig import DEFAULT_RIG
 
 from .measure import Row, relative_mse
 
@@ -64,6 +65,7 @@ class DenoiseSettings:
     ibl_width: int = 256
     cases: tuple[tuple[str, str], ...] = CASES
     guide_spp: int = GUIDE_SPP
+    rig: str = DEFAULT_RIG  # the proofs' rig beside the material (``--rig none``: without)
 
     @classmethod
     def quick(cls) -> DenoiseSettings:
@@ -91,6 +93,7 @@ class Case:
     resolution: tuple[int, int] = (0, 0)
     guide_spp: int = GUIDE_SPP
     load_average: tuple[float, float] = (0.0, 0.0)
+    rig: str = DEFAULT_RIG
 
     def as_json(self) -> dict[str, Any]:
         return asdict(self)
@@ -116,13 +119,16 @@ class _Frame:
         resolution: tuple[int, int],
         depth: int,
         guide_spp: int,
+        rig: str = DEFAULT_RIG,
     ):
         import drjit as dr
         import mitsuba as mi
 
         from lookdev.pipeline.proof import shaderball
 
-        scene = shaderball.scene_dict(bsdf, environment, resolution, depth, pixel_filter="box")
+        scene = shaderball.scene_dict(
+            bsdf, environment, resolution, depth, rig=rig, pixel_filter="box"
+        )
         self.scene = mi.load_dict(scene)
         self.guide_spp = guide_spp
 
@@ -165,7 +171,7 @@ def bench_case(
 ) -> Case:
     """Measure one case (see the module docstring)."""
     load_before = _load()
-    frame = _Frame(bsdf, environment, settings.resolution, depth, settings.guide_spp)
+    frame = _Frame(bsdf, environment, settings.resolution, depth, settings.guide_spp, settings.rig)
     progress(f"{preset}: reference ({settings.reference_spp} spp)")
     half = max(1, settings.reference_spp // 2)
     ref_a = frame.render(half, seed=1_000_001)[0]
@@ -229,6 +235,7 @@ def bench_case(
         tuple(settings.resolution),
         settings.guide_spp,
         (load_before, _load()),
+        settings.rig,
     )
 
 

@@ -187,6 +187,14 @@ def error_(
             "(default: the proofs' GUIDE_SPP).",
         ),
     ] = None,
+    denoise_rig: Annotated[
+        str | None,
+        typer.Option(
+            "--rig",
+            help="Item denoise: the rig beside the material, full|balls|none (default: "
+            "the proofs' full rig).",
+        ),
+    ] = None,
     as_json: JsonOut = False,
 ) -> None:
     """Error against run time of every approximation lookdev makes, measured now.
@@ -218,6 +226,16 @@ def error_(
         settings = dataclasses.replace(
             settings,
             denoise=dataclasses.replace(settings.denoise, resolution=tuple(denoise_resolution)),
+        )
+    if denoise_rig is not None:
+        from lookdev.pipeline.proof.rig import RIGS
+
+        if denoise_rig not in RIGS:
+            raise error.BenchError(
+                f"unknown rig {denoise_rig!r}; allowed {', '.join(RIGS)}", field="--rig"
+            )
+        settings = dataclasses.replace(
+            settings, denoise=dataclasses.replace(settings.denoise, rig=denoise_rig)
         )
     if guide_spp is not None:
         settings = dataclasses.replace(
@@ -263,7 +281,8 @@ def error_(
             console.print(
                 f"{case.preset} × {case.ibl}: {case.summary['claim']}: {verdict}; "
                 f"reference {case.reference_spp} spp, its own relMSE {case.reference_floor:.2g}; "
-                f"{case.resolution[0]}×{case.resolution[1]}, guides ≤ {case.guide_spp} spp, "
+                f"{case.resolution[0]}×{case.resolution[1]}, rig {case.rig}, "
+                f"guides ≤ {case.guide_spp} spp, "
                 f"load average {case.load_average[0]:g} → {case.load_average[1]:g}",
                 highlight=False,
             )
