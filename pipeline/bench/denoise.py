@@ -1,14 +1,18 @@
 """Equal-time curves of raw and denoised proof frames (``lookdev bench error --item denoise``).
 
-For each case (a preset under an IBL) one proof frame (the shader ball and cup at the
-turntable's first pose, the proofs' scene; 96×48 by default, small enough for a
-4096-spp reference on a shared two-core machine) is rendered with a **box** pixel filter (the
-filter denoised frames need: :mod:`lookdev.pipeline.proof.denoise`) at a ladder of
-samples per pixel, several seeds each, and compared with a converged reference of the
-same frame: relative MSE (:func:`.measure.relative_mse`, Rousselle et al. 2011), mean
-over the seeds. A denoised point costs its raw render *plus* its guides (albedo and
-normal, ``min(spp, GUIDE_SPP)`` samples) *plus* the denoiser, all wall time, the renders
-frozen (``dr.freeze``) as the proofs run them, after warm-up launches.
+For each case (a preset under an IBL) one proof frame (the shader ball, cup and rig at the
+turntable's first pose, the proofs' scene; 192×96 by default, ``--resolution`` for the
+proofs' 480×240, whose 4096-spp reference costs 6.25× as much) is rendered with a
+**box** pixel filter (the filter denoised frames need:
+:mod:`lookdev.pipeline.proof.denoise`) at a ladder of samples per pixel, several seeds
+each, and compared with a converged reference of the same frame: relative MSE
+(:func:`.measure.relative_mse`, Rousselle et al. 2011), mean over the seeds. A denoised
+point costs its raw render *plus* its guides (albedo and normal, ``min(spp, guide_spp)``
+samples, as the proofs render them) *plus* the denoiser, the renders frozen
+(``dr.freeze``) as the proofs run them, after warm-up launches. Every cost is taken twice:
+wall time, and process time (CPU seconds of all this process's threads), which a
+machine shared with other jobs disturbs less; raw and denoised renders are interleaved
+seed by seed, so load hits both alike.
 
 From the curves (:func:`summarise`):
 
