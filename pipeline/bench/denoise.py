@@ -20,6 +20,8 @@ From the curves (:func:`summarise`):
   relMSE = K/spp (unbiased Monte Carlo: variance ∝ 1/spp; K is the geometric mean of
   relMSE·spp over the raw ladder) and time = a + b·spp (least squares), read at the
   denoised point's time; ``ratio`` = denoised/raw there (the claim checked: ≤ 1/10);
+  ``ratio_cpu`` the same read on process time; ``ratio_same_spp`` denoised/raw at the
+  same spp (the denoiser's gain before its cost);
 * **the spp raw rendering needs to reach the denoised error**: K / relMSE_denoised,
   extrapolated along the 1/spp line beyond the ladder (stated as such in the output).
 
