@@ -131,7 +131,8 @@ def _base_scale(xp: Any, pr: dict[str, Any], ci: Any, co: Any) -> Any:
         return 1.0
     color = _conty_kulla_color(xp, pr)
     r = xp.asarray(pr["sheen_r"])  # an array of the model's dtype: float32 stays float32
-    return xp.maximum(_conty_kulla().base_scale(xp, ci, co, r, color), 0.0)
+    scale = _conty_kulla().base_scale(xp, ci, co, r, color, exact=pr["sheen_exact"])
+    return xp.maximum(scale, 0.0)
 
 
 def _masked(xp: Any, cond: Any, x: Any) -> Any:
@@ -187,7 +188,8 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
         terms.append((pr["base"] * scale, _masked(xp, up, k)))
     if "sheen" in lobes:
         if pr["sheen_model"] == "conty_kulla":
-            lobe = _conty_kulla().lobe(xp, wi, wo, xp.asarray(pr["sheen_r"]), True)
+            r = xp.asarray(pr["sheen_r"])
+            lobe = _conty_kulla().lobe(xp, wi, wo, r, True, pr["sheen_exact"])
             color = _conty_kulla_color(xp, pr)
         else:
             lobe = w * pr["sheen"]  # 2014 addendum: sheen · (1 − cos θd)⁵, no 1/π (Explorer)

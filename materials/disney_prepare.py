@@ -39,8 +39,9 @@ DISNEY_LOBES = (
     Lobe(
         "sheen",
         "glossy",
-        params=("sheen", "sheen_tint", "sheen_model", "sheen_roughness"),
+        params=("sheen", "sheen_tint", "sheen_model", "sheen_roughness", "sheen_lambda"),
         switches=("sheen",),
+        reciprocal=False,  # with sheen_model = "conty_kulla": its terminator softening
     ),
     Lobe("specular", "glossy", highlight=True, params=("specular_gamma",)),
     Lobe(
@@ -156,6 +157,7 @@ def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
         "sheen_color": mix(1.0, tint, p["sheen_tint"]),
         "sheen_model": params.sheen_model,
         "sheen_r": p["sheen_roughness"],
+        "sheen_exact": params.sheen_lambda == "exact",
         "clearcoat": 0.25 * p["clearcoat"],
         "clearcoat_a2": _sq(mix(0.1, 0.001, p["clearcoat_gloss"])),  # Burley §5.4 / App. B
         "subsurface": 0.0 if volume else p["subsurface"],

@@ -72,6 +72,9 @@ def _unit(default: float, description: str, *, le: float | None = 1.0, ge: float
     return Field(default, ge=ge, le=le, description=description)
 
 
+SheenLambda = Literal["fit", "exact"]
+"""Conty-Kulla's Smith Λ: Table 1's fit (r ≥ 0.08) or the integrated one (r ≥ 0.01),
+:mod:`lookdev.materials.sheen`."""
 SHEEN_MAX = 10.0
 """Ceiling of Disney ``sheen`` (DESIGN.md, Ranges: every parameter has a ceiling)."""
 SPECULAR_GAMMA_MAX = 10.0
@@ -150,7 +153,16 @@ class DisneyParams(Params):
     sheen_model: Literal["disney", "conty_kulla"] = Field(
         "disney", description="Burley's Fresnel-shaped sheen or the Conty-Kulla microfacet sheen."
     )
-    sheen_roughness: float = _unit(0.3, "Conty-Kulla sheen roughness r (sheen_model only).")
+    sheen_roughness: float = _unit(
+        0.3,
+        "Conty-Kulla sheen roughness r (sheen_model only); clamped to 0.08 with the fitted "
+        "Λ, to 0.01 with sheen_lambda 'exact'.",
+    )
+    sheen_lambda: SheenLambda = Field(
+        "fit",
+        description="Conty-Kulla Smith Λ: 'fit' is the paper's Table 1 (what MaterialX's "
+        "sheen_bsdf renders), 'exact' the integrated Λ, tabulated (sheen_model only).",
+    )
     clearcoat: float = _unit(
         0.0, "Second specular lobe; 0..1 ↦ weight 0..0.25, up to 4 (weight 1).", le=4.0
     )

@@ -22,7 +22,8 @@ bilinear read against direct quadrature at off-node points
 16×16: 7.9e-3, 32×32: 4.1e-3, 64×16: 3.3e-3, **64×32: 1.5e-3**, 64×64: 1.6e-3,
 128×32: 6.8e-4. 1.5e-3 is the most the layering can gain (tests/test_sheen.py).
 
-Roughness: the paper's r lies in (0, 1] and r is clamped to :data:`R_MIN` = 0.08.
+Roughness: the paper's r lies in (0, 1] and, with the fitted Λ (``sheen_lambda = "fit"``),
+r is clamped to :data:`R_MIN` = 0.08.
 Table 1's "r = 0" row cannot be a fit at r → 0, where D tends to a delta at θm = 90°
 and Λ to infinity; measured against the integrated Λ (``lookdev.pipeline.analysis.
 sheen_fit``), the fit is under half the true Λ below r ≈ 0.03 and the lobe then reflects
@@ -31,6 +32,15 @@ already 1.10 at r = 0.05). From r = 0.08 up the albedo stays below 0.96 either w
 Over r ∈ [0.08, 1], cos θ ∈ [0.01, 1] the fit's worst relative error is 0.21 (at r = 0.08,
 cos θ = 0.97, counting Λ ≥ 0.01 only); the r = 1 row is within 6% (tests/test_sheen.py
 prints the figures, ``sheen_fit.lambda_fit_error`` computes them).
+
+``sheen_lambda = "exact"`` replaces the fit by the integrated Λ, read from a table
+(:mod:`.sheen_exact`, see :func:`lambda_exact`: 64 θ × 24 log r, worst relative error
+1.6e-3), and lowers the floor to :data:`R_MIN_EXACT` = 0.01; its own albedo tables
+(64 μ × 24 r on the same r nodes, worst error 1.25e-3, at most 7e-5 low) keep the
+layering consistent. Measured over r ∈ [0.01, 1] (tests/test_sheen.py): the lobe's albedo
+stays ≤ 0.99992, ≤ 1.0001 over a white base. The default stays ``"fit"``: the paper's
+model, which MaterialX's ``sheen_bsdf`` (``mode = "conty_kulla"``) implements, so a DCC
+shows what the proofs show (the two modes' albedos differ by up to 0.07 at r = 0.3).
 
 >>> import numpy as np
 >>> round(float(D(np.float64(0.0), 1.0)), 6)  # (2 + 1)/2π · sin^1 90°
@@ -49,13 +59,28 @@ from pydantic import Field
 
 from .arrays import NumpyOps
 from .bsdf import Lobe, Model, density, draw, evaluate
-from .params import Color, Params, register_schema
+from .params import Color, Params, SheenLambda, register_schema
 from .sheen_albedo import N_MU as _N_MU
 from .sheen_albedo import N_R as _N_R
 from .sheen_albedo import VALUES as _TABLE_VALUES
+from .sheen_exact import ALBEDO as _EXACT_ALBEDO
+from .sheen_exact import N_MU as _EXACT_N_MU
+from .sheen_exact import N_R as _EXACT_N_R
+from .sheen_tables import _AREA_TABLE as _AREA_TABLE
+from .sheen_tables import (
+    COS_MIN,
+    R_MIN,
+    bilinear,
+    clamp_roughness,
+    exact_roughness_nodes,
+    lambda_exact,
+    log_r_index,
+    roughness_floor,
+)
+from .sheen_tables import R_MIN_EXACT as R_MIN_EXACT  # re-exported for callers of sheen
+from .sheen_tables import area_nodes as area_nodes
+from .sheen_tables import projected_area as projected_area
 
-R_MIN = 0.08
-COS_MIN = 1e-5
 INV_TWO_PI = 1.0 / (2.0 * math.pi)
 
 # Table 1: (a, b, c, d, e) of L(x) = a / (1 + b x^c) + d x + e at r = 0 and r = 1.
@@ -69,26 +94,29 @@ class SheenParams(Params):
 
     color: Color = Field((1.0, 1.0, 1.0), description="Sheen colour F (eq. 1), linear RGB.")
     roughness: float = Field(
-        0.3, ge=0.0, le=1.0, description="Fibre spread r (eq. 2); below 0.01 it is clamped."
+        0.3,
+        ge=0.0,
+        le=1.0,
+        description="Fibre spread r (eq. 2); clamped to 0.08 with the fitted Λ, 0.01 exact.",
     )
     terminator_softening: bool = Field(
         True, description="Eq. 4's softer light terminator (non-reciprocal)."
     )
+    sheen_lambda: SheenLambda = Field(
+        "fit",
+        description="Smith Λ: 'fit' is the paper's Table 1 (r ≥ 0.08, what MaterialX's "
+        "sheen_bsdf renders), 'exact' the integrated Λ from a table (r ≥ 0.01).",
+    )
 
 
 # -- the distribution, eq. 2 ---------------------------------------------------------------
-def clamp_roughness(xp: Any, r: Any) -> Any:
-    """r in [R_MIN, 1]: the paper's (0, 1] with the delta limit kept out."""
-    return xp.clip(r, R_MIN, 1.0)
-
-
-def distribution(xp: Any, sin2_theta: Any, r: Any) -> Any:
+def distribution(xp: Any, sin2_theta: Any, r: Any, r_min: float = R_MIN) -> Any:
     """D(m) = (2 + 1/r) sin^(1/r) θm / 2π (eq. 2), from sin²θm.
 
     Written as exp(log(sin²θ) / 2r) so that r → 0 and sin θ = 0 give 0, not NaN.
     Normalised: ∫ D cos θm dωm = (2 + 1/r) ∫₀¹ s^(1/r + 1) ds = 1 for every r.
     """
-    r = clamp_roughness(xp, r)
+    r = clamp_roughness(xp, r, r_min)
     return (2.0 + 1.0 / r) * INV_TWO_PI * xp.exp(xp.log(sin2_theta) * (0.5 / r))
 
 
@@ -122,19 +150,29 @@ def log_lambda_light(xp: Any, cos_theta: Any, coeffs: tuple[Any, ...], soften: b
     log_l = log_lambda(xp, cos_theta, coeffs)
     if not soften:
         return log_l
-    one_minus = 1.0 - xp.clip(cos_theta, 0.0, 1.0)
-    return log_l * (1.0 + 2.0 * xp.power(one_minus, 8.0))
+    return log_l * softening_exponent(xp, cos_theta)
 
 
-def shadowing(xp: Any, cos_i: Any, cos_o: Any, r: Any, soften: bool) -> Any:
-    """Correlated G = 1 / (1 + Λ(ωo) + Λ'(ωi)) (§3, §4)."""
+def softening_exponent(xp: Any, cos_theta: Any) -> Any:
+    """1 + 2(1 − cos θi)^8, the exponent of eq. 4's Λ'(θi) = Λ(θi)^(…)."""
+    return 1.0 + 2.0 * xp.power(1.0 - xp.clip(cos_theta, 0.0, 1.0), 8.0)
+
+
+def shadowing(xp: Any, cos_i: Any, cos_o: Any, r: Any, soften: bool, exact: bool = False) -> Any:
+    """Correlated G = 1 / (1 + Λ(ωo) + Λ'(ωi)) (§3, §4), Λ fitted or ``exact``."""
+    if exact:
+        lam_o = lambda_exact(xp, cos_o, r)
+        lam_i = lambda_exact(xp, cos_i, r)
+        if soften:
+            lam_i = xp.power(lam_i, softening_exponent(xp, cos_i))
+        return 1.0 / (1.0 + lam_o + lam_i)
     coeffs = fit_coefficients(xp, clamp_roughness(xp, r))
     lam_o = xp.exp(log_lambda(xp, cos_o, coeffs))
     lam_i = xp.exp(log_lambda_light(xp, cos_i, coeffs, soften))
     return 1.0 / (1.0 + lam_o + lam_i)
 
 
-def lobe(xp: Any, wi: Any, wo: Any, r: Any, soften: bool) -> Any:
+def lobe(xp: Any, wi: Any, wo: Any, r: Any, soften: bool, exact: bool = False) -> Any:
     """Uncoloured sheen f(ωi, ωo) (eq. 1 with F = 1); 0 unless both lie above the surface.
 
     The cosines in 1/(4 cos θi cos θo) are floored at :data:`COS_MIN` (θ ≤ 89.9994°):
@@ -147,9 +185,9 @@ def lobe(xp: Any, wi: Any, wo: Any, r: Any, soften: bool) -> Any:
     h = wi + wo
     # sin²θh from the half vector's components: exact near the normal, unlike 1 − cos².
     sin2_h = (h[0] * h[0] + h[1] * h[1]) / xp.maximum(xp.dot(h, h), xp.tiny)
-    g = shadowing(xp, cos_i, cos_o, r, soften)
+    g = shadowing(xp, cos_i, cos_o, r, soften, exact)
     denom = 4.0 * xp.maximum(cos_i, COS_MIN) * xp.maximum(cos_o, COS_MIN)
-    f = distribution(xp, sin2_h, r) * g / denom
+    f = distribution(xp, sin2_h, r, roughness_floor(exact)) * g / denom
     return xp.select(upper, f, 0.0)
 
 
@@ -162,60 +200,47 @@ _EXP = 0.125
 _T0 = COS_MIN**_EXP
 
 
-def table_nodes(n_mu: int, n_r: int) -> tuple[np.ndarray, np.ndarray]:
-    """(μ, r) at which the albedo table is sampled."""
+def table_nodes(n_mu: int, n_r: int, exact: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """(μ, r) at which an albedo table is sampled.
+
+    The exact mode's r nodes are the projected-area table's (:func:`area_nodes`, log r):
+    its lobe is bilinear in log r between those nodes, with a kink at each, and an albedo
+    table whose cells straddle a kink underestimated E by 1e-3 (a gain) at 64 × 32 sqrt-r
+    nodes, against 8e-5 at 64 × 24 aligned ones (measured at the cells' midpoints).
+    """
     t = np.linspace(_T0, 1.0, n_mu)
+    if exact:
+        return t ** (1.0 / _EXP), exact_roughness_nodes(n_r)
     return t ** (1.0 / _EXP), R_MIN + (1.0 - R_MIN) * np.linspace(0.0, 1.0, n_r) ** 2
 
 
-def _gather(xp: Any, flat: np.ndarray, index: Any) -> Any:
-    """``flat[index]`` for an index of any backend (integral values held as floats)."""
-    if xp.name == "numpy":
-        return flat[np.asarray(index, dtype=np.int64)]
-    if isinstance(index, int | float):  # Mitsuba's scalar_rgb: its Float is Python's float
-        return float(flat[int(index)])
-    dr = xp.dr
-    return dr.gather(xp.Float, _on_device(xp.Float, flat), dr.uint32_array_t(xp.Float)(index))
-
-
-_DEVICE_TABLES: dict[tuple[type, int], Any] = {}
-
-
-def _on_device(float_type: type, flat: np.ndarray) -> Any:
-    """``flat`` as a Dr.Jit array, copied once per array type and table.
-
-    Copying in the render (4 copies a lookup) cost a host-to-device transfer per call and
-    made renders impossible to freeze (``dr.freeze`` cannot record a host copy).
-    """
-    key = (float_type, hash(flat.tobytes()))
-    if key not in _DEVICE_TABLES:
-        _DEVICE_TABLES[key] = float_type(flat)
-    return _DEVICE_TABLES[key]
-
-
-def interpolate(xp: Any, table: np.ndarray, cos_theta: Any, r: Any) -> Any:
+def interpolate(xp: Any, table: np.ndarray, cos_theta: Any, r: Any, exact: bool = False) -> Any:
     """Bilinear read of ``table`` (shape (n_r, n_mu), nodes :func:`table_nodes`)."""
     n_r, n_mu = table.shape
     mu = xp.clip(cos_theta, COS_MIN, 1.0)
     x = (xp.power(mu, _EXP) - _T0) * ((n_mu - 1) / (1.0 - _T0))
+    if exact:
+        return bilinear(xp, table, x, log_r_index(xp, r, n_r) + 0.0 * x)
     y = xp.sqrt((clamp_roughness(xp, r) - R_MIN) / (1.0 - R_MIN)) * (n_r - 1) + 0.0 * x
-    i = xp.clip(xp.floor(x), 0.0, n_mu - 2.0)
-    j = xp.clip(xp.floor(y), 0.0, n_r - 2.0)
-    fx, fy = x - i, y - j
-    flat = np.ascontiguousarray(table, dtype=np.float64).reshape(-1)
-    k = j * n_mu + i
-    e0 = xp.lerp(_gather(xp, flat, k), _gather(xp, flat, k + 1.0), fx)
-    e1 = xp.lerp(_gather(xp, flat, k + n_mu), _gather(xp, flat, k + n_mu + 1.0), fx)
-    return xp.lerp(e0, e1, fy)
+    return bilinear(xp, table, x, y)
 
 
-def albedo_lookup(xp: Any, cos_theta: Any, r: Any, soften: bool = True) -> Any:
-    """E(μ, r) = ∫ f(ωi, ωo) cos θi dωi for a view at cos θo = μ (F = 1), from the table."""
+def albedo_lookup(xp: Any, cos_theta: Any, r: Any, soften: bool = True, exact: bool = False) -> Any:
+    """E(μ, r) = ∫ f(ωi, ωo) cos θi dωi for a view at cos θo = μ (F = 1), from the table
+    of the Λ mode in use (each tabulates its own lobe, from its own roughness floor)."""
+    if exact:
+        return interpolate(xp, _EXACT_TABLES[int(soften)], cos_theta, r, exact=True)
     return interpolate(xp, _TABLES[int(soften)], cos_theta, r)
 
 
 def base_scale(
-    xp: Any, cos_i: Any, cos_o: Any, r: Any, color: Any = 1.0, soften: bool = True
+    xp: Any,
+    cos_i: Any,
+    cos_o: Any,
+    r: Any,
+    color: Any = 1.0,
+    soften: bool = True,
+    exact: bool = False,
 ) -> Any:
     """Factor on the layer under the sheen: 1 − F · max(E(ωi), E(ωo)).
 
@@ -226,7 +251,8 @@ def base_scale(
     F ≤ 1 this is ≤ 1 − F·E(ωo), so sheen + scaled base never reflects more than the
     base alone could: no energy gain, whichever way the light travels.
     """
-    e = xp.maximum(albedo_lookup(xp, cos_i, r, soften), albedo_lookup(xp, cos_o, r, soften))
+    e_i = albedo_lookup(xp, cos_i, r, soften, exact)
+    e = xp.maximum(e_i, albedo_lookup(xp, cos_o, r, soften, exact))
     return 1.0 - color * e
 
 
@@ -235,13 +261,20 @@ def _prepare(xp: Any, params: SheenParams, **maps: Any) -> dict[str, Any]:
     color = xp.color(maps.get("color", params.color))
     r = xp.scalar(maps.get("roughness", params.roughness))
     lobes = () if xp.known_zero(color) else (SHEEN_LOBES[0].name,)
-    return {"color": color, "r": r, "soften": params.terminator_softening, "lobes": lobes}
+    return {
+        "color": color,
+        "r": r,
+        "soften": params.terminator_softening,
+        "exact": params.sheen_lambda == "exact",
+        "lobes": lobes,
+    }
 
 
 def _eval(xp: Any, prepared: dict[str, Any], wi: Any, wo: Any) -> Any:
     if not prepared["lobes"]:
         return xp.zeros(wi[2]) * prepared["color"]
-    return prepared["color"] * lobe(xp, wi, wo, prepared["r"], prepared["soften"])
+    r, soften, exact = prepared["r"], prepared["soften"], prepared["exact"]
+    return prepared["color"] * lobe(xp, wi, wo, r, soften, exact)
 
 
 def _pdf(xp: Any, prepared: dict[str, Any], wi: Any, wo: Any) -> Any:
@@ -264,7 +297,15 @@ def _sample(xp: Any, prepared: dict[str, Any], wo: Any, u: Any) -> tuple[Any, An
 
 # [without, with] terminator softening, each (n_r, n_mu).
 _TABLES = np.asarray(_TABLE_VALUES, dtype=np.float64).reshape(2, _N_R, _N_MU)
-SHEEN_LOBES = (Lobe("sheen", "glossy", params=("color", "roughness", "terminator_softening")),)
+_EXACT_TABLES = np.asarray(_EXACT_ALBEDO, dtype=np.float64).reshape(2, _EXACT_N_R, _EXACT_N_MU)
+SHEEN_LOBES = (
+    Lobe(
+        "sheen",
+        "glossy",
+        params=("color", "roughness", "terminator_softening", "sheen_lambda"),
+        reciprocal=False,  # with terminator_softening (eq. 4, the default)
+    ),
+)
 
 
 def _guide(xp: Any, prepared: dict[str, Any], wo: Any) -> Any:
@@ -272,7 +313,7 @@ def _guide(xp: Any, prepared: dict[str, Any], wo: Any) -> Any:
     directional albedo E(θo) from the table (OIDN: the surface's approximate colour)."""
     if not prepared["lobes"]:
         return None
-    e = albedo_lookup(xp, xp.abs(wo[2]), prepared["r"], prepared["soften"])
+    e = albedo_lookup(xp, xp.abs(wo[2]), prepared["r"], prepared["soften"], prepared["exact"])
     return prepared["color"] * e
 
 
@@ -280,11 +321,12 @@ MODEL = Model("sheen", SheenParams, _prepare, _eval, _pdf, _sample, lobes=SHEEN_
 
 
 # -- public numpy API ----------------------------------------------------------------------
-def D(cos_theta: Any, r: Any) -> np.ndarray:
+def D(cos_theta: Any, r: Any, r_min: float = R_MIN) -> np.ndarray:
     """Eq. 2 at micro-normal angle θ, float64, broadcast over both arguments."""
     c = np.asarray(cos_theta, dtype=np.float64)
     with np.errstate(divide="ignore"):
-        return distribution(NumpyOps(), np.maximum(1.0 - c * c, 0.0), np.asarray(r, float))
+        s2 = np.maximum(1.0 - c * c, 0.0)
+        return distribution(NumpyOps(), s2, np.asarray(r, float), r_min)
 
 
 def lambda_fit(cos_theta: Any, r: Any) -> np.ndarray:
@@ -294,11 +336,19 @@ def lambda_fit(cos_theta: Any, r: Any) -> np.ndarray:
     return np.exp(log_lambda(xp, c, fit_coefficients(xp, clamp_roughness(xp, rr))))
 
 
-def albedo(cos_theta: Any, r: Any, terminator_softening: bool = True) -> np.ndarray:
+def lambda_table(cos_theta: Any, r: Any) -> np.ndarray:
+    """Λ(θ) from the integrated table (``sheen_lambda = "exact"``), broadcast."""
+    c, rr = np.broadcast_arrays(np.asarray(cos_theta, float), np.asarray(r, float))
+    return lambda_exact(NumpyOps(), c, rr)
+
+
+def albedo(
+    cos_theta: Any, r: Any, terminator_softening: bool = True, sheen_lambda: str = "fit"
+) -> np.ndarray:
     """Tabulated directional albedo E(μ, r) of the lobe with F = 1."""
     xp = NumpyOps()
     c, rr = np.broadcast_arrays(np.asarray(cos_theta, float), np.asarray(r, float))
-    return albedo_lookup(xp, c, rr, terminator_softening)
+    return albedo_lookup(xp, c, rr, terminator_softening, sheen_lambda == "exact")
 
 
 def eval(params: SheenParams, wi: Any, wo: Any, **kw: Any) -> np.ndarray:  # noqa: A001

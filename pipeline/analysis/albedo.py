@@ -160,12 +160,13 @@ def _stratified_uniforms(rng: np.random.Generator, n: int) -> np.ndarray:
 def sheen_table(params: Any, cos_theta: np.ndarray) -> np.ndarray:
     """Conty-Kulla sheen: its shipped E(μ, r) table (F = 1) times the sheen colour F.
 
-    The model ships one table with the terminator softening (eq. 4) and one without;
-    the one matching ``params.terminator_softening`` is read.
+    The model ships a table with the terminator softening (eq. 4) and one without, for
+    each Λ mode; the one matching ``params.terminator_softening`` and
+    ``params.sheen_lambda`` is read.
     """
     from lookdev.materials import sheen
 
-    e = sheen.albedo(cos_theta, params.roughness, params.terminator_softening)
+    e = sheen.albedo(cos_theta, params.roughness, params.terminator_softening, params.sheen_lambda)
     return e[..., None] * np.asarray(params.color, dtype=np.float64)
 
 

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from lookdev.library import files
-from lookdev.materials import sheen
+from lookdev.materials import sheen, sheen_tables
 from lookdev.materials.arrays import NumpyOps
 
 
@@ -48,8 +48,20 @@ def _clamped_cosine_azimuthal(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.where(b >= a, 2.0 * math.pi * b, 2.0 * (a * np.sin(phi0) + b * phi0))
 
 
-def lambda_integrated(cos_theta: Any, r: float, n: int = 128) -> np.ndarray:
-    """Λ(θ) of eq. 2's distribution by the projected-area integral (Heitz 2014)."""
+def lambda_integrated(
+    cos_theta: Any, r: float, n: int = 128, r_min: float = sheen.R_MIN_EXACT
+) -> np.ndarray:
+    """Λ(θ) of eq. 2's distribution by the projected-area integral (Heitz 2014), for the
+    roughness r clamped to ``r_min`` (the exact mode's floor: the true Λ of every r the
+    model renders)."""
+    mu = np.atleast_1d(np.asarray(cos_theta, dtype=np.float64))
+    return projected_area_integrated(mu, r, n, r_min) / mu - 1.0
+
+
+def projected_area_integrated(
+    cos_theta: Any, r: float, n: int = 128, r_min: float = sheen.R_MIN_EXACT
+) -> np.ndarray:
+    """A(θ) = ∫ ⟨ω·m⟩ D(m) dm = cos θ (1 + Λ(θ)) (Heitz 2014 eq. 3), finite at cos θ = 0."""
     mu = np.atleast_1d(np.asarray(cos_theta, dtype=np.float64))
     x, w = gauss_legendre(n)
     sin_o = np.sqrt(np.maximum(0.0, 1.0 - mu * mu))
@@ -60,9 +72,9 @@ def lambda_integrated(cos_theta: Any, r: float, n: int = 128) -> np.ndarray:
         t = (0.5 * (lo + hi))[:, None] + half[:, None] * x[None, :]
         a = sin_o[:, None] * np.sin(t)
         b = mu[:, None] * np.cos(t)
-        d = sheen.D(np.cos(t), r)
+        d = sheen.D(np.cos(t), r, r_min)
         total += half * np.sum(w * d * np.sin(t) * _clamped_cosine_azimuthal(a, b), axis=1)
-    return total / mu - 1.0
+    return total
 
 
 @dataclass(frozen=True)
@@ -110,7 +122,9 @@ def lambda_fit_error(cos_theta: Any = None, roughness: Any = None, *, n: int = 1
 
 
 # -- directional albedo --------------------------------------------------------------------
-def albedo_integrated(cos_theta: Any, r: float, *, n: int = 96, soften: bool = True) -> np.ndarray:
+def albedo_integrated(
+    cos_theta: Any, r: float, *, n: int = 96, soften: bool = True, exact: bool = False
+) -> np.ndarray:
     """E(μ) = ∫ f(ωi, ωo) cos θi dωi (F = 1) by Gauss-Legendre × trapezoid quadrature.
 
     μi = s² concentrates nodes near grazing light, where the lobe peaks; the integrand is
@@ -128,14 +142,17 @@ def albedo_integrated(cos_theta: Any, r: float, *, n: int = 96, soften: bool = T
     weights = np.outer(wmu * mu, np.full(n, 2.0 * math.pi / n)).reshape(1, -1)
     wo = np.stack([np.sqrt(1.0 - mu_o * mu_o), np.zeros_like(mu_o), mu_o])[:, :, None]
     with np.errstate(all="ignore"):
-        f = sheen.lobe(NumpyOps(), wi, wo, r, soften)
+        f = sheen.lobe(NumpyOps(), wi, wo, r, soften, exact)
     return np.sum(f * weights, axis=-1)
 
 
-def build_albedo_table(n_mu: int, n_r: int, *, soften: bool = True, n: int = 96) -> np.ndarray:
-    """E at the table's nodes (:func:`~lookdev.materials.sheen.table_nodes`), (n_r, n_mu)."""
-    mu, r = sheen.table_nodes(n_mu, n_r)
-    return np.stack([albedo_integrated(mu, rr, n=n, soften=soften) for rr in r])
+def build_albedo_table(
+    n_mu: int, n_r: int, *, soften: bool = True, n: int = 96, exact: bool = False
+) -> np.ndarray:
+    """E at the table's nodes (:func:`~lookdev.materials.sheen.table_nodes`), (n_r, n_mu),
+    of the lobe with the fitted Λ or (``exact``) the tabulated one, from its floor."""
+    mu, r = sheen.table_nodes(n_mu, n_r, exact)
+    return np.stack([albedo_integrated(mu, rr, n=n, soften=soften, exact=exact) for rr in r])
 
 
 def albedo_table_error(
@@ -146,15 +163,20 @@ def albedo_table_error(
     n_r: int = 23,
     n: int = 96,
     seed: int = 0,
+    exact: bool = False,
 ) -> FitError:
     """Interpolated ``table`` against direct quadrature at off-node (μ, r) points."""
     rng = np.random.default_rng(seed)
+    floor = sheen.roughness_floor(exact)
     mu = np.sort(np.concatenate([rng.random(n_mu - 4) ** 4, [0.0, 1e-5, 1e-3, 1.0]]))
-    r = np.sort(rng.uniform(sheen.R_MIN, 1.0, n_r))
+    r = np.sort(rng.uniform(floor, 1.0, n_r))
+    if exact:  # the floor itself, where the lobe is sharpest, and every cell's middle
+        nodes = np.log(sheen.exact_roughness_nodes(table.shape[0]))
+        r = np.sort(np.concatenate([r, [floor], np.exp(0.5 * (nodes[1:] + nodes[:-1]))]))
     mu_ref = np.maximum(mu, sheen.COS_MIN)
-    ref = np.stack([albedo_integrated(mu_ref, rr, n=n, soften=soften) for rr in r])
+    ref = np.stack([albedo_integrated(mu_ref, rr, n=n, soften=soften, exact=exact) for rr in r])
     xp = NumpyOps()
-    got = sheen.interpolate(xp, table, mu[None, :], r[:, None])
+    got = sheen.interpolate(xp, table, mu[None, :], r[:, None], exact)
     err = np.abs(got - ref)
     return _worst(err, err / np.maximum(ref, 1e-3), mu, r)
 
@@ -178,8 +200,98 @@ def write_albedo_module(path: Path, tables: np.ndarray, errors: list[FitError]) 
 TABLE_SHAPE = (64, 32)  # (μ, r) nodes: chosen by albedo_table_error, see sheen_albedo
 
 
+# -- the exact Λ (sheen_lambda = "exact") ----------------------------------------------------
+def build_area_table(n_theta: int, n_r: int, n: int = 128) -> np.ndarray:
+    """A(θ, r) = cos θ (1 + Λ) at :func:`~lookdev.materials.sheen.area_nodes`, (n_r, n_θ)."""
+    mu, r = sheen.area_nodes(n_theta, n_r)
+    return np.stack([projected_area_integrated(mu, rr, n) for rr in r])
+
+
+def area_table_error(table: np.ndarray, *, n_theta: int = 97, n_r: int = 41, seed: int = 0):
+    """The interpolated projected area against the integral at off-node (θ, r) points,
+    θ uniform and r log-uniform over [0.01, 1], the ends included. Its relative error is
+    that of 1 + Λ and of G1 = cos θ / A."""
+    rng = np.random.default_rng(seed)
+    theta = np.sort(np.concatenate([rng.uniform(0.0, 0.5 * math.pi, n_theta - 2), [0.0, 1.5]]))
+    mu = np.concatenate([np.cos(theta), [sheen.COS_MIN]])
+    lo = math.log(sheen.R_MIN_EXACT)
+    r = np.sort(np.concatenate([np.exp(rng.uniform(lo, 0.0, n_r - 2)), [sheen.R_MIN_EXACT, 1.0]]))
+    ref = np.stack([projected_area_integrated(mu, rr) for rr in r])
+    got = sheen.projected_area(NumpyOps(), mu[None, :], r[:, None], table)
+    err = np.abs(got - ref)
+    return _worst(err, err / ref, mu, r)
+
+
+def lambda_table_error(cos_theta: Any = None, roughness: Any = None) -> FitError:
+    """The shipped exact-mode Λ (:func:`~lookdev.materials.sheen.lambda_table`) against
+    :func:`lambda_integrated`, counted as :func:`lambda_fit_error` counts the fit."""
+    mu = np.linspace(0.01, 1.0, 34) if cos_theta is None else np.asarray(cos_theta, float)
+    r = np.geomspace(0.01, 1.0, 20) if roughness is None else np.asarray(roughness, float)
+    ref = np.stack([lambda_integrated(mu, rr) for rr in r])
+    err = np.abs(sheen.lambda_table(mu[None, :], r[:, None]) - ref)
+    return _worst(err, np.where(ref >= 0.01, err / np.maximum(ref, 0.01), 0.0), mu, r)
+
+
+AREA_SHAPE = (64, 24)  # (θ, r) nodes of the exact Λ: chosen by area_table_error
+EXACT_TABLE_SHAPE = (64, AREA_SHAPE[1])  # (μ, r) of the exact albedo: r nodes the area's
+
+
+def _values(a: np.ndarray) -> str:
+    values = [f"{v:.7g}," for v in a.ravel()]
+    return "\n".join("    " + " ".join(values[k : k + 6]) for k in range(0, len(values), 6))
+
+
+def _indent(error: FitError) -> str:
+    return str(error).replace("\n", "\n  ")
+
+
+def write_exact_module(
+    path: Path, area: np.ndarray, albedo: np.ndarray, errors: list[FitError]
+) -> None:
+    """Rewrite the exact mode's data module (projected area and albedo, row-major)."""
+    (n_ra, n_th), (_, n_r, n_mu) = area.shape, albedo.shape
+    text = (
+        '"""Generated by ``python -m lookdev.pipeline.analysis.sheen_fit``; do not edit.\n\n'
+        'The exact-Λ Conty-Kulla sheen (``sheen_lambda = "exact"``, r ≥ 0.01):\n\n'
+        f"* AREA: projected area A = cos θ (1 + Λ), ({n_ra} r, {n_th} θ) at\n"
+        "  :func:`lookdev.materials.sheen.area_nodes`; interpolated against the integral:\n"
+        f"  {_indent(errors[0])}.\n"
+        f"* ALBEDO: E(μ, r) without and with softening, (2, {n_r} r, {n_mu} μ) at\n"
+        "  :func:`lookdev.materials.sheen.table_nodes` (exact); against quadrature,\n"
+        f"  without softening: {_indent(errors[1])};\n"
+        f"  with softening: {_indent(errors[2])}.\n"
+        '"""\n\n'
+        f"N_THETA = {n_th}\nN_R_AREA = {n_ra}\nN_MU = {n_mu}\nN_R = {n_r}\n# fmt: off\n"
+        f"AREA = (\n{_values(area)}\n)\nALBEDO = (\n{_values(albedo)}\n)\n# fmt: on\n"
+    )
+    files.atomic_write(path, text)
+
+
+def build_exact(n: int = 96) -> tuple[np.ndarray, np.ndarray, list[FitError]]:
+    """The exact mode's tables and their measured errors.
+
+    The albedo tabulates the lobe as it renders, with the *interpolated* Λ, so the area
+    table is put in place first (generation only: the shipped module is rewritten after).
+    """
+    area = build_area_table(*AREA_SHAPE)
+    errors = [area_table_error(area)]
+    shipped, sheen_tables._AREA_TABLE = sheen_tables._AREA_TABLE, area
+    try:
+        n_mu, n_r = EXACT_TABLE_SHAPE
+        albedo = np.stack(
+            [build_albedo_table(n_mu, n_r, soften=s, n=n, exact=True) for s in (False, True)]
+        )
+        errors += [
+            albedo_table_error(t, soften=s, n=n, exact=True)
+            for t, s in zip(albedo, (False, True), strict=True)
+        ]
+    finally:
+        sheen_tables._AREA_TABLE = shipped
+    return area, albedo, errors
+
+
 def main() -> None:
-    """Rebuild ``materials/sheen_albedo.py`` and print its measured error."""
+    """Rebuild ``materials/sheen_albedo.py`` and ``sheen_exact.py``; print their errors."""
     n_mu, n_r = TABLE_SHAPE
     tables = np.stack([build_albedo_table(n_mu, n_r, soften=s) for s in (False, True)])
     errors = [albedo_table_error(t, soften=s) for t, s in zip(tables, (False, True), strict=True)]
@@ -187,6 +299,10 @@ def main() -> None:
     for soften, error in zip((False, True), errors, strict=True):
         print(f"albedo table {n_mu}x{n_r}, softening {soften}: {error}")
     write_albedo_module(Path(sheen.__file__).with_name("sheen_albedo.py"), tables, errors)
+    area, albedo, exact_errors = build_exact()
+    for what, error in zip(("area", "albedo", "albedo softened"), exact_errors, strict=True):
+        print(f"exact {what}: {error}")
+    write_exact_module(Path(sheen.__file__).with_name("sheen_exact.py"), area, albedo, exact_errors)
 
 
 if __name__ == "__main__":

@@ -49,6 +49,9 @@ UNBOUNDED_HIGH = 10.0
 ceiling (DESIGN.md, Ranges), so the sweep tests each at its ceiling; only the composited
 Pixar lobe weights (model inputs a blend produces, never written in a preset) use this."""
 
+SHEEN_ROUGHNESS = (0.01, 0.05, 0.08, 1.0)
+"""Conty-Kulla roughness swept in both Λ modes (``sheen_lambda``)."""
+
 # Named stiff combinations (DESIGN.md), applied where every named field exists.
 COMBINATIONS: tuple[dict[str, Any], ...] = (
     {"roughness": 0.0, "metallic": 1.0},  # delta metal (α clamp)
@@ -85,6 +88,19 @@ COMBINATIONS: tuple[dict[str, Any], ...] = (
     {"sheen_model": "conty_kulla", "sheen": 1.0, "sheen_roughness": 0.0},
     {"sheen_model": "conty_kulla", "sheen": 1.0, "sheen_roughness": 1.0},
     {"roughness": 0.0, "terminator_softening": False},
+    # Conty-Kulla's Λ in both modes at the exact mode's floor 0.01, at 0.05 (where the fit
+    # gains energy: it reads r = 0.08 there), at the fit's floor 0.08 and at 1
+    *(
+        {"sheen_model": "conty_kulla", "sheen": 1.0, "sheen_roughness": r, "sheen_lambda": m}
+        for m in ("fit", "exact")
+        for r in SHEEN_ROUGHNESS
+    ),
+    *(
+        {"roughness": r, "sheen_lambda": m, "terminator_softening": s}
+        for m in ("fit", "exact")
+        for r in SHEEN_ROUGHNESS
+        for s in (False, True)
+    ),
     {"roughness": 0.0, "clear": 1.0, "back": 1.0},  # powerR at its cone floor, refraction
     {"roughness": 0.0, "specular_cone_scale": 0.0, "reflection_cone_scale": 0.0},
     {"roughness": 0.5, "normal_fresnel": 20.0, "grazing_fresnel": 0.0, "clear": 1.0},

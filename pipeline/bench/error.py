@@ -10,6 +10,8 @@ lambda     the Conty-Kulla Λ fit against numerical integration
 precision  float32 against float64 evaluation of every model
 denoise    equal-time curves of raw and OIDN-denoised proof frames (plastic, glass
            under sky, box filter) against a converged reference (:mod:`.denoise`)
+sheen_     both modes of the Conty-Kulla ``sheen_lambda`` (Table 1's fit, the exact
+lambda     table) against numerical integration, r from 0.01 to 1
 ========== ==============================================================================
 
 Outputs: a Rich table, ``error_bench.json`` (every row, the settings and the machine)
@@ -37,7 +39,7 @@ from . import denoise as denoise_bench
 from . import measure
 from .measure import Row
 
-ITEMS = ("render", "albedo", "lambda", "precision", "denoise")
+ITEMS = ("render", "albedo", "lambda", "precision", "denoise", "sheen_lambda")
 
 RENDER_IBL = "studio"
 # Proof-render cases: label → built-in preset name.
@@ -239,6 +241,13 @@ def run(
                 ),
             )
         )
+    if "sheen_lambda" in items:
+        tasks.append(
+            (
+                "sheen_lambda",
+                lambda: measure.bench_sheen_lambda(reference_nodes=settings.lambda_reference_nodes),
+            )
+        )
     if "precision" in items:
         for label, model, params in model_cases(models):
             tasks.append(
@@ -363,4 +372,5 @@ ERROR_NAMES = {
     "lambda": "relative RMS error",
     "precision": "max relative error of float32",
     "denoise": "relative MSE (mean over seeds)",
+    "sheen_lambda": "relative RMS error of Λ",
 }

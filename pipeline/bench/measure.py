@@ -215,6 +215,78 @@ def bench_lambda(
     return rows
 
 
+SHEEN_LAMBDA_ROUGHNESS = (0.01, 0.03, 0.08, 0.3, 1.0)
+"""Down to the exact mode's floor; the fit reads r < 0.08 as 0.08 (its rows show that)."""
+
+
+def bench_sheen_lambda(
+    *, roughness: Sequence[float] = SHEEN_LAMBDA_ROUGHNESS, reference_nodes: int = 2048
+) -> list[Row]:
+    """Both modes of ``sheen_lambda``, Λ as the lobe evaluates it (the fit of eq. 3 with
+    its floor 0.08, the exact mode's table with its floor 0.01), against the converged
+    projected-area integral at the roughness asked for, and each one's run time (per
+    value, over 10⁵ directions: a render's batch, not Python's call overhead)."""
+    from lookdev.materials import sheen
+    from lookdev.pipeline.analysis.sheen_fit import lambda_integrated
+
+    modes = {"fit (eq. 3)": sheen.lambda_fit, "table": sheen.lambda_table}
+    settings = {"fit (eq. 3)": "Table 1, r ≥ 0.08", "table": "exact, r ≥ 0.01"}
+    batch = np.tile(LAMBDA_COS, 2000)
+    backends = {"numpy": modes, **_drjit_lambdas(batch)}
+    rows = []
+    for r in roughness:
+        ref, t_ref = timed(lambda r=r: lambda_integrated(LAMBDA_COS, r, reference_nodes))
+        for backend, fns in backends.items():
+            for method, fn in fns.items():
+                value, t = timed(lambda fn=fn, r=r: np.asarray(fn(batch, r), dtype=np.float64))
+                rows.append(
+                    Row(
+                        "sheen_lambda",
+                        f"r = {r:g}",
+                        method,
+                        f"{settings[method]}, {backend}",
+                        relative_rms(value[: len(LAMBDA_COS)], ref),
+                        t,
+                        len(batch),
+                        f"integral {reference_nodes} nodes",
+                        t_ref,
+                    )
+                )
+    return rows
+
+
+def _drjit_lambdas(batch: np.ndarray) -> dict[str, dict[str, Callable[..., Any]]]:
+    """Both Λ modes on the renderer's backend (Dr.Jit, float32, forced and waited for),
+    or nothing where Mitsuba is not installed."""
+    try:
+        from lookdev.pipeline.variant import use_mitsuba
+
+        use_mitsuba()
+        import drjit as dr
+    except ImportError:
+        return {}
+    from lookdev.materials import sheen
+    from lookdev.materials.arrays import DrJitOps
+
+    xp = DrJitOps.for_mitsuba()
+    cos = xp.Float(batch)
+
+    def run(fn: Callable[..., Any]) -> Callable[[np.ndarray, float], np.ndarray]:
+        def call(_: np.ndarray, r: float) -> np.ndarray:
+            out = fn(xp, cos, xp.Float(r))
+            dr.eval(out)
+            dr.sync_thread()
+            return np.asarray(out)
+
+        return call
+
+    def fit(xp: Any, c: Any, r: Any) -> Any:
+        coeffs = sheen.fit_coefficients(xp, sheen.clamp_roughness(xp, r))
+        return xp.exp(sheen.log_lambda(xp, c, coeffs))
+
+    return {"Dr.Jit": {"fit (eq. 3)": run(fit), "table": run(sheen.lambda_exact)}}
+
+
 # -- float32 against float64 -----------------------------------------------------------
 def direction_pairs(n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Random (wi, wo) pairs over both hemispheres, plus the edge cases DESIGN.md lists:

@@ -37,10 +37,14 @@ SCALARS = tuple(
     if info.annotation in (float, "float") and name != COLOR
 )
 """Continuous scalar parameters, blended linearly (``ior`` travels as ``specular``)."""
-DISCRETE = ("thin", "sheen_model", "scatter_distance_scale")
+DISCRETE = ("thin", "sheen_model", "sheen_lambda", "scatter_distance_scale")
 """Parameters with no in-between: every layer that shows must agree (the per-channel
 scale of the scatter distance shapes one homogeneous interior medium, so it is one value)."""
-VOTERS = {"sheen_model": "sheen", "scatter_distance_scale": "scatter_distance"}
+VOTERS = {
+    "sheen_model": "sheen",
+    "sheen_lambda": "sheen",
+    "scatter_distance_scale": "scatter_distance",
+}
 """A layer votes on these only where the parameter they refine is non-zero."""
 
 

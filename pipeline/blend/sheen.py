@@ -46,7 +46,8 @@ def base_scale(blended: BlendedMaterial, cos_theta: float = 1.0) -> Any:
         return (1.0, 1.0, 1.0)
     color = xp.color(prepared["sheen"] * prepared["sheen_color"])
     mu = np.float64(cos_theta)
-    scale = np.maximum(sheen.base_scale(xp, mu, mu, xp.asarray(prepared["sheen_r"]), color), 0.0)
+    r, exact = xp.asarray(prepared["sheen_r"]), prepared["sheen_exact"]
+    scale = np.maximum(sheen.base_scale(xp, mu, mu, r, color, exact=exact), 0.0)
     scale = np.broadcast_to(scale, (3, np.size(scale) // 3))
     if scale.shape[1] == 1:
         return tuple(float(x) for x in scale[:, 0])

@@ -29,6 +29,7 @@ FINER_GROUPS: dict[str, dict[str, str]] = {
         "specular_tint": "dielectric",
         "ior": "dielectric",
         "sheen_roughness": "conty_kulla",
+        "sheen_lambda": "conty_kulla",
         "subsurface": "subsurface",
         "flatness": "flatness",
         "scatter_distance": "scatter",

@@ -24,6 +24,7 @@ from lookdev.materials.errors import LookdevError
 
 from .lobes import DEFAULTS, REGISTRY_MODEL, active_lobes, canonical, effective
 from .names import Slot
+from .sheen_lambda import exact_sheen
 
 CONTEXT_OUTPUT = {"universal": "surface", "mtlx": "mtlx:surface", "ri": "ri:surface"}
 """render context → the Material's terminal output name (UsdShade convention)."""
@@ -206,7 +207,7 @@ def source_from_params(name: str, model: str, params: Any, description: str = ""
     """A constant material's :class:`Source` (no maps)."""
     spelling = "ior" if getattr(params, "ior", None) is not None else DEFAULT_SPELLING[model]
     source = Source(name, model, canonical(params), spelling=spelling, description=description)
-    return gtr_as_ggx(source)
+    return exact_sheen(gtr_as_ggx(source))
 
 
 def gtr_as_ggx(source: Source) -> Source:

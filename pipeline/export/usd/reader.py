@@ -288,6 +288,11 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
         values["specular_gamma"] = float(spec.custom["specular_gamma"])
         if "roughness" in spec.custom:
             values["roughness"] = float(spec.custom["roughness"])
+    if model == "disney" and "sheen_lambda" in spec.custom:
+        # The exact-Λ sheen: no target has it; the writer kept it (sheen_lambda module).
+        from .sheen_lambda import CARRIED
+
+        values.update({k: spec.custom[k] for k in CARRIED if k in spec.custom})
     _to_preset_space(values, space, result)
     result.params = _preset_params(values, model, spelling)
     return result

@@ -141,7 +141,7 @@ def test_cli_prints_one_json_object(cli, tmp_path):
 def test_cli_rejects_an_unknown_item_in_one_line(cli, tmp_path):
     res = cli("bench", "error", "--item", "speed", "-o", str(tmp_path))
     assert res.code == 2
-    assert "allowed render, albedo, lambda, precision" in res.err
+    assert "allowed render, albedo, lambda, precision, denoise, sheen_lambda" in res.err
     assert "Traceback" not in res.err
 
 
@@ -187,3 +187,14 @@ def test_a_failing_case_is_reported_and_the_others_still_measured():
     report = E.run(TINY, ("precision",), models={"broken": broken, "lambert": LAMBERT})
     assert report.skipped == {"precision broken default": "failed: ZeroDivisionError: model bug"}
     assert {r.case for r in report.rows} == {"lambert default"}
+
+
+@pytest.mark.slow
+def test_sheen_lambda_rows_show_both_modes_against_the_integral():
+    rows = M.bench_sheen_lambda(roughness=(0.01, 0.3), reference_nodes=512)
+    by = {(r.case, r.method, r.setting.rsplit(", ", 1)[1]): r for r in rows}
+    for backend in {k[2] for k in by}:
+        for case in ("r = 0.01", "r = 0.3"):
+            table, fit = by[(case, "table", backend)], by[(case, "fit (eq. 3)", backend)]
+            assert table.error < 2e-3 < 0.1 < fit.error  # the fit reads r = 0.01 as 0.08
+            assert table.seconds > 0 and fit.seconds > 0

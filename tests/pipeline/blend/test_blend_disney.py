@@ -381,3 +381,12 @@ def test_a_flat_twin_over_a_normal_map_is_kept(tmp_path):
     assert out.decisions[-1].kept  # same parameters, but it flattens the normals below
     expected = np.array([0.5 / np.sqrt(2), 0.0, 0.5 / np.sqrt(2) + 0.5])
     assert np.allclose(out.normal_map, expected / np.linalg.norm(expected), atol=1e-6)
+
+
+def test_sheen_lambda_is_voted_only_by_layers_with_sheen():
+    exact = disney("velvet", sheen=1.0, sheen_model="conty_kulla", sheen_lambda="exact")
+    fitted = disney("cloth", sheen=0.5, sheen_model="conty_kulla")
+    out = blend(layered(layer(GOLD), layer(exact, 0.5)), 2)
+    assert out.constants["sheen_lambda"] == "exact"
+    with pytest.raises(BlendError, match="sheen_lambda"):
+        blend(layered(layer(fitted), layer(exact, 0.5)), 2)

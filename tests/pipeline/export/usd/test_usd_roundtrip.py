@@ -290,3 +290,28 @@ def test_specular_gamma_round_trips_through_custom_data(tmp_path):
     for node in ("preview_surface", "mtlx_surface", "ri_surface"):
         written = stage.GetPrimAtPath(f"/Materials/m/{node}").GetAttribute("inputs:roughness")
         assert written.Get() == pytest.approx(0.35677, abs=1e-4)  # lookdev.materials.highlight
+
+
+def test_exact_sheen_lambda_names_its_loss_and_round_trips(tmp_path):
+    # MaterialX's sheen_bsdf (conty_kulla) has the fitted Λ: the exact mode is a named,
+    # measured loss in every context, and customData carries it back with its sheen.
+    values = {
+        "sheen": 1.0,
+        "sheen_model": "conty_kulla",
+        "sheen_roughness": 0.03,
+        "sheen_lambda": "exact",
+    }
+    out = tmp_path / "exact.usda"
+    export_usd([source_from_params("m", "disney", DisneyParams(**values))], out)
+    (found,) = import_usd(out)
+    assert {k: found.params[k] for k in values} == pytest.approx(values)
+    for line in found.loss:
+        assert "sheen_lambda=exact" in line and "directional albedo differs by up to" in line
+    # The fit mode exports as before: nothing carried, no sheen_lambda in the notes.
+    fit = tmp_path / "fit.usda"
+    export_usd(
+        [source_from_params("m", "disney", DisneyParams(**{**values, "sheen_lambda": "fit"}))], fit
+    )
+    (found,) = import_usd(fit)
+    assert "sheen_lambda" not in found.params
+    assert not any("sheen_lambda" in line for line in found.loss)
