@@ -90,9 +90,9 @@ class Settings:
     presets: tuple[str, ...] = DEFAULT_PRESETS
     ibl: str = "sky"
     spp: int = 16
-    reference_spp: int = 1024
+    reference_spp: int = 256
     resolution: tuple[int, int] = (128, 64)
-    repeat: int = 16
+    repeat: int = 24
     ibl_width: int = 256
 
     @classmethod

@@ -297,14 +297,17 @@ def glass_(
     ibl: Annotated[str, typer.Option("--ibl", help="Built-in IBL name or an .exr/.hdr.")] = "sky",
     spp: Annotated[int, typer.Option("--spp", min=1, help="Samples per pixel.")] = 16,
     reference_spp: Annotated[
-        int, typer.Option("--reference-spp", min=4, help="Samples of each reference.")
-    ] = 1024,
+        int,
+        typer.Option(
+            "--reference-spp", min=4, help="Samples of each reference (relMSE denominator)."
+        ),
+    ] = 256,
     resolution: Annotated[
         tuple[int, int], typer.Option("--resolution", help="Width and height in pixels.")
     ] = (128, 64),
     repeat: Annotated[
         int, typer.Option("--repeat", min=1, help="Seeds (interleaved rounds).")
-    ] = 16,
+    ] = 24,
     as_json: JsonOut = False,
 ) -> None:
     """Cost of our glass at equal noise against Mitsuba's dielectric / roughdielectric.
