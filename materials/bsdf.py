@@ -39,6 +39,9 @@ import numpy as np
 
 from .arrays import NumpyOps, from_channel_first, to_channel_first
 
+ADJOINT = "adjoint"
+"""Key of a prepared material: sample the delta lobes' adjoint (see :class:`Model`)."""
+
 
 @dataclass(frozen=True)
 class Lobe:
@@ -65,6 +68,13 @@ class Lobe:
     switches: tuple[str, ...] = ()
     """The parameters that switch the lobe on (its own weight); none for a base lobe that
     any material has unless others take its energy (the Disney diffuse and specular)."""
+    reciprocal: bool = True
+    """f(light, viewer) = f(viewer, light), apart from the (η_viewer/η_light)² of a
+    refraction into a solid (Veach 1997 §5.2), which the model's ``prepared["eta"]``
+    carries. False for a lobe that is not, for some of its parameters: Smits' transmitted
+    highlights are centred on the *refracted view*, Conty–Kulla's terminator softening
+    acts on the light side only. A light tracer evaluates such a lobe with the roles as
+    they are, and Mitsuba flags it ``NonSymmetric``."""
 
     @property
     def mitsuba_flag(self) -> str:
@@ -86,6 +96,13 @@ class Model:
     ``restrict(xp, prepared, names)`` limits a prepared material to some of its lobes:
     a material whose lobe groups have their own shading normals renders as two
     restricted halves (:mod:`lookdev.pipeline.export.mitsuba.normals`).
+
+    ``prepared[ADJOINT]`` (set by a light tracer's adapter, Mitsuba's Importance mode)
+    asks ``sample`` for the *adjoint* of its delta lobes: given where the light comes
+    from (in the viewer's argument), the direction towards the viewer and the weight
+    f(light, viewer)·|cos|/pdf (Veach 1997 §3.7). A delta has no f the adapter could
+    evaluate, so only the model knows it; lobes with a density are unchanged (the
+    adapter weights them by ``eval`` with the roles swapped).
     """
 
     name: str

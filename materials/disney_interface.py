@@ -34,6 +34,7 @@ from typing import Any
 
 from . import fresnel as fr
 from . import microfacet as mf
+from .bsdf import ADJOINT
 
 __all__ = [
     "INTERFACE",
@@ -185,10 +186,15 @@ def delta_reflectance(xp: Any, pr: dict[str, Any], co: Any, front: Any, scale: A
 
 def delta_transmittance(xp: Any, pr: dict[str, Any], co: Any, front: Any) -> Any:
     """The smooth glass's transmitted weight: w_g T (1 − F(θo)), over η² through a solid
-    (radiance, as :func:`.microfacet.dielectric_btdf`); a thin sheet does not refract."""
+    (radiance, as :func:`.microfacet.dielectric_btdf`); a thin sheet does not refract.
+
+    The adjoint (``pr["adjoint"]``, a light tracer: ``co`` is then the light's side)
+    has no 1/η²: Snell pairs have one Fresnel, and radiance/η² is what is conserved,
+    so the η² of the radiance form is all that differs (Mitsuba's ``dielectric``).
+    """
     e = etap(xp, pr, front)
     t = pr["glass"] * (1.0 - fr.dielectric(xp, co, e))
-    if not pr["thin"]:
+    if not pr["thin"] and not pr.get(ADJOINT, False):
         t = t / (e * e)
     return pr["trans_color"] * t
 

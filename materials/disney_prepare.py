@@ -41,6 +41,7 @@ DISNEY_LOBES = (
         "glossy",
         params=("sheen", "sheen_tint", "sheen_model", "sheen_roughness"),
         switches=("sheen",),
+        reciprocal=False,  # with sheen_model = "conty_kulla": its terminator softening
     ),
     Lobe("specular", "glossy", highlight=True, params=("specular_gamma",)),
     Lobe(

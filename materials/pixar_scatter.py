@@ -13,7 +13,7 @@ from __future__ import annotations
 from typing import Any
 
 from . import pixar_lobes as lobes
-from .bsdf import Lobe
+from .bsdf import ADJOINT, Lobe
 
 PIXAR_LOBES = (
     Lobe("diffuse", "diffuse", family="diffuse", params=("diffuse_scale",)),
@@ -47,6 +47,7 @@ PIXAR_LOBES = (
         family="specular",
         params=("specular_t_scale", "transmission_tint", "ior"),
         switches=("clear",),
+        reciprocal=False,
     ),
     Lobe(
         "reflection_t",
@@ -56,6 +57,7 @@ PIXAR_LOBES = (
         family="reflection",
         params=("reflection_t_scale", "transmission_tint", "ior"),
         switches=("clear",),
+        reciprocal=False,
     ),
 )
 """Smits' three lobes and their transmitted twins; a lobe's ``family`` is its type in
@@ -233,7 +235,30 @@ def _delta_weight(xp: Any, prep: dict[str, Any], lobe: str, wo: Any) -> Any:
     return lobes.frn_blend(xp, w[p + "N"], w[p + "G"], wo[2])
 
 
+def _adjoint_refraction(xp: Any, prep: dict[str, Any], lobe: str, wl: Any) -> tuple[Any, Any]:
+    """The adjoint of a delta transmitted lobe, for light arriving from ``wl`` (+z side):
+    (the viewer's direction, its weight).
+
+    The lobe sends the view v to g(v) = (−vx/η, −vy/η, −cos θt), sin θt = sin θv/η. Its
+    adjoint sends light from l to the one viewer that sees it, v* = g⁻¹(l): (−η lx,
+    −η ly, −√(1 − η² sin²θl)), none where η sin θl > 1 (that light reaches no viewer
+    through this lobe). Projected solid angle scales as sin²θ, so dσ(v) = η² dσ(l) and
+    the weight is η² W(v*), W the radiance weight FrnBlend[N, G, cos θv*] (Veach 1997
+    §5.2: the adjoint of a bending without the 1/η² of radiance transport).
+    """
+    eta = prep["eta"]
+    sin2 = eta * eta * (1.0 - wl[2] * wl[2])
+    cos_v = xp.safe_sqrt(1.0 - sin2)
+    view = xp.vec3(-wl[0] * eta, -wl[1] * eta, -cos_v)
+    weight = _delta_weight(xp, prep, lobe, xp.vec3(view[0], view[1], cos_v)) * (eta * eta)
+    return view, xp.select(sin2 < 1.0, weight, 0.0)
+
+
 def scatter_sample(xp: Any, prep: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any, Any, Any]:
+    """One sampled direction; with ``prep[ADJOINT]`` the delta lobes' adjoint (``wo`` is
+    then where the light comes from, :class:`~.bsdf.Model`): the mirror is its own,
+    a transmitted lobe's is :func:`_adjoint_refraction`."""
+    adjoint = prep.get(ADJOINT, False)
     s = xp.select(wo[2] < 0.0, -1.0, 1.0)
     wo = xp.vec3(wo[0], wo[1], wo[2] * s)
     wi = xp.vec3(xp.zeros(u[0]), xp.zeros(u[0]), xp.zeros(u[0]) + 1.0)
@@ -245,12 +270,17 @@ def scatter_sample(xp: Any, prep: dict[str, Any], wo: Any, u: Any) -> tuple[Any,
     for lobe, prob in _selection(xp, prep, wo).items():
         chosen = (u[0] >= cumulative) & (u[0] < cumulative + prob)
         cumulative = cumulative + prob
-        wi = xp.select(chosen, _candidate(xp, prep, lobe, wo, u[1], u[2]), wi)
+        if adjoint and lobe in prep["delta"] and lobe.endswith("_t"):
+            candidate, value = _adjoint_refraction(xp, prep, lobe, wo)
+        else:
+            candidate = _candidate(xp, prep, lobe, wo, u[1], u[2])
+            value = _delta_weight(xp, prep, lobe, wo) if lobe in prep["delta"] else None
+        wi = xp.select(chosen, candidate, wi)
         if lobe.endswith("_t"):
             transmitted = transmitted | chosen
         if lobe in prep["delta"]:
             delta = delta | chosen
-            delta_value = xp.select(chosen, _delta_weight(xp, prep, lobe, wo), delta_value)
+            delta_value = xp.select(chosen, value, delta_value)
             delta_prob = xp.select(chosen, prob, delta_prob)
     # A highlight sample that leaves its own side failed (pdf 0), as in a renderer.
     ok = (u[0] < cumulative) & xp.select(transmitted, wi[2] < 0.0, wi[2] > 0.0)

@@ -264,7 +264,14 @@ def _sample(xp: Any, prepared: dict[str, Any], wo: Any, u: Any) -> tuple[Any, An
 
 # [without, with] terminator softening, each (n_r, n_mu).
 _TABLES = np.asarray(_TABLE_VALUES, dtype=np.float64).reshape(2, _N_R, _N_MU)
-SHEEN_LOBES = (Lobe("sheen", "glossy", params=("color", "roughness", "terminator_softening")),)
+SHEEN_LOBES = (
+    Lobe(
+        "sheen",
+        "glossy",
+        params=("color", "roughness", "terminator_softening"),
+        reciprocal=False,  # with terminator_softening (eq. 4, the default)
+    ),
+)
 
 
 def _guide(xp: Any, prepared: dict[str, Any], wo: Any) -> Any:

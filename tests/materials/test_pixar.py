@@ -300,6 +300,36 @@ def test_a_closed_reflection_cone_is_a_delta_along_the_mirror_and_the_refraction
     np.testing.assert_allclose(closed, open_, rtol=0.01)
 
 
+def test_the_adjoint_of_the_refraction_delta_sees_the_light_from_its_one_viewer():
+    """A light tracer (prepared[ADJOINT]) gets, for light from l, the viewer v* whose
+    refracted view is l, weighted η² W(v*): projected solid angle goes as sin²θ."""
+    from lookdev.materials.bsdf import ADJOINT
+
+    eta = 1.52
+    p = P(surface_color=(0.9, 0.8, 0.7), roughness=0.0, clear=1.0, ior=eta)
+    pr = pixar.MODEL.prepare(XP, p)
+    rng = np.random.default_rng(4)
+    n = 512
+    z = rng.uniform(0.05, 1.0, n)
+    phi = rng.uniform(0.0, 2.0 * math.pi, n)
+    r = np.sqrt(1.0 - z * z)
+    light = XP.vec3(r * np.cos(phi), r * np.sin(phi), z)
+    u = XP.vec3(np.full(n, 0.99999), np.full(n, 0.5), np.full(n, 0.5))  # the last lobe
+    v, w_adj, p_adj, d_adj = pixar.MODEL.sample(XP, {**pr, ADJOINT: True}, light, u)
+    ok = p_adj > 0
+    assert np.all(d_adj[ok]) and np.all(v[2][ok] < 0)
+    # Light beyond sin θ = 1/η reaches no viewer through this lobe.
+    np.testing.assert_array_equal(ok, eta * r < 1.0)
+    assert ok.any() and (~ok).any()
+    back = XP.vec3(*(np.where(ok, v[k], -light[k]) for k in range(3)))
+    lw, w_rad, p_rad, _ = pixar.MODEL.sample(XP, pr, back, u)
+    for k in range(3):  # the viewer's refracted view is the light
+        np.testing.assert_allclose(lw[k][ok], light[k][ok], atol=1e-12)
+    weight_adj = np.asarray(w_adj)[:, ok] * p_adj[ok]  # the lobe's W, not over its odds
+    weight_rad = np.asarray(w_rad)[:, ok] * p_rad[ok]
+    np.testing.assert_allclose(weight_adj, eta * eta * weight_rad, rtol=1e-12)
+
+
 def test_two_sided():
     p = P(roughness=0.3, clear=0.5, back=0.5)
     wi, wo = _dir(0.4, 2.0), _dir(0.8, 0.1)

@@ -12,15 +12,43 @@ Conventions at the boundary, and only here (DESIGN.md, Conventions):
 * Mitsuba's ``sample`` draws the light side from ``sample1`` (lobe choice) and ``sample2``
   (direction): ``u = (sample1, sample2.x, sample2.y)``, and our sample weight
   ``f·|cos θi|/pdf`` is exactly Mitsuba's sample value.
-* Transport mode. The models describe radiance: a refraction into a medium of relative
-  index η carries the 1/η² of the solid angle's compression (Veach 1997 §5.2, the
-  non-symmetric BSDF). Under ``TransportMode.Importance`` (a light tracer such as
-  ``ptracer``) that factor is taken out again: ``eval`` and the sampled weight of a
-  refracting pair are multiplied by η², η = η(wo side)/η(si.wi side) — the ``bs.eta`` of
-  the sample. This is Mitsuba's own convention (mitsuba3 ``src/bsdfs/roughdielectric.cpp``:
-  ``scale = Radiance ? sqr(inv_eta) : 1`` in ``eval``, ``factor = Radiance ? sqr(eta_ti)
-  : 1`` in ``sample``), and like it the refracting component is flagged ``NonSymmetric``.
-  Reflection, thin sheets and η = 1 do not refract and are symmetric in both modes.
+* Transport mode. Our models describe radiance: f(light, viewer), a refraction into a
+  medium of relative index η carrying the 1/η² of the solid angle's compression (Veach 1997
+  §5.2, the non-symmetric BSDF). Under ``TransportMode.Importance`` (a light tracer such
+  as ``ptracer``) si.wi is where the light came from and wo leads to the sensor, and
+  Mitsuba asks for the adjoint f*(si.wi, wo) = f(light = si.wi, viewer = wo): the plugin
+  evaluates the model with the roles as they physically are, and a sampled direction
+  (drawn by the model's sampler with si.wi as the viewer, so the pdf is unchanged) is
+  worth that f·|cos θo|/pdf. For a radiance-form refraction this is f·η², η = η(wo
+  side)/η(si.wi side), exactly Mitsuba's convention (mitsuba3 ``roughdielectric.cpp``:
+  ``scale = Radiance ? sqr(inv_eta) : 1`` in ``eval``; ``dielectric.cpp``: ``factor =
+  Radiance ? sqr(eta_ti) : 1`` in ``sample``), but it is also right for lobes that are not
+  of that form: a Lambertian ``diff_trans`` beside the glass has no η², Smits'
+  transmitted highlights (:mod:`lookdev.materials.pixar`) are centred on the refracted
+  view, so f(l, v) ≠ f(v, l) at any IOR, and Conty–Kulla's terminator softening
+  (:mod:`lookdev.materials.sheen`) acts on the light side only
+  (:attr:`~lookdev.materials.bsdf.Lobe.reciprocal`).
+  A delta sample has no f to evaluate, so the model supplies its adjoint itself when
+  ``prepared[ADJOINT]`` asks (:class:`~lookdev.materials.bsdf.Model`): the Disney glass
+  drops its 1/η², as ``dielectric`` does; Smits' refracted view sends light from l to
+  the one viewer whose view refracts to l, weight η² W (:mod:`lookdev.materials.pixar_scatter`).
+  A reciprocal BSDF is untouched in both modes
+  (same kernel, bit-identical values). The components holding a refraction or a
+  non-reciprocal lobe are flagged ``NonSymmetric``.
+
+  Measured (``tests/_transport_furnace.py``, which ``python tests/_transport_furnace.py``
+  prints; test ``test_mitsuba_transport.py``): white glass, η = 1.5, seen by a camera
+  *inside* it (the radiance in the glass, η² = 2.25 if lossless), ``path`` / ``ptracer``:
+  smooth 2.250 / 2.232 (``dielectric`` the same), rough 0.3 2.213 / 2.205
+  (``roughdielectric`` 2.213 / 2.206), thin 1.000 / 1.000; spec_trans 0.6 + diff_trans 0.3
+  1.415 / 1.406 (1.588 before, +12 %: the η² was applied to the Lambertian part too); the
+  Pixar glass (clear, back 1) 0.476 / 0.474 (1.265 before). Seen from outside, where
+  ``ptracer`` connects by the Importance ``eval`` of the rough transmission: 0.497 / 0.503
+  (``roughdielectric`` 0.498 / 0.498). ``ptracer`` noise there ≈ 1.1 % (32768 spp, 8×8).
+  The preset ``pixar_clear_glass`` (delta lobes only), camera inside: 1.000 / 1.024
+  (8 more seeds: 1.001 ± 0.006; 5.3 before, the η² guessed for its delta). The sheen's
+  softening changes only grazing light: a white sheen ball agrees either way
+  (0.078 / 0.078), which is why its test is on ``eval`` (``test_mitsuba_models.py``).
 
 Delta lobes. A model may sample some lobes as Dirac deltas (smooth glass, mirrors:
 ``prepared["delta"]``, :mod:`lookdev.materials.disney_interface`). They form their own
@@ -48,7 +76,7 @@ from typing import Any
 import numpy as np
 
 from lookdev.materials.arrays import DrJitOps
-from lookdev.materials.bsdf import Model
+from lookdev.materials.bsdf import ADJOINT, Model
 from lookdev.materials.errors import LookdevError
 from lookdev.materials.guides import guide_albedo
 from lookdev.materials.registry import is_color_field
@@ -201,14 +229,25 @@ def _plugin_class(variant: str) -> type:
                 extra |= flag.Anisotropic
             self.refracts = self._refracts(prepared)
             """Transmission bends the path (η ≠ 1 through a solid): non-symmetric."""
-            ns = flag.NonSymmetric if self.refracts else flag.Empty
-            non_symmetric = [flag.Empty, ns, flag.Empty, ns]
+            self.non_symmetric = self._non_symmetric(delta_lobes(prepared))
+            """Per component (0–3 as ``components``): f(l, v) ≠ f(v, l) somewhere in it."""
             self.m_components = [
-                c | extra | ns
-                for c, ns in zip(self.components, non_symmetric, strict=True)
+                c | extra | (flag.NonSymmetric if ns else flag.Empty)
+                for c, ns in zip(self.components, self.non_symmetric, strict=True)
                 if c != flag.Empty
             ]
             self.m_flags = functools.reduce(lambda a, b: a | b, self.m_components, flag.Empty)
+
+        def _non_symmetric(self, delta: tuple[str, ...]) -> list[bool]:
+            """Which of the four components is not reciprocal: the transmission of a
+            refracting solid (its η²) and any component holding a lobe the registry
+            declares non-reciprocal (:attr:`~lookdev.materials.bsdf.Lobe.reciprocal`)."""
+            out = [False, self.refracts, False, self.refracts]
+            for name in self.lobes:
+                lobe = self.model.lobe(name)
+                if not lobe.reciprocal:
+                    out[int(lobe.transmits) + 2 * (name in delta)] = True
+            return out
 
         def _placeholder(self, field: str) -> Any:
             # A texture may be non-zero somewhere: an opaque value keeps its lobe alive.
@@ -278,10 +317,22 @@ def _plugin_class(variant: str) -> type:
             # select, not ~: on scalar variants the mask is a Python bool, and ~True is -2.
             return dr.select(same_side, want_r, want_t)
 
+        def _f(self, ctx: mi.BSDFContext, prepared: Any, si_wi: Any, wo: Any) -> Any:
+            """The model's f for Mitsuba's (si.wi, wo) in the context's transport mode.
+
+            Ours is ``eval(light, viewer)``. Radiance: si.wi is the viewer, wo the light.
+            Importance (a light tracer): si.wi is where the light came from and wo leads to
+            the sensor, and Mitsuba asks for the adjoint f*(si.wi, wo) = f(light = si.wi,
+            viewer = wo) — the model evaluated with the roles as they physically are. For a
+            reciprocal model that is the same number, so only a non-symmetric BSDF pays.
+            """
+            if ctx.mode == mi.TransportMode.Importance and any(self.non_symmetric):
+                return self.model.eval(self.xp, prepared, si_wi, wo)
+            return self.model.eval(self.xp, prepared, wo, si_wi)
+
         def eval(self, ctx, si, wo, active=True):
             prepared = self._prepare(si, active)
-            f = self.model.eval(self.xp, prepared, wo, si.wi)  # ours: wi = light, wo = viewer
-            f = self._transport(ctx, prepared, si.wi.z, wo.z, f)
+            f = self._f(ctx, prepared, si.wi, wo)
             ok = active & self._hemisphere_mask(ctx, si.wi.z, wo.z)
             return dr.select(ok, self._scaled(mi.Spectrum(f) * dr.abs(wo.z)), 0.0)
 
@@ -293,8 +344,7 @@ def _plugin_class(variant: str) -> type:
 
         def eval_pdf(self, ctx, si, wo, active=True):
             prepared = self._prepare(si, active)
-            f = self.model.eval(self.xp, prepared, wo, si.wi)
-            f = self._transport(ctx, prepared, si.wi.z, wo.z, f)
+            f = self._f(ctx, prepared, si.wi, wo)
             pdf = self.model.pdf(self.xp, prepared, wo, si.wi)
             ok = active & self._hemisphere_mask(ctx, si.wi.z, wo.z)
             return (
@@ -304,6 +354,9 @@ def _plugin_class(variant: str) -> type:
 
         def sample(self, ctx, si, sample1, sample2, active=True):
             prepared = self._prepare(si, active)
+            adjoint = ctx.mode == mi.TransportMode.Importance and any(self.non_symmetric)
+            if adjoint and isinstance(prepared, dict):
+                prepared = {**prepared, ADJOINT: True}  # the model's deltas, adjoint
             u = self.xp.vec3(sample1, sample2.x, sample2.y)
             wi, weight, pdf, delta = self.model.sample(self.xp, prepared, si.wi, u)
             bs = dr.zeros(mi.BSDFSample3f)
@@ -334,8 +387,8 @@ def _plugin_class(variant: str) -> type:
             bs.sampled_component = mi.UInt32(dr.select(delta, index[1], index[0]))
             bs.sampled_type = mi.UInt32(dr.select(delta, kind[1], kind[0]))
             ok = active & (bs.pdf > 0) & dr.select(delta, enabled[1], enabled[0])
-            if self.refracts and ctx.mode == mi.TransportMode.Importance:
-                weight = self.xp.Array3(weight) * (bs.eta * bs.eta)  # see _transport
+            if adjoint:
+                weight = self._adjoint_weight(ctx, prepared, si, bs, weight, delta)
             value = dr.select(ok, self._scaled(mi.Spectrum(weight)), 0.0)
             bs.pdf = dr.select(ok, bs.pdf, 0.0)
             return bs, value
@@ -362,16 +415,23 @@ def _plugin_class(variant: str) -> type:
             except (TypeError, RuntimeError):
                 return True  # a texture or an opaque value: it may
 
-        def _transport(
-            self, ctx: mi.BSDFContext, prepared: Any, cos_view: mi.Float, cos_light: mi.Float, f
-        ) -> Any:
-            """f for the context's transport mode: the model's radiance f, or under
-            ``Importance`` that f times η² on a refracting pair (η = η_light/η_view side,
-            Mitsuba's ``roughdielectric``: it drops its ``sqr(inv_eta)``)."""
-            if not self.refracts or ctx.mode != mi.TransportMode.Importance:
-                return f
-            eta = self._eta(prepared, cos_view, cos_view * cos_light > 0)
-            return self.xp.Array3(f) * (eta * eta)
+        def _adjoint_weight(self, ctx, prepared, si, bs, weight, delta) -> Any:
+            """The sampled value f*(si.wi, wo)·|cos θo|/pdf of a light tracer.
+
+            The direction is drawn by the model's own sampler with si.wi in the viewer's
+            place, so the pdf of a sample with a density is unchanged, and its value is
+            the adjoint f of :meth:`_f` over that pdf (what ``eval``/``pdf`` say, so MIS
+            stays consistent). A delta has no f to evaluate: the model, asked through
+            ``prepared[ADJOINT]``, returned its adjoint direction and weight itself.
+            """
+            if delta is True:
+                return weight
+            f = self.xp.Array3(self._f(ctx, prepared, si.wi, bs.wo))
+            inv_pdf = dr.select(bs.pdf > 0, dr.rcp(bs.pdf), 0.0)
+            dense = f * (dr.abs(bs.wo.z) * inv_pdf)
+            if delta is False:
+                return dense
+            return dr.select(delta, self.xp.Array3(weight), dense)
 
         def _eta(self, prepared: Any, cos_view: mi.Float, reflected: mi.Bool) -> mi.Float:
             """Relative IOR along a sampled path (Mitsuba's Russian roulette tracks it).
