@@ -75,6 +75,16 @@ class Lobe:
     highlights are centred on the *refracted view*, Conty–Kulla's terminator softening
     acts on the light side only. A light tracer evaluates such a lobe with the roles as
     they are, and Mitsuba flags it ``NonSymmetric``."""
+    reciprocal_unless: tuple[str, ...] = ()
+    """Switches that make a reciprocal lobe non-reciprocal when on (a parameter set
+    true): Turquin's energy compensation of the Disney specular is read at the view
+    only (:mod:`.energy`), so ``energy_compensation`` does."""
+
+    def is_reciprocal(self, params: Any) -> bool:
+        """Whether this lobe is reciprocal for these parameters (see ``reciprocal``)."""
+        return self.reciprocal and not any(
+            getattr(params, name, False) is True for name in self.reciprocal_unless
+        )
 
     @property
     def mitsuba_flag(self) -> str:

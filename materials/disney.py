@@ -51,6 +51,7 @@ import importlib
 import math
 from typing import Any
 
+from . import energy
 from . import fresnel as fr
 from . import microfacet as mf
 from .arrays import NumpyOps
@@ -135,6 +136,12 @@ def _base_scale(xp: Any, pr: dict[str, Any], ci: Any, co: Any) -> Any:
     return xp.maximum(scale, 0.0)
 
 
+def _energy_factor(xp: Any, pr: dict[str, Any], co: Any, front: Any) -> Any:
+    """1 + F0 (1 − E(μo))/E(μo) outside, 1 inside a solid (the glass's own reflection)."""
+    extra = energy.factor(xp, pr["energy_f0"], co, pr["energy_r"]) - 1.0
+    return 1.0 + times(extra, front)
+
+
 def _masked(xp: Any, cond: Any, x: Any) -> Any:
     """x where cond, else 0, for an ``x`` that is finite everywhere.
 
@@ -176,12 +183,18 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
         dg = _masked(xp, up, 0.25 * d * g) if pr["ggx"] else xp.select(up, 0.25 * d * g, 0.0)
         a, b, c = pr["spec_a"], pr["spec_b"], pr["spec_c"]
         dg_out = times(dg, front)
-        terms += [(a * scale, dg_out), ((b - a) * scale, dg_out * w)]
+        spec_scale = scale
+        if pr["energy"]:
+            # Turquin 2019, seen from outside only (:mod:`.energy`): a colour factor
+            # on this lobe alone (the layers under it keep ``scale``).
+            ms = _energy_factor(xp, pr, co, front)
+            spec_scale = ms if isinstance(scale, float) else scale * ms
+        terms += [(a * spec_scale, dg_out), ((b - a) * spec_scale, dg_out * w)]
         if not xp.known_zero(c):
             # The glass reflects the exact Fresnel on either side; inside, nothing else does.
             f_exact = fr.dielectric(xp, cos_d, pick(xp, front, pr["eta"], 1.0 / pr["eta"]))
             k = f_exact * dg * pick(xp, front, c, pr["glass"])
-            terms.append((None if isinstance(scale, float) else scale, k))
+            terms.append((None if isinstance(spec_scale, float) else spec_scale, k))
     if "diffuse" in lobes:
         shape = _diffuse_shape(xp, pr, ci, co, cos2_d)
         k = times(pr["diffuse"] * INV_PI * shape, front)
@@ -437,27 +450,6 @@ def lobe_model(*names: str) -> Model:
         return restrict(xp, prepare(xp, params, **maps), names)
 
     return dataclasses.replace(MODEL, name="disney[" + ",".join(names) + "]", prepare=prepare_only)
-
-
-# -- the interior of a solid ---------------------------------------------------------------
-def medium_coefficients(xp: Any, color: Any, scatter_distance: Any) -> tuple[Any, Any]:
-    """(σt, single-scattering albedo) of the isotropic medium inside a solid transmissive
-    material whose apparent colour ``color`` appears at mean free path ``scatter_distance``.
-
-    Burley 2015 (after Christensen & Burley's fit, as in Schutte's CalculateExtinction):
-    s = 1.9 − A + 3.5 (A − 0.8)², σt = 1 / (s·d), albedo = 1 − exp(−5.09406 A
-    + 2.61188 A² − 4.31805 A³). ``scatter_distance`` 0 means no medium (σt = ∞): the BSDF
-    itself never needs it; the renderer's interior medium does.
-
-    >>> from .arrays import NumpyOps
-    >>> sigma_t, albedo = medium_coefficients(NumpyOps(), (0.8, 0.8, 0.8), 0.5)
-    >>> [round(float(v), 4) for v in sigma_t[:, 0]], round(float(albedo[0, 0]), 4)
-    ([1.8182, 1.8182, 1.8182], 0.9901)
-    """
-    a = xp.color(color)
-    s = 1.9 - a + 3.5 * (a - 0.8) * (a - 0.8)
-    albedo = 1.0 - xp.exp(a * (-5.09406 + a * (2.61188 - 4.31805 * a)))
-    return 1.0 / (s * scatter_distance), albedo
 
 
 # -- public numpy API --------------------------------------------------------------------

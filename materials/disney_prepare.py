@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from . import energy
 from . import fresnel as fr
 from . import microfacet as mf
 from .bsdf import Lobe
@@ -43,7 +44,13 @@ DISNEY_LOBES = (
         switches=("sheen",),
         reciprocal=False,  # with sheen_model = "conty_kulla": its terminator softening
     ),
-    Lobe("specular", "glossy", highlight=True, params=("specular_gamma",)),
+    Lobe(
+        "specular",
+        "glossy",
+        highlight=True,
+        params=("specular_gamma", "energy_compensation"),
+        reciprocal_unless=("energy_compensation",),  # Turquin's factor is read at the view
+    ),
     Lobe(
         "clearcoat",
         "glossy",
@@ -171,6 +178,11 @@ def prepare(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
     pr["gamma"] = float(gamma) if isinstance(gamma, int | float) else xp.scalar(gamma)
     pr["ggx"] = isinstance(gamma, int | float) and gamma == 2.0
     pr["a2"] = ax * ay
+    # Turquin 2019 multiple-scattering factor of the specular lobe (:mod:`.energy`).
+    pr["energy"] = energy.compensated(params, pr["ggx"])
+    if pr["energy"]:
+        pr["energy_r"] = energy.table_roughness(xp, ax, ay)
+        pr["energy_f0"] = energy.f0_of(xp, pr)
     pr["spec_lum_a"] = luminance(a)
     r_t = p["roughness"]
     if thin:

@@ -142,6 +142,13 @@ class DisneyParams(Params):
         "Burley's GGX, lower gives a longer tail, higher a tighter one. Isotropic when not 2.",
         json_schema_extra={"texturable": False},  # it picks the lobe's sampling technique
     )
+    energy_compensation: bool = Field(
+        False,
+        description="Scale the primary specular lobe by Turquin 2019's multiple-scattering "
+        "factor 1 + F0 (1 − E)/E (lookdev.materials.energy), so a white rough metal reflects "
+        "all the light; off keeps Burley's single-scattering look. GGX only: no effect where "
+        "specular_gamma is not 2; the glass's transmission and the clearcoat stay uncompensated.",
+    )
     sheen: float = _unit(
         0.0,
         "Additional grazing lobe for cloth; may exceed 1 (Burley), up to 10: ten times the "

@@ -2,8 +2,8 @@
 
 The roughness floors of the two Smith Λ (:data:`R_MIN` for Table 1's fit, :data:`R_MIN_EXACT`
 for the integrated one), the exact Λ from its projected-area table (:mod:`.sheen_exact`),
-and the bilinear table read that :mod:`.sheen` also uses for its albedo tables: numpy
-indexing, or a Dr.Jit gather from a copy made once per table.
+and the bilinear table read that :mod:`.sheen` also uses for its albedo tables
+(:func:`.tables.bilinear`, shared with :mod:`.energy`, re-exported here).
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ import numpy as np
 from .sheen_exact import AREA as _AREA
 from .sheen_exact import N_R_AREA as _N_R_AREA
 from .sheen_exact import N_THETA as _N_THETA
+from .tables import bilinear  # the one bilinear read of every shipped table
 
 __all__ = [
     "COS_MIN",
@@ -91,41 +92,3 @@ def lambda_exact(xp: Any, cos_theta: Any, r: Any) -> Any:
     """
     mu = xp.clip(cos_theta, COS_MIN, 1.0)
     return xp.maximum(projected_area(xp, mu, r) / mu - 1.0, 0.0)
-
-
-def _gather(xp: Any, flat: np.ndarray, index: Any) -> Any:
-    """``flat[index]`` for an index of any backend (integral values held as floats)."""
-    if xp.name == "numpy":
-        return flat[np.asarray(index, dtype=np.int64)]
-    if isinstance(index, int | float):  # Mitsuba's scalar_rgb: its Float is Python's float
-        return float(flat[int(index)])
-    dr = xp.dr
-    return dr.gather(xp.Float, _on_device(xp.Float, flat), dr.uint32_array_t(xp.Float)(index))
-
-
-_DEVICE_TABLES: dict[tuple[type, int], Any] = {}
-
-
-def _on_device(float_type: type, flat: np.ndarray) -> Any:
-    """``flat`` as a Dr.Jit array, copied once per array type and table.
-
-    Copying in the render (4 copies a lookup) cost a host-to-device transfer per call and
-    made renders impossible to freeze (``dr.freeze`` cannot record a host copy).
-    """
-    key = (float_type, hash(flat.tobytes()))
-    if key not in _DEVICE_TABLES:
-        _DEVICE_TABLES[key] = float_type(flat)
-    return _DEVICE_TABLES[key]
-
-
-def bilinear(xp: Any, table: np.ndarray, x: Any, y: Any) -> Any:
-    """``table`` (n_rows, n_cols) read bilinearly at fractional column x and row y."""
-    n_r, n_mu = table.shape
-    i = xp.clip(xp.floor(x), 0.0, n_mu - 2.0)
-    j = xp.clip(xp.floor(y), 0.0, n_r - 2.0)
-    fx, fy = x - i, y - j
-    flat = np.ascontiguousarray(table, dtype=np.float64).reshape(-1)
-    k = j * n_mu + i
-    e0 = xp.lerp(_gather(xp, flat, k), _gather(xp, flat, k + 1.0), fx)
-    e1 = xp.lerp(_gather(xp, flat, k + n_mu), _gather(xp, flat, k + n_mu + 1.0), fx)
-    return xp.lerp(e0, e1, fy)

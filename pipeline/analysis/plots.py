@@ -261,7 +261,8 @@ def draw_sphere(ax: Any, image: np.ndarray, exposure: float, title: str) -> None
 # -- one parameter varied -------------------------------------------------------------
 def varied(hubs: Sequence[BlendedMaterial], field: str, values: Sequence[float]) -> list:
     """Each uniform material once per value of one parameter, side by side (the columns
-    of ``lookdev plot --vary specular_gamma=1,1.5,2,3``): how one knob reshapes a lobe."""
+    of ``lookdev plot --vary specular_gamma=1,1.5,2,3``): how one knob reshapes a lobe.
+    A switch takes 0 and 1 (``--vary energy_compensation=off,on``)."""
     out = []
     for hub in hubs:
         if hub.maps or hub.normal_map is not None:
@@ -271,12 +272,16 @@ def varied(hubs: Sequence[BlendedMaterial], field: str, values: Sequence[float])
             raise PlotError(
                 f"{hub.name} has no parameter {field!r}; known: {known}", field="--vary"
             )
+        switch = type(hub.params).model_fields[field].annotation is bool
         for value in values:
+            # a switch (``energy_compensation``) takes 0/1 and is labelled off/on
+            v = bool(value) if switch else value
+            label = ("on" if v else "off") if switch else f"{value:g}"
             try:
-                params = hub.params.replace(**{field: value})
+                params = hub.params.replace(**{field: v})
             except LookdevError as exc:
                 raise PlotError(str(exc), where=hub.name, field="--vary") from None
-            out.append(BlendedMaterial.of_params(params, name=f"{hub.name} {field}={value:g}"))
+            out.append(BlendedMaterial.of_params(params, name=f"{hub.name} {field}={label}"))
     return out
 
 

@@ -221,6 +221,38 @@ def _sweep_energy_at(
         report._count(name, "energy_gain", int(gained.sum()), Finding("energy_gain", case, value))
 
 
+MEDIUM_UNITS = (1.0, 0.05)
+"""Metres per scene unit the interior is checked at: a preset's own and the proof's."""
+
+
+def _sweep_medium(report: ModelReport, label: str, params: Any, dtype: Any) -> None:
+    """A solid's interior medium as the renderer receives it, in ``dtype``: σt finite and
+    positive, albedo in [0, 1] (above 1 is an energy gain); nothing for other cases."""
+    from lookdev.materials.subsurface import has_interior, interior
+    from lookdev.pipeline.export.mitsuba.medium import interior_dict
+
+    if not hasattr(params, "scatter_distance") or not has_interior(params):
+        return
+    name = np.dtype(dtype).name
+    for unit in MEDIUM_UNITS:
+        sigma_t, albedo = interior(params, unit)
+        medium = interior_dict(params, unit)
+        normalised = np.asarray(medium["sigma_t"]["value"]) * medium["scale"]
+        for what, value in (("σt", sigma_t), ("albedo", albedo), ("Mitsuba σt", normalised)):
+            with np.errstate(over="ignore"):  # an overflow to ∞ is the finding
+                v = np.asarray(value, dtype=np.float64).astype(dtype)
+            report.cases += 1
+            report.cases_by_dtype[name] += 1
+            kind = (
+                "nan" if np.isnan(v).any() else "inf" if np.isinf(v).any()
+                else "negative" if (v < 0).any() or (what != "albedo" and (v <= 0).any())
+                else "energy_gain" if what == "albedo" and (v > 1).any() else None
+            )  # fmt: skip
+            if kind:
+                case = f"{label}; {name}; interior {what} {v} at {unit:g} m per unit"
+                report._count(name, kind, 1, Finding(kind, case))
+
+
 def check_model(
     name: str, model: Model, progress: Callable[[str], None] = lambda label: None
 ) -> ModelReport:
@@ -236,6 +268,8 @@ def check_model(
             try:
                 with np.errstate(all="ignore"):
                     _sweep_queries(report, model, label, params, dtype, with_maps)
+                    if not with_maps:
+                        _sweep_medium(report, label, params, dtype)
                     if plausible(params) and not with_maps:
                         _sweep_energy(report, model, label, params, dtype)
             except Exception as exc:  # noqa: BLE001 — a crashing model is a finding, not a stop

@@ -12,7 +12,10 @@ The cases of DESIGN.md, "Numerics that need care", for every model:
   wi = wo and the mirror direction (the peak of a delta-like lobe);
 * **uniforms** — the corners 0, ½ and 1 − 2⁻²⁴ of every sampling dimension, and random;
 * **maps** — once more with every float and colour field given per element (mixing its
-  extremes), the array code path that textures take.
+  extremes), the array code path that textures take;
+* **interiors** — a solid's medium (σt per unit at metres and at the proof's 5 cm unit,
+  albedo, and the Mitsuba dictionary's normalised σt and scale) for every case that has
+  one, in both precisions: finite, σt > 0, albedo in [0, 1].
 
 Allowances: the Conty-Kulla lobe and Smits' model conserve energy by construction (sheen
 0.002: its albedo table's measured interpolation error; pixar 0). The Disney BRDF adds
@@ -26,7 +29,11 @@ The maximum is along the bitangent of an anisotropic lobe: with ``anisotropic`` 
 (roughness 1, sheen 1, clearcoat 1, clearcoat_gloss 0, specular 1), at θo = 89.9999° it is
 1.718 ± 0.001 at φo = 0, 1.722 ± 0.001 at 45° and **1.783 ± 0.0014 at 90°** (2.6·10⁵
 samples each, float64); 1.783 + 4σ < 1.79, hence 0.79. (White satin, the preset, reaches
-1.41 along the bitangent against 1.11 along the tangent.) Parameters pushed past their
+1.41 along the bitangent against 1.11 along the tangent.) ``energy_compensation``
+(Turquin's factor on the specular, :mod:`lookdev.materials.energy`) adds F0 (1/E − 1) of
+the specular lobe on top: ≤ 0.0011 on a white plastic at specular 0.5 (1.5648 → 1.5659 at
+89°), ≤ 0.0044 at specular 1, and the maximum above becomes 1.787 ± 0.0014 (same samples),
+1.787 − 4σ < 1.79 (tests/materials/test_energy.py). Parameters pushed past their
 plausible range (sheen 10, specular 12.5, clearcoat 4) are checked for NaN, infinity and
 sign only: Burley allows them precisely to add energy.
 """
@@ -42,6 +49,7 @@ import numpy as np
 from lookdev.materials import registry
 from lookdev.materials.bsdf import Model
 from lookdev.materials.errors import LookdevError
+from lookdev.materials.params import SCATTER_DISTANCE_MAX, SCATTER_DISTANCE_MIN
 
 ALLOWANCE = {"disney": 0.79, "sheen": 0.002, "pixar": 0.0, "pixar_layered": 0.0}
 UNBOUNDED_HIGH = 10.0
@@ -81,6 +89,46 @@ COMBINATIONS: tuple[dict[str, Any], ...] = (
     ),
     {"specular_gamma": 1.0 - 1e-6, "specular": 1.0, "roughness": 0.3},
     {"specular_gamma": 10.0, "spec_trans": 1.0, "roughness": 0.2},
+    # the interior of a solid (Burley 2015, lookdev.materials.subsurface): the distance at
+    # its floor and ceiling, the most uneven per-channel scale each allows (the product is
+    # bounded, not the scale), black and white colours, the glass and every lobe above it
+    {"scatter_distance": SCATTER_DISTANCE_MIN},  # (the ceiling alone is a field extreme)
+    {
+        "scatter_distance": SCATTER_DISTANCE_MAX,
+        "scatter_distance_scale": (1.0, SCATTER_DISTANCE_MIN / SCATTER_DISTANCE_MAX, 0.5),
+    },
+    {
+        "scatter_distance": 1.0,
+        "scatter_distance_scale": (SCATTER_DISTANCE_MIN, 1.0, 1.0),
+        "base_color": (1.0, 1.0, 1.0),
+    },
+    {
+        "scatter_distance": 0.01,
+        "scatter_distance_scale": (1.0, 0.4, 0.2),
+        "base_color": (0.0, 0.0, 0.0),
+    },
+    {"scatter_distance": 0.01, "spec_trans": 1.0, "roughness": 0.0},
+    {"scatter_distance": 0.01, "spec_trans": 0.5, "roughness": 0.3, "diff_trans": 1.0},
+    {"scatter_distance": 0.01, "roughness": 1.0, "sheen": 1.0, "clearcoat": 1.0, "specular": 1.0},
+    # Turquin's energy compensation (materials/energy.py): a white metal at 1 from every
+    # view, the table's ends (R_MIN, 1), anisotropic, the most energetic plastic, glass,
+    # and γ ≠ 2 (left uncompensated)
+    *(
+        {"energy_compensation": True, "metallic": 1.0, "roughness": r}
+        for r in (0.0, 0.02, 0.0317, 0.5, 1.0)
+    ),
+    {"energy_compensation": True, "metallic": 1.0, "roughness": 1.0, "anisotropic": 1.0},
+    {
+        "energy_compensation": True,
+        "roughness": 1.0,
+        "sheen": 1.0,
+        "clearcoat": 1.0,
+        "clearcoat_gloss": 0.0,
+        "specular": 1.0,
+        "anisotropic": 1.0,
+    },
+    {"energy_compensation": True, "spec_trans": 1.0, "roughness": 0.5},
+    {"energy_compensation": True, "specular_gamma": 1.5, "metallic": 1.0, "roughness": 0.5},
     {"spec_trans": 1.0, "roughness": 0.0},  # smooth glass
     {"spec_trans": 1.0, "ior": 1.0, "roughness": 0.3},  # η = 1: refraction degenerates
     {"spec_trans": 1.0, "thin": True, "roughness": 0.0},
@@ -178,8 +226,12 @@ def parameter_cases(params_type: type) -> list[tuple[str, Any]]:
 
 
 def short(value: Any) -> str:
+    if isinstance(value, tuple) and all(v == 1 for v in value):
+        return "white"
+    if isinstance(value, tuple) and all(v == 0 for v in value):
+        return "black"
     if isinstance(value, tuple):
-        return "white" if all(v == 1 for v in value) else "black"
+        return "(" + ", ".join(f"{v:g}" for v in value) + ")"
     return f"{value:g}" if isinstance(value, float) else str(value)
 
 

@@ -12,6 +12,8 @@ denoise    equal-time curves of raw and OIDN-denoised proof frames (plastic, gla
            under sky, box filter) against a converged reference (:mod:`.denoise`)
 sheen_     both modes of the Conty-Kulla ``sheen_lambda`` (Table 1's fit, the exact
 lambda     table) against numerical integration, r from 0.01 to 1
+energy     a white rough metal's furnace |1 − E| with ``energy_compensation`` off and on,
+           by roughness, against the eval time the table look-up costs (:mod:`.energy`)
 ========== ==============================================================================
 
 Outputs: a Rich table, ``error_bench.json`` (every row, the settings and the machine)
@@ -39,7 +41,7 @@ from . import denoise as denoise_bench
 from . import measure
 from .measure import Row
 
-ITEMS = ("render", "albedo", "lambda", "precision", "denoise", "sheen_lambda")
+ITEMS = ("render", "albedo", "lambda", "precision", "denoise", "sheen_lambda", "energy")
 
 RENDER_IBL = "studio"
 # Proof-render cases: label → built-in preset name.
@@ -66,6 +68,7 @@ class Settings:
     lambda_nodes: tuple[int, ...] = (8, 16, 32, 64, 128)
     lambda_reference_nodes: int = 2048
     precision_pairs: int = 20000
+    energy_samples: int = 16384
     denoise: denoise_bench.DenoiseSettings = field(default_factory=denoise_bench.DenoiseSettings)
 
     @classmethod
@@ -81,6 +84,7 @@ class Settings:
             lambda_nodes=(4, 16),
             lambda_reference_nodes=512,
             precision_pairs=2000,
+            energy_samples=2048,
             denoise=denoise_bench.DenoiseSettings.quick(),
         )
 
@@ -260,6 +264,11 @@ def run(
             )
     if "denoise" in items:
         tasks += _denoise_tasks(settings.denoise, report)
+    if "energy" in items:
+        from . import energy
+
+        n = settings.energy_samples
+        tasks.append(("energy", lambda: energy.bench_energy(samples=n)))
     for done, (name, task) in enumerate(tasks):
         progress(name, done, len(tasks))
         try:
@@ -373,4 +382,5 @@ ERROR_NAMES = {
     "precision": "max relative error of float32",
     "denoise": "relative MSE (mean over seeds)",
     "sheen_lambda": "relative RMS error of Λ",
+    "energy": "white furnace max |1 − E|",
 }

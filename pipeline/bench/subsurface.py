@@ -3,10 +3,12 @@
 * :func:`slab` — a thick slab of a solid subsurface material (a 100 × 100 × 2 box of
   scatter distance 0.02, so ≥ 50 σt⁻¹ deep and wide) under a uniform white sky, seen
   straight down by an orthographic camera: the radiance it sends up is its directional
-  albedo at normal incidence, to be compared with its base colour (the claim of Chiang,
-  Kutz & Burley 2016's albedo inversion, :mod:`lookdev.materials.subsurface`). Specular
+  albedo at normal incidence, to be compared with its base colour (the claim of the
+  slab albedo table, :data:`lookdev.materials.subsurface.SLAB_TABLE`). Specular
   and roughness 0, so the surface adds nothing but the entry into the medium.
-* :func:`furnace` — a white solid subsurface sphere in a uniform white sky (≤ 1).
+* :func:`furnace` — a white solid subsurface sphere in a uniform white sky (≤ 1 at
+  roughness 0; rougher, Burley's retro-reflection adds energy on the surface by design,
+  less than it adds to the same sphere without a distance).
 * :func:`rim_glow` — the proof cup lit from behind: the radiance of its thin rim with
   the material's scatter distance against the same preset without one.
 * :func:`cost` — a proof's render time and noise with the medium against the same preset
@@ -20,11 +22,26 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["COLOURS", "cost", "furnace", "rim_glow", "run", "slab"]
+__all__ = [
+    "COLOURS",
+    "albedo_table",
+    "cost",
+    "furnace",
+    "rim_glow",
+    "run",
+    "slab",
+    "slab_of_albedo",
+]
 
 COLOURS = {"grey": (0.5, 0.5, 0.5), "skin": (0.8, 0.5, 0.35), "jade": (0.3, 0.6, 0.4)}
 """The three colours whose slabs are measured (a grey, a warm and a cool one)."""
 SLAB_DISTANCE = 0.02
+RIM_CLAMP = 10.0
+"""Per-sample radiance limit of :func:`rim_glow` (the light is 500): the near rim does not
+see the light past the far wall, so a polished cup (marble, roughness 0.12) is lit there
+by rare glossy interreflection paths, fireflies whose unclamped mean did not converge
+(marble without a distance: 0.026, 0.039, 0.058 at 8, 32, 128 spp; the ratio 8.1, 0.76,
+1.85). Clamped, both renders lose the same caustic paths and keep the diffuse glow."""
 SLAB_DEPTH = 4096  # paths end by Russian roulette long before; a slab is a deep walk
 
 
@@ -56,15 +73,24 @@ def slab(
 ) -> tuple[np.ndarray, np.ndarray]:
     """The thick slab's rendered directional albedo (RGB) at normal incidence, and the
     standard error of that mean (from the spread of its independent pixels)."""
-    mi = _variant()
+    _variant()
 
     from lookdev.materials.params import DisneyParams
     from lookdev.pipeline.export.mitsuba import bsdf_dict
-    from lookdev.pipeline.export.mitsuba.medium import integrator, interior_dict
+    from lookdev.pipeline.export.mitsuba.medium import interior_dict
 
     p = DisneyParams(base_color=colour, specular=0.0, roughness=0.0, scatter_distance=SLAB_DISTANCE)
     medium = interior_dict(p)
-    scene = {
+    return _mean_and_error(
+        _render(_slab_scene(bsdf_dict(p), medium, spp, size), spp).reshape(-1, 3)
+    )
+
+
+def _slab_scene(bsdf: dict, medium: dict, spp: int, size: int) -> dict[str, Any]:
+    mi = _variant()
+    from lookdev.pipeline.export.mitsuba.medium import integrator
+
+    return {
         "type": "scene",
         "integrator": integrator(SLAB_DEPTH, medium),
         "sensor": {
@@ -79,11 +105,50 @@ def slab(
         "slab": {
             "type": "cube",
             "to_world": mi.ScalarTransform4f().scale([50, 50, 1]),
-            "bsdf": bsdf_dict(p),
+            "bsdf": bsdf,
             "interior": medium,
         },
     }
+
+
+def slab_of_albedo(
+    albedo: tuple[float, float, float], *, spp: int = 256, size: int = 16
+) -> tuple[np.ndarray, np.ndarray]:
+    """The thick slab's rendered reflectance (RGB) and its standard error for a medium of
+    single-scattering ``albedo`` per channel: the slab of :func:`slab` with its medium's
+    albedo set directly and σt that of a grey 0.5 in every channel (the slab is hundreds
+    of mean free paths deep whatever σt, so the reflectance depends on the albedo alone)."""
+    from lookdev.materials.params import DisneyParams
+    from lookdev.pipeline.export.mitsuba import bsdf_dict
+    from lookdev.pipeline.export.mitsuba.medium import interior_dict
+
+    grey = (0.5, 0.5, 0.5)  # one σt for all channels: no channel's free flight reweighted
+    p = DisneyParams(base_color=grey, specular=0.0, roughness=0.0, scatter_distance=SLAB_DISTANCE)
+    medium = interior_dict(p)
+    medium["albedo"] = {"type": "rgb", "value": [float(a) for a in albedo]}
+    scene = _slab_scene(bsdf_dict(p), medium, spp, size)
     return _mean_and_error(_render(scene, spp).reshape(-1, 3))
+
+
+def albedo_table(
+    roots: Any = None, *, spp: int = 256, size: int = 32
+) -> tuple[tuple[float, float], ...]:
+    """(rendered slab reflectance A, albedo α) rows of our own thick slab, for the table
+    :data:`lookdev.materials.subsurface.SLAB_TABLE`: α = 1 − u² over ``roots`` u (three
+    per render, one per channel), plus the exact ends (0, 0). Rows sorted by α; a noisy
+    non-increasing A is kept as rendered (the test bounds it by the standard error).
+    """
+    if roots is None:
+        roots = (*np.linspace(1.0, 0.1, 28)[1:], 0.08, 0.06, 0.045, 0.03, 0.02, 0.014, 0.01)
+        roots = (*roots, 0.005, 0.0)
+    u = np.asarray(roots, dtype=np.float64)
+    u = np.concatenate([u, np.full((-len(u)) % 3, u[-1])])  # whole renders of three
+    rows = {0.0: 0.0}
+    for chunk in u.reshape(-1, 3):
+        alpha = 1.0 - chunk * chunk
+        got, _ = slab_of_albedo(tuple(alpha), spp=spp, size=size)
+        rows.update({float(a): float(r) for a, r in zip(alpha, got, strict=True)})
+    return tuple((rows[a], a) for a in sorted(rows))
 
 
 def furnace(
@@ -103,17 +168,29 @@ def furnace(
     return float(mean[0]), float(error[0])
 
 
-def _preset_pair(name: str) -> tuple[Any, Any]:
+def _preset_pair(name: str, distance_scale: float = 1.0) -> tuple[Any, Any]:
     from lookdev import blend, load
 
     hub = blend(load(name), 64)
+    if distance_scale != 1.0:
+        d = hub.constants["scatter_distance"] * distance_scale
+        hub.constants = {**hub.constants, "scatter_distance": d}
+        hub.__dict__.pop("params", None)  # its cache, if built: from the constants again
     flat = blend(load(name), 64)
     flat.constants = {**flat.constants, "scatter_distance": 0.0}
     return hub, flat
 
 
-def rim_glow(name: str = "skin", *, spp: int = 64, size: tuple[int, int] = (160, 80)) -> dict:
-    """Mean radiance of the cup's rim under a back light, with and without the distance.
+def rim_glow(
+    name: str = "skin",
+    *,
+    spp: int = 64,
+    size: tuple[int, int] = (160, 80),
+    distance_scale: float = 1.0,
+    clamp: float | None = RIM_CLAMP,
+) -> dict:
+    """Mean radiance of the cup's rim under a back light, with and without the distance
+    (the preset's, times ``distance_scale``).
 
     The environment is black but for a small bright light behind the cup (opposite the
     camera), so what the rim sends to the camera is light that went through it, or
@@ -128,10 +205,12 @@ def rim_glow(name: str = "skin", *, spp: int = 64, size: tuple[int, int] = (160,
     # edge columns; its centre column faces the camera, :data:`.ibl.ORIENTATION`).
     env[56:64, :4] = env[56:64, -4:] = 500.0
     out = {}
-    for label, hub in zip(("with", "without"), _preset_pair(name), strict=True):
+    for label, hub in zip(("with", "without"), _preset_pair(name, distance_scale), strict=True):
         bsdf, depth = material_bsdf(hub)
         interior = material_interior(hub)
-        scene = shaderball.scene_dict(bsdf, env, size, depth, rig="none", interior=interior)
+        scene = shaderball.scene_dict(
+            bsdf, env, size, depth, rig="none", interior=interior, clamp=clamp
+        )
         out[label] = _render(scene, spp)
     rim = _rim_mask(size)
     w, wo = out["with"][rim].mean(), out["without"][rim].mean()
@@ -198,19 +277,32 @@ def cost(name: str = "skin", *, spp: int = 16, repeats: int = 2) -> dict[str, fl
     }
 
 
-def run(*, spp: int = 64, presets: tuple[str, ...] = ("skin", "jade")) -> dict[str, Any]:
+def run(
+    *,
+    spp: int = 64,
+    presets: tuple[str, ...] = ("skin", "jade"),
+    rims: tuple[str, ...] = ("skin", "jade", "marble"),
+) -> dict[str, Any]:
     """Every figure of this module in one run: slab error per colour and channel, the
     furnace's brightest block, the rim ratios, and the cost against no distance."""
     slabs = {}
     for name, colour in COLOURS.items():
-        got, std = slab(colour, spp=4 * spp)
+        got, std = slab(colour, spp=4 * spp, size=32)
         slabs[name] = {"base": list(colour), "rendered": got.tolist(),
                        "error": (got - np.asarray(colour)).tolist(),
                        "standard_error": std.tolist()}  # fmt: skip
     return {
-        "mapping": "Chiang, Kutz & Burley 2016 albedo inversion, s of Christensen-Burley 2015",
+        "mapping": "albedo from our own slab table (SLAB_TABLE), s of Christensen-Burley 2015",
         "slab": slabs,
-        "furnace": dict(zip(("mean", "standard_error"), furnace(spp=2 * spp), strict=True)),
-        "rim": {name: rim_glow(name, spp=spp) for name in presets},
+        # roughness 0: the medium and its boundary alone (≤ 1); 0.5: with Burley's
+        # retro-reflection on the surface, which adds energy by design (see the opaque)
+        "furnace": dict(
+            zip(("mean", "standard_error"), furnace(roughness=0.0, spp=2 * spp), strict=True)
+        ),
+        "furnace_rough": {
+            "with": furnace(roughness=0.5, spp=2 * spp)[0],
+            "without": furnace(scatter_distance=0.0, roughness=0.5, spp=2 * spp)[0],
+        },
+        "rim": {name: rim_glow(name, spp=spp) for name in rims},
         "cost": {name: cost(name, spp=max(spp // 4, 4)) for name in presets},
     }

@@ -13,9 +13,10 @@ Unrolled, the chain is a weighted sum (:func:`stack_weights`)::
 which is exact at masks 0 and 1 (a full-coverage layer gives weight exactly 1 to itself and
 exactly 0 below), and lets one matrix product produce every parameter map of a tile.
 
-Parameters that cannot be interpolated (``thin``, ``sheen_model``) must agree across the
-layers that show; ``ior`` is blended as the ``specular`` it spells (Burley's parameter,
-linear in F0) and spelled back as ``ior`` only when every layer wrote ``ior``.
+Parameters that cannot be interpolated (``thin``, ``sheen_model``, ``energy_compensation``)
+must agree across the layers that show; ``ior`` is blended as the ``specular`` it spells
+(Burley's parameter, linear in F0) and spelled back as ``ior`` only when every layer wrote
+``ior``.
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ SCALARS = tuple(
     if info.annotation in (float, "float") and name != COLOR
 )
 """Continuous scalar parameters, blended linearly (``ior`` travels as ``specular``)."""
-DISCRETE = ("thin", "sheen_model", "sheen_lambda", "scatter_distance_scale")
+DISCRETE = ("thin", "sheen_model", "sheen_lambda", "scatter_distance_scale", "energy_compensation")
 """Parameters with no in-between: every layer that shows must agree (the per-channel
 scale of the scatter distance shapes one homogeneous interior medium, so it is one value)."""
 VOTERS = {

@@ -73,7 +73,7 @@ def plot(
             "--vary",
             metavar="PARAM=V1,V2,…",
             help="Draw each preset once per value of one parameter, e.g. "
-            "specular_gamma=1,1.5,2,3 (uniform presets).",
+            "specular_gamma=1,1.5,2,3 or energy_compensation=off,on (uniform presets).",
         ),
     ] = None,
     uv: Annotated[
@@ -95,6 +95,8 @@ def plot(
       lookdev plot velvet --view sphere --ibl studio -o velvet.png --exposure -1
 
       lookdev plot gold --vary specular_gamma=1,1.5,2,3 -o gamma.png --exposure -3
+
+      lookdev plot gold --view albedo --vary energy_compensation=off,on -o ms.png
       lookdev --view Un-tone-mapped plot gold -o gold.png    # another OCIO view (global)
     """
     from lookdev.pipeline import api
@@ -124,10 +126,14 @@ def _vary(text: str | None) -> tuple[str, list[float]] | None:
     from lookdev.pipeline.analysis.plots import PlotError
 
     name, _, values = text.partition("=")
+    switch = {"off": 0.0, "false": 0.0, "on": 1.0, "true": 1.0}  # a switch's two values
+    words = [v.strip().lower() for v in values.split(",") if v.strip()]
     try:
-        numbers = [float(v) for v in values.split(",") if v.strip()]
+        numbers = [switch[w] if w in switch else float(w) for w in words]
     except ValueError:
         numbers = []
     if not name.strip() or not numbers:
-        raise PlotError(f"--vary {text!r}: expected PARAM=V1,V2,… with numbers", field="--vary")
+        raise PlotError(
+            f"--vary {text!r}: expected PARAM=V1,V2,… with numbers (or off,on)", field="--vary"
+        )
     return name.strip(), numbers

@@ -7,6 +7,8 @@ from lookdev.materials import disney
 from lookdev.materials.params import DisneyParams, ParameterError
 from lookdev.materials.subsurface import (
     JENSEN_2001,
+    REFLECTANCE_MAX,
+    SLAB_TABLE,
     albedo_of,
     colour_for_albedo,
     from_measured,
@@ -16,9 +18,22 @@ from lookdev.materials.subsurface import (
 )
 
 
-def test_inversion_round_trips_over_the_unit_range():
-    a = np.linspace(0.0, 1.0, 101)
+def test_inversion_round_trips_up_to_the_boundary_s_cap():
+    a = np.linspace(0.0, REFLECTANCE_MAX, 101)
     assert np.allclose(colour_for_albedo(albedo_of(a)), a, atol=1e-9)
+    # brighter colours than a slab of albedo 1 reflects take albedo 1 (the cap)
+    assert np.all(albedo_of([REFLECTANCE_MAX, 0.9, 1.0]) == 1.0)
+    assert albedo_of(0.0) == 0.0 and colour_for_albedo(1.0) == REFLECTANCE_MAX
+
+
+def test_the_slab_table_is_increasing_and_tighter_than_the_fit_it_replaces():
+    a, alpha = np.array(SLAB_TABLE).T
+    assert np.all(np.diff(a) > 0) and np.all(np.diff(alpha) > 0)
+    assert SLAB_TABLE[0] == (0.0, 0.0) and SLAB_TABLE[-1][1] == 1.0
+    # Chiang-Kutz-Burley's α(A) = 1 − exp(−5.09406 A + 2.61188 A² − 4.31805 A³) gives
+    # less albedo than our slab needs (its slab reflected 4-14 % too little).
+    ckb = 1.0 - np.exp(a * (-5.09406 + a * (2.61188 - 4.31805 * a)))
+    assert np.all(ckb[1:-1] < alpha[1:-1])
 
 
 def test_interior_follows_the_seed_and_scales_with_the_scene_unit():
@@ -36,7 +51,7 @@ def test_measured_media_convert_back_to_their_coefficients():
         sigma_t, albedo = interior(p, 1e-3)  # per millimetre
         ss, sa = np.asarray(ss), np.asarray(sa)
         assert np.allclose(sigma_t, ss + sa, rtol=1e-6)
-        keep = albedo < 0.998  # α(1) = 0.9989 caps what the fit can express
+        keep = np.asarray(colour) < REFLECTANCE_MAX  # the cap: albedo 1 and beyond
         assert np.allclose(albedo[keep], (ss / (ss + sa))[keep], atol=1e-6)
 
 

@@ -3,7 +3,7 @@
 A solid Disney material with a scatter distance (:func:`lookdev.materials.subsurface.
 has_interior`) is a boundary BSDF (our plugin: surface lobes, the diffuse entry and the
 glass) around a Mitsuba ``homogeneous`` medium, isotropic, whose σt and albedo come from
-:func:`lookdev.materials.subsurface.interior` (Chiang, Kutz & Burley 2016). Only scenes
+:func:`lookdev.materials.subsurface.interior` (our slab's albedo table). Only scenes
 holding such a medium need the volumetric path tracer; every other scene keeps ``path``
 and its speed (:func:`integrator`).
 """

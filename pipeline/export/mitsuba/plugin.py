@@ -245,7 +245,7 @@ def _plugin_class(variant: str) -> type:
             out = [False, self.refracts, False, self.refracts]
             for name in self.lobes:
                 lobe = self.model.lobe(name)
-                if not lobe.reciprocal:
+                if not lobe.is_reciprocal(self.params):
                     out[int(lobe.transmits) + 2 * (name in delta)] = True
             return out
 

@@ -124,6 +124,8 @@ def principled_equivalent(hub: BlendedMaterial) -> dict[str, Any] | None:
         return None
     if getattr(hub.params, "specular_gamma", 2.0) != 2.0:
         return None  # ``principled`` is GGX only (γ = 2): the plugin renders any GTR γ
+    if getattr(hub.params, "energy_compensation", False):
+        return None  # ``principled`` is single-scattering: the plugin compensates
     if is_delta(float(hub.params.roughness), float(hub.params.anisotropic)):
         return None  # a smooth metal is a delta in our model, principled is glossy (α 10⁻³)
     out: dict[str, Any] = {"type": "principled", "metallic": 1.0}

@@ -21,18 +21,27 @@ coat_weight × 4                   coat × 4                    clearcoat (Burle
 coat_roughness                    coat_roughness              clearcoat_gloss (α = r², App. B.2)
 transmission_weight               transmission                spec_trans
 subsurface_weight                 subsurface                  subsurface
-subsurface_radius × _scale        subsurface_radius × _scale  scatter_distance (mean, × mpu)
+subsurface_radius × _scale        subsurface_radius × _scale  scatter_distance, _scale (RGB × mpu)
 fuzz_weight                       sheen                       sheen (sheen_model conty_kulla)
 geometry_thin_walled              thin_walled                 thin
 ================================  ==========================  ===================================
+
+The radius is per channel (OpenPBR: a length times a colour, Standard Surface: a colour
+times a length); it becomes lookdev's distance (the largest channel) and scale. It makes
+an interior only where the surface scatters: at subsurface weight 0 (the DCCs' default)
+the authored or default radius shows nothing, so it is not read; a weight below 1 is
+named, since lookdev's solid sends its whole diffuse into its interior (Burley 2015).
 """
 
 from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
 from lookdev.materials.colour import luminance
 from lookdev.materials.fresnel import F0_MAX, SPECULAR_F0_SCALE
+from lookdev.materials.subsurface import split_distances
 
 from .names import CLEARCOAT_PREVIEW_SCALE, roughness_to_gloss
 from .network import Connection, Node
@@ -66,7 +75,7 @@ TABLES: dict[str, dict[str, tuple[str, str | None, Any]]] = {
         "clearcoat_gloss": ("coat_roughness", None, roughness_to_gloss),
         "spec_trans": ("transmission_weight", None, None),
         "subsurface": ("subsurface_weight", None, None),
-        "scatter_distance": ("subsurface_radius", "subsurface_radius_scale", _mean),
+        "scatter_distance": ("subsurface_radius", "subsurface_radius_scale", None),
         "sheen": ("fuzz_weight", None, None),
         "thin": ("geometry_thin_walled", None, bool),
     },
@@ -80,7 +89,7 @@ TABLES: dict[str, dict[str, tuple[str, str | None, Any]]] = {
         "clearcoat_gloss": ("coat_roughness", None, roughness_to_gloss),
         "spec_trans": ("transmission", None, None),
         "subsurface": ("subsurface", None, None),
-        "scatter_distance": ("subsurface_radius", "subsurface_scale", _mean),
+        "scatter_distance": ("subsurface_radius", "subsurface_scale", None),
         "sheen": ("sheen", None, None),
         "thin": ("thin_walled", None, bool),
     },
@@ -156,7 +165,11 @@ def read_foreign(
             continue
         if value is None:
             continue
-        if scale is not None:
+        if param == "scatter_distance":
+            value = np.broadcast_to(value, (3,)) * np.broadcast_to(
+                1.0 if scale is None else scale, (3,)
+            )
+        elif scale is not None:
             value = (
                 tuple(x * _mean(scale) for x in value)
                 if isinstance(value, tuple)
@@ -165,14 +178,32 @@ def read_foreign(
         values[param] = convert(value) if convert else value
     if "sheen" in values:
         values["sheen_model"] = "conty_kulla"
-    if "scatter_distance" in values:
-        values["scatter_distance"] *= meters_per_unit
+    _read_radius(values, maps, losses, surface.id, meters_per_unit)
     for name in UNREAD[surface.id]:
         if name in surface.inputs and not _at_default(surface.inputs[name][1], defaults.get(name)):
             value = surface.inputs[name][1]
             shown = "a connected map" if isinstance(value, Connection) else _short(value)
             losses.append(f"{surface.id} {name} = {shown} has no Disney parameter")
     return values, maps, losses
+
+
+def _read_radius(values, maps, losses, surface_id: str, meters_per_unit: float) -> None:
+    """The RGB radius (scene units) in ``values`` → ``scatter_distance`` (metres) and
+    ``scatter_distance_scale``, where the surface scatters (see the module note)."""
+    radius = values.pop("scatter_distance", None)
+    weight = values.get("subsurface", 0.0)
+    if radius is None or "subsurface" in maps or values.get("thin"):
+        return
+    if not weight > 0.0:
+        return
+    d, values["scatter_distance_scale"] = split_distances(radius * meters_per_unit)
+    if d > 0.0:
+        values["scatter_distance"] = d
+    if weight < 1.0:
+        losses.append(
+            f"{surface_id} subsurface weight {weight:g}: lookdev's solid sends its whole "
+            "diffuse into the interior (Burley 2015), as at weight 1"
+        )
 
 
 def _at_default(value: Any, default: Any) -> bool:

@@ -33,6 +33,7 @@ FINER_GROUPS: dict[str, dict[str, str]] = {
         "subsurface": "subsurface",
         "flatness": "flatness",
         "scatter_distance": "scatter",
+        "scatter_distance_scale": "scatter",
     },
 }
 """model → parameter → the exporter's group (:func:`active_lobes`) that alone keeps it
@@ -106,18 +107,20 @@ def active_lobes(
         on["dielectric"] = v.get("metallic", 0.0) < 1.0
         return on
     thin = bool(v["thin"])
-    subsurface = on["diffuse"] and v["subsurface"] > 0.0
+    # Burley 2015: a solid's scatter distance fills its interior, entered by the diffuse
+    # (diff_trans) and the glass (lookdev.materials.subsurface); the 2012 `subsurface`
+    # blend is then off (disney_prepare: the whole diffuse enters the medium).
+    scatter = (on["spec_trans"] or on["diff_trans"]) and not thin and v["scatter_distance"] > 0
+    subsurface = on["diffuse"] and v["subsurface"] > 0.0 and not scatter
     return {
         **on,
         "dielectric": v["metallic"] < 1.0,
         "conty_kulla": on["sheen"] and v["sheen_model"] == "conty_kulla",
         "subsurface": subsurface,
         "flatness": on["diffuse"] and thin and v["flatness"] > 0.0,
-        # Burley 2015: a solid's scatter distance fills its interior, entered by the
-        # diffuse (diff_trans) and the glass (lookdev.materials.subsurface).
-        "scatter": (on["spec_trans"] or on["diff_trans"] or subsurface)
-        and not thin
-        and v["scatter_distance"] > 0,
+        "scatter": scatter,
+        # A DCC's subsurface (its weight and colour): the 2012 blend or the interior.
+        "subsurface_any": subsurface or scatter,
         "thin": thin,
     }
 

@@ -85,10 +85,6 @@ def _grey(v):
     return (v, v, v)
 
 
-def _mean(v):
-    return sum(v) / 3.0
-
-
 def _flag(v):
     return int(bool(v))
 
@@ -139,22 +135,35 @@ _BURLEY_CAMEL: tuple[Slot, ...] = (
 )
 
 
+def _largest(v):
+    return max(v)
+
+
 def _scatter(target_name: str) -> Slot:
+    """The per-channel radius, ``scatter_distance · scatter_distance_scale`` in scene
+    units: written whole by :func:`.network.subsurface_inputs` (it needs both parameters
+    and the stage's unit); read back as its largest channel, the scale as each over it
+    (:func:`lookdev.materials.subsurface.split_distances`). A distance map is written as
+    it is (grey)."""
     return Slot(
         "scatter_distance",
         target_name,
         "color3f",
         lobe="scatter",
         to_target=_grey,
-        from_target=_mean,
+        from_target=_largest,
         texture_linear=None,
     )
 
 
+SUBSURFACE_WEIGHT = "subsurface"
+"""The subsurface weight's input on both Disney targets (ND_disney_principled and
+PxrDisneyBsdf mix their diffuse towards subsurface by it)."""
+
 # MaterialX 1.39 ND_disney_principled (libraries/bxdf/disney_principled.mtlx).
 MTLX_DISNEY: tuple[Slot, ...] = (
     *_BURLEY_CAMEL,
-    Slot("subsurface", "subsurface", "float", lobe="subsurface"),
+    Slot("subsurface", SUBSURFACE_WEIGHT, "float", lobe="subsurface"),
     _scatter("subsurfaceDistance"),
 )
 
@@ -167,10 +176,10 @@ RI_DISNEY: tuple[Slot, ...] = (
     *(s for s in _BURLEY_CAMEL if s.param not in ("specular", "ior")),
     Slot("ior", "ior", "float", lobe="dielectric"),
     Slot("diff_trans", "diffTrans", "float", lobe="diff_trans"),
-    Slot("subsurface", "subsurface", "float", lobe="subsurface"),
+    Slot("subsurface", SUBSURFACE_WEIGHT, "float", lobe="subsurface"),
     # Burley 2015's subsurface is tinted by the base colour; PxrDisneyBsdf takes that
     # tint as its own input (default: RenderMan's, not ours), so it is written.
-    Slot("base_color", "subsurfaceColor", "color3f", lobe="subsurface"),
+    Slot("base_color", "subsurfaceColor", "color3f", lobe="subsurface_any"),
     _scatter("scatterDistances"),
     Slot("thin", "isThin", "int", lobe="thin", to_target=_flag, from_target=bool),
     # PxrDisneyBsdf has no `flatness` input: the loss note names it.
@@ -307,6 +316,8 @@ DERIVED_FROM: dict[str, frozenset[str]] = {
     "reflTN": _SMITS_WEIGHT,
     "eta": frozenset(("ior", "normal_fresnel")),
     "highlight_roughness": frozenset(("roughness", "specular_cone_scale", "reflection_cone_scale")),
+    # The RGB radius carries both (Disney targets with a scatter-distance input).
+    "scatter_distance": frozenset(("scatter_distance", "scatter_distance_scale")),
 }
 WEIGHTS_DERIVED_FROM: dict[str, frozenset[str]] = {
     "preview_base": frozenset(("front", "f0", "specN", "reflN")),

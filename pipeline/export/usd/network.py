@@ -15,6 +15,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -23,7 +24,7 @@ from lookdev.materials import registry
 from lookdev.materials.errors import LookdevError
 
 from .lobes import DEFAULTS, REGISTRY_MODEL, active_lobes, canonical, effective
-from .names import Slot
+from .names import SUBSURFACE_WEIGHT, Slot
 from .sheen_lambda import exact_sheen
 
 CONTEXT_OUTPUT = {"universal": "surface", "mtlx": "mtlx:surface", "ri": "ri:surface"}
@@ -207,6 +208,23 @@ def source_from_params(name: str, model: str, params: Any, description: str = ""
     """A constant material's :class:`Source` (no maps)."""
     spelling = "ior" if getattr(params, "ior", None) is not None else DEFAULT_SPELLING[model]
     source = Source(name, model, canonical(params), spelling=spelling, description=description)
+    return untargeted(source)
+
+
+def untargeted(source: Source) -> Source:
+    """``source`` with the values no DCC target has carried in ``customData`` for the
+    import: the GTR γ (:func:`gtr_as_ggx`), the exact-Λ sheen (:func:`.sheen_lambda.exact_sheen`)
+    and ``energy_compensation``.
+
+    No target has a switch for the specular's multiple scattering: UsdPreviewSurface and
+    PxrDisneyBsdf have none, and MaterialX's ``ND_disney_principled`` (its
+    ``generalized_schlick_bsdf`` and ``dielectric_bsdf``, pbrlib_defs.mtlx) neither; its
+    GLSL reference always applies Turquin's factor (``mx_ggx_energy_compensation``), its
+    OSL leaves it to the renderer's closures. So the switch is a named loss
+    (:func:`loss_note`) in every context, and kept here so the import gives it back.
+    """
+    if source.model == "disney" and source.values.get("energy_compensation", False):
+        source.custom["energy_compensation"] = True
     return exact_sheen(gtr_as_ggx(source))
 
 
@@ -303,24 +321,48 @@ def local_subsurface(source: Source) -> bool:
 def subsurface_radius(
     source: Source, inputs: dict[str, tuple[str, Any]], name: str, meters_per_unit: float
 ) -> str:
-    """Write the subsurface/scatter radius input ``name`` in the stage's units; the
-    sentence naming what that changes, or ``""``.
+    """Write a Disney target's subsurface: the radius input ``name`` in the stage's units
+    and, for a solid's interior, the weight; the sentence naming what that loses, or ``""``.
 
-    ``scatter_distance`` (metres, :data:`UNIT`) ÷ ``metersPerUnit``; where only the 2012
-    subsurface is live (no distance given), :data:`LOCAL_SUBSURFACE_M` instead.
+    A solid with a scatter distance (Burley 2015, :mod:`lookdev.materials.subsurface`)
+    sends its whole diffuse into its interior medium, as ND_disney_principled and
+    PxrDisneyBsdf do at ``subsurface`` 1 (they mix diffuse and subsurface by it), so the
+    weight is written 1 whatever the preset's 2012 ``subsurface`` (which the model then
+    ignores); the radius is ``scatter_distance · scatter_distance_scale`` per channel
+    (metres, :data:`UNIT`) ÷ ``metersPerUnit``. Where only the 2012 subsurface is live
+    (no distance given), :data:`LOCAL_SUBSURFACE_M` instead.
     """
+    from lookdev.materials.subsurface import scatter_distances
+
     lobes = source.lobes
+    lost = []
+    if lobes.get("scatter"):
+        inputs[SUBSURFACE_WEIGHT] = ("float", 1.0)
+        if lobes.get("spec_trans"):
+            lost.append(
+                f"the glass (spec_trans) enters no medium there: {name} scatters the diffuse only"
+            )
     if "scatter_distance" in source.maps:
         if meters_per_unit != 1.0:
-            return (
+            lost.append(
                 f"{name} is the scatter_distance map in metres, not scaled to "
                 f"metersPerUnit {meters_per_unit:g}"
             )
-        return ""
+        scale = source.live_values["scatter_distance_scale"]
+        if "scatter_distance_scale" in source.maps or len(set(scale)) > 1:
+            lost.append(f"{name} is the scatter_distance map, grey: no scatter_distance_scale")
+        return "; ".join(lost)
     if lobes.get("scatter"):
-        d = source.live_values["scatter_distance"] / meters_per_unit
-        inputs[name] = ("color3f", (d, d, d))
-        return ""
+        values = source.live_values
+        if "scatter_distance_scale" in source.maps:
+            lost.append(f"{name} takes the mean of the scatter_distance_scale map")
+        params = SimpleNamespace(
+            scatter_distance=values["scatter_distance"],
+            scatter_distance_scale=values["scatter_distance_scale"],
+        )
+        radius = scatter_distances(params) / meters_per_unit
+        inputs[name] = ("color3f", tuple(float(x) for x in radius))
+        return "; ".join(lost)
     if local_subsurface(source):
         d = LOCAL_SUBSURFACE_M / meters_per_unit
         inputs[name] = ("color3f", (d, d, d))

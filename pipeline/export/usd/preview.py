@@ -41,6 +41,8 @@ SHAPE_NOTES = {
     "disney": {
         "clearcoat": "the clearcoat is GGX here, Burley's GTR1 (App. B.2) there",
         "diffuse": "the diffuse has no retro-reflection (Burley §5.3)",
+        "scatter": "UsdPreviewSurface has no subsurface: the solid's interior medium "
+        "renders as an opaque diffuse of its base colour (no light bleeds or shows through)",
     },
     "pixar": {
         "highlights": "Smits' specular and reflection lobes become one GGX lobe",

@@ -29,6 +29,7 @@ import numpy as np
 
 from lookdev.materials.errors import LookdevError
 from lookdev.materials.fresnel import ior_to_specular, specular_to_ior
+from lookdev.materials.subsurface import split_distances
 from lookdev.materials.textures import TextureInput
 
 from .foreign import FOREIGN_SURFACES, preview_extras, read_foreign, specular_workflow
@@ -288,6 +289,8 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
         values["specular_gamma"] = float(spec.custom["specular_gamma"])
         if "roughness" in spec.custom:
             values["roughness"] = float(spec.custom["roughness"])
+    if model == "disney" and spec.custom.get("energy_compensation"):
+        values["energy_compensation"] = True  # no target has the switch (network.untargeted)
     if model == "disney" and "sheen_lambda" in spec.custom:
         # The exact-Λ sheen: no target has it; the writer kept it (sheen_lambda module).
         from .sheen_lambda import CARRIED
@@ -380,16 +383,23 @@ def _read_surface(net, surface, context, model, values, result, units: float = 1
                 )
             elif texture is not None:
                 result.maps.setdefault(slot.param, texture)
+        elif given is not None and slot.param == "scatter_distance":
+            # RGB in scene units → metres, largest channel and each channel over it.
+            radius = np.broadcast_to(np.asarray(given[1], dtype=np.float64), (3,)) * units
+            d, values["scatter_distance_scale"] = split_distances(radius)
+            values[slot.param] = d
         elif given is not None:
             values[slot.param] = slot.from_target(given[1])
-            if slot.param == "scatter_distance":
-                values[slot.param] *= units
         elif defaults is not None and slot.input in defaults:
             pending.append(slot)
     lobes = active_lobes(values, model)
     for slot in pending:
         if slot.lobe is None or lobes[slot.lobe]:
             values[slot.param] = slot.from_target(defaults[slot.input])
+    if lobes.get("scatter") and values.get("subsurface") == 1.0:
+        # The weight a solid's interior is written with (:func:`.network.subsurface_radius`),
+        # not Burley 2012's blend, which the model ignores there.
+        values["subsurface"] = DEFAULTS[model]["subsurface"]
     if has_specular:
         values["ior"] = specular_to_ior(values["specular"])
 

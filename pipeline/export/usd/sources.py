@@ -22,8 +22,7 @@ from lookdev.pipeline.blend.result import LOBE_WEIGHTS, BlendedMaterial
 
 from .live import live_stack
 from .lobes import DEFAULTS, canonical
-from .network import ExportError, Image, Source, gtr_as_ggx, source_from_params
-from .sheen_lambda import exact_sheen
+from .network import ExportError, Image, Source, source_from_params, untargeted
 
 SUPPORTED = registry.PRESET_MODELS  # a layered Pixar blend: see weights_source
 
@@ -116,7 +115,7 @@ def baked_source(hub: BlendedMaterial, texture_dir: Path, scratch: Path) -> Sour
         live=hub.live_lobes,
         height=height,
     )
-    return exact_sheen(gtr_as_ggx(source))
+    return untargeted(source)
 
 
 CHANNEL_OUTPUTS: dict[Any, str] = {

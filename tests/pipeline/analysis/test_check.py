@@ -73,6 +73,16 @@ def test_parameter_cases_cover_every_extreme_and_the_named_combinations():
     assert not any("metallic=1, roughness" in label for label in labels)  # Disney-only combo
 
 
+def test_the_sweep_switches_energy_compensation_on_alone_and_in_the_stiff_cases():
+    from lookdev.materials.params import DisneyParams
+
+    cases = dict(stability_cases.parameter_cases(DisneyParams))
+    assert cases["energy_compensation=True"].energy_compensation
+    on = [label for label in cases if label.startswith("energy_compensation=True, ")]
+    assert len(on) >= 8  # white metal by roughness, anisotropic, every lobe, glass, γ ≠ 2
+    assert all(cases[label].energy_compensation for label in on)
+
+
 def test_directions_hold_the_stiff_pairs():
     d = stability_cases.directions()
     np.testing.assert_allclose(np.linalg.norm(d, axis=1), 1.0, rtol=1e-12)
@@ -204,3 +214,48 @@ def test_the_largest_disney_albedo_is_within_its_documented_allowance(dtype):
     assert "φo = 90°" in top.case
     assert 1.0 + stability_cases.allowance("disney") - 0.08 < top.value < 1.79
     assert report.max_albedo_by_azimuth[0.0].value < top.value
+
+
+def _interior_cases():
+    from lookdev.materials.params import DisneyParams
+
+    return [(l, p) for l, p in stability_cases.parameter_cases(DisneyParams) if "scatter" in l]
+
+
+def _empty_report(dtype: str) -> stability.ModelReport:
+    report = stability.ModelReport("disney", 0.79)
+    report.by_dtype[dtype] = dict.fromkeys(stability.KINDS, 0)
+    report.cases_by_dtype[dtype] = 0
+    return report
+
+
+def test_the_interior_extremes_are_swept_with_uneven_scales():
+    labels = [label for label, _ in _interior_cases()]
+    assert "scatter_distance=1e-06" in labels and "scatter_distance=1e+06" in labels
+    uneven = [label for label in labels if "scatter_distance_scale=(" in label]
+    assert any("1e-12" in label for label in uneven)  # 1e6 m × 1e-12: the floor, 1e-6 m
+    assert any("1e-06, 1, 1" in label for label in uneven)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_every_interior_case_gives_a_finite_medium(dtype):
+    report = _empty_report(np.dtype(dtype).name)
+    for label, params in _interior_cases():
+        stability._sweep_medium(report, label, params, dtype)
+    # three quantities at two units for every case with an interior (all but the three
+    # of scatter_distance 0)
+    assert report.cases == 6 * (len(_interior_cases()) - 3)
+    assert not report.failed, report.failures
+
+
+def test_a_broken_interior_is_a_finding(monkeypatch):
+    import lookdev.materials.subsurface as subsurface
+    from lookdev.materials.params import DisneyParams
+
+    def overflowing(params, unit=1.0):
+        return np.array([1e39, 1.0, 1.0]), np.array([0.5, 1.2, 0.5])
+
+    monkeypatch.setattr(subsurface, "interior", overflowing)
+    report = _empty_report("float32")
+    stability._sweep_medium(report, "x", DisneyParams(scatter_distance=0.01), np.float32)
+    assert report.counts["inf"] > 0 and report.counts["energy_gain"] > 0

@@ -377,3 +377,20 @@ def test_varied_rejects_what_the_schema_rejects_in_one_line(cli, tmp_path):
     res = cli("plot", "gold", "--vary", "nonsense", "-o", str(tmp_path / "a.png"))
     assert res.code == 2 and "--vary" in res.err
     assert not list(tmp_path.iterdir())
+
+
+def test_varied_switch_shows_energy_compensation_off_and_on(cli, tmp_path):
+    from lookdev.materials.params import DisneyParams
+    from lookdev.pipeline.analysis.albedo import albedo_monte_carlo
+
+    metal = DisneyParams(metallic=1.0, base_color=(1.0, 1.0, 1.0), roughness=0.9)
+    hubs = P.varied([BlendedMaterial.of_params(metal, name="m")], "energy_compensation", [0, 1])
+    assert [h.name for h in hubs] == ["m energy_compensation=off", "m energy_compensation=on"]
+    assert [h.params.energy_compensation for h in hubs] == [False, True]
+    off, on = (albedo_monte_carlo(h.bsdf_model, h.params, [0.0]).albedo[0, 0] for h in hubs)
+    assert off < 0.5 and on == pytest.approx(1.0, abs=0.01)
+    out = tmp_path / "ms.png"
+    res = cli(
+        "plot", "gold", "--view", "albedo", "--vary", "energy_compensation=off,on", "-o", str(out)
+    )
+    assert res.code == 0 and out.stat().st_size > 0

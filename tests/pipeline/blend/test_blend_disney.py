@@ -390,3 +390,12 @@ def test_sheen_lambda_is_voted_only_by_layers_with_sheen():
     assert out.constants["sheen_lambda"] == "exact"
     with pytest.raises(BlendError, match="sheen_lambda"):
         blend(layered(layer(fitted), layer(exact, 0.5)), 2)
+
+
+def test_energy_compensation_is_one_switch_the_layers_agree_on():
+    on = disney("gold_ms", metallic=1.0, roughness=0.6, energy_compensation=True)
+    rough = disney("rough_ms", metallic=1.0, roughness=0.9, energy_compensation=True)
+    out = blend(layered(layer(on), layer(rough, 0.5)), 2)
+    assert out.constants["energy_compensation"] is True and out.params.energy_compensation
+    with pytest.raises(BlendError, match="energy_compensation"):
+        blend(layered(layer(GOLD), layer(rough, 0.5)), 2)

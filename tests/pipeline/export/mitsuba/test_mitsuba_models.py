@@ -67,6 +67,20 @@ CASES = [
     ("disney", {"specular_gamma": 1.0, "roughness": 0.5}, "disney-gamma1", 0.25),
     ("disney", {"specular_gamma": 1.5, "metallic": 1.0, "roughness": 0.5}, "disney-gamma1.5", 0.25),
     ("disney", {"specular_gamma": 3.0, "metallic": 1.0, "roughness": 0.3}, "disney-gamma3", 0.09),
+    # Turquin's multiple-scattering factor on the specular lobe (sampling unchanged)
+    (
+        "disney",
+        {"metallic": 1.0, "roughness": 0.7, "energy_compensation": True},
+        "disney-ms-metal",
+        0.49,
+    ),
+    ("disney", {"roughness": 0.6, "energy_compensation": True}, "disney-ms-plastic", 0.36),
+    (
+        "disney",
+        {"spec_trans": 1.0, "roughness": 0.5, "ior": 1.5, "energy_compensation": True},
+        "disney-ms-glass",
+        0.08,  # refracted: α 0.25 narrows by (η − 1)/η, as the frosted glass's
+    ),
     # Pixar: "α" here is the reflection cone's half-angle in radians (10·r degrees).
     ("pixar", {"roughness": 0.0}, "pixar-r0", None),  # a delta reflection over the diffuse
     ("pixar", {"clear": 1.0, "roughness": 0.0, "ior": 1.52}, "pixar-clear-glass", None),
@@ -192,6 +206,7 @@ FURNACE_CASES = [
     ("disney", {"roughness": 0.5, "base_color": [0.8, 0.4, 0.2]}, "disney-plastic"),
     ("disney", {"metallic": 1.0, "roughness": 0.2}, "disney-metal"),
     ("disney", {"metallic": 1.0, "roughness": 0.4, "specular_gamma": 1.5}, "disney-gamma1.5"),
+    ("disney", {"metallic": 1.0, "roughness": 0.8, "energy_compensation": True}, "disney-ms-metal"),
     ("disney", {"clearcoat": 1.0, "roughness": 0.7, "base_color": [0.2, 0.3, 0.8]}, "disney-coat"),
     ("disney", {"spec_trans": 1.0, "roughness": 0.0, "ior": 1.5}, "disney-glass"),
     ("sheen", {"roughness": 0.3, "color": [0.9, 0.5, 0.3]}, "sheen"),
@@ -405,3 +420,60 @@ def test_transport_mode_leaves_non_refracting_lobes_alone(mi, model_name, values
         np.array(bsdf.sample(importance, si, s1, s2)[1]),
         np.array(bsdf.sample(mi.BSDFContext(), si, s1, s2)[1]),
     )
+
+
+def test_energy_compensation_reads_a_roughness_texture_at_the_hit(mi):
+    """The table look-up on Dr.Jit arrays from a texture (the array path), against numpy."""
+    from lookdev.materials.params import DisneyParams
+    from lookdev.materials.registry import model_named
+    from lookdev.pipeline.export.mitsuba import register_plugins
+
+    register_plugins()
+    data = mi.TensorXf(np.array([[[0.3], [0.9]]], dtype=np.float32))
+    bsdf = mi.load_dict(
+        {
+            "type": "lookdev_disney",
+            "metallic": 1.0,
+            "energy_compensation": True,
+            "roughness": {"type": "bitmap", "data": data, "raw": True, "filter_type": "nearest"},
+        }
+    )
+    view = _unit(np.array([[0.3, 0.1, 0.9]]))
+    light = _unit(np.array([0.2, -0.4, 0.7]))
+    for u, r in ((0.25, 0.3), (0.75, 0.9)):
+        si = _interaction(mi, view, uv=(u, 0.5))
+        wl = mi.Vector3f(light[None, :].astype(np.float32).T)
+        got = np.array(bsdf.eval(mi.BSDFContext(), si, wl)).ravel()
+        params = DisneyParams(metallic=1.0, roughness=r, energy_compensation=True)
+        want = evaluate(model_named("disney"), params, light, view[0]) * light[2]
+        off = evaluate(
+            model_named("disney"), params.replace(energy_compensation=False), light, view[0]
+        )
+        assert np.all(want > off * light[2])  # the factor is there to see
+        np.testing.assert_allclose(got, want.ravel(), rtol=2e-4)
+
+
+def test_energy_compensation_is_non_symmetric_and_a_light_tracer_sees_the_adjoint(mi):
+    """Turquin's factor is read at the viewer: f(l, v) ≠ f(v, l). With the switch on the
+    reflection is flagged NonSymmetric and Importance mode evaluates the model with the
+    roles as they physically are; off, the plain metal stays symmetric."""
+    model, params = _case_params(
+        "disney", {"metallic": 1.0, "roughness": 0.8, "energy_compensation": True}
+    )
+    plain = mi.load_dict(_plugin(mi, params.replace(energy_compensation=False)))
+    assert not plain.flags() & mi.BSDFFlags.NonSymmetric
+    bsdf = mi.load_dict(_plugin(mi, params))
+    assert bsdf.flags() & mi.BSDFFlags.NonSymmetric
+    rng = np.random.default_rng(8)
+    view = _unit(np.abs(rng.normal(size=(256, 3))))
+    light = _unit(np.abs(rng.normal(size=(256, 3))))
+    si = _interaction(mi, view)
+    wo = mi.Vector3f(light.astype(np.float32).T)
+    importance = mi.BSDFContext(mi.TransportMode.Importance)
+    got = np.array(bsdf.eval(importance, si, wo)).T
+    view32, light32 = np.array(si.wi).T.astype(np.float64), light.astype(np.float32)
+    # adjoint: light arrives along si.wi, leaves towards wo (the sensor side)
+    want = evaluate(model, params, view32, light32.astype(np.float64)) * light32[:, 2:3]
+    np.testing.assert_allclose(got, want, rtol=2e-4, atol=1e-6)
+    radiance = np.array(bsdf.eval(mi.BSDFContext(), si, wo)).T
+    assert np.max(np.abs(radiance - got)) > 1e-3  # the two modes differ

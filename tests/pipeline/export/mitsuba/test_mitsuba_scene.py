@@ -276,6 +276,7 @@ def test_fast_path_only_where_measured(m, disney):
     assert fast(metallic=1.0, clearcoat=0.5) is None  # clearcoat normalisation differs
     assert fast(metallic=1.0, specular_gamma=3.0) is None  # principled is GGX (γ = 2) only
     assert fast(metallic=1.0, specular_gamma=2.0) is not None
+    assert fast(metallic=1.0, energy_compensation=True) is None  # principled: single scattering
     assert m.bsdf_dict(DisneyParams(metallic=1.0), force_all_lobes=True)["type"] == "lookdev_disney"
 
 

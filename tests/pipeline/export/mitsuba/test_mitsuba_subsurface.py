@@ -43,8 +43,11 @@ def test_the_proof_puts_the_medium_in_ball_and_cup_at_its_scale():
 def test_white_furnace_of_a_white_subsurface_sphere_stays_at_most_one():
     from lookdev.pipeline.bench.subsurface import furnace
 
-    mean, error = furnace(spp=128)
+    mean, error = furnace(roughness=0.0, spp=128)  # the medium and boundary alone
     assert mean <= 1.0 + 3.0 * error
+    # Rougher, Burley's retro-reflection (kept on the surface) adds energy by design:
+    # less than it adds to the same sphere without a distance (1.0047 against 1.049).
+    assert furnace(roughness=0.5, spp=64)[0] < furnace(scatter_distance=0.0, spp=64)[0]
 
 
 @pytest.mark.slow
@@ -53,7 +56,22 @@ def test_a_thick_slab_reflects_its_base_colour_within_the_documented_error():
 
     colour = COLOURS["grey"]
     got, error = slab(colour, spp=64, size=8)
-    assert np.all(np.abs(got - colour) <= 0.06 + 3.0 * error)  # the README's measured error
+    assert np.all(np.abs(got - colour) <= 0.01 + 4.0 * error)  # the README's measured error
+
+
+@pytest.mark.slow
+def test_the_shipped_slab_table_is_what_the_slab_renders():
+    """albedo_table re-run at small size (three rows, one render) against SLAB_TABLE."""
+    from lookdev.materials.subsurface import SLAB_TABLE
+    from lookdev.pipeline.bench.subsurface import albedo_table
+
+    want = {alpha: a for a, alpha in SLAB_TABLE}
+    roots = [np.sqrt(1.0 - alpha) for alpha in (0.51, 0.91, 0.99)]
+    got = albedo_table(roots, spp=64, size=8)
+    for a, alpha in got[1:]:
+        key = min(want, key=lambda k: abs(k - alpha))
+        assert abs(key - alpha) < 1e-6
+        assert a == pytest.approx(want[key], abs=0.01)
 
 
 def test_subsurface_proofs_trace_the_measured_depth():

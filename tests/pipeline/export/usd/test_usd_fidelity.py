@@ -14,6 +14,7 @@ import pytest
 pytest.importorskip("pxr")
 from pxr import Usd  # noqa: E402
 
+import lookdev  # noqa: E402
 from lookdev.materials.arrays import NumpyOps  # noqa: E402
 from lookdev.materials.bsdf import evaluate  # noqa: E402
 from lookdev.materials.fresnel import ior_to_f0  # noqa: E402
@@ -133,8 +134,8 @@ def test_subsurface_radius_is_in_scene_units(tmp_path):
         path = f"/Materials/{name}/mtlx_surface.inputs:subsurfaceDistance"
         return tuple(stage.GetAttributeAtPath(path).Get())
 
-    # marble's 0.439 mm (Jensen 2001) in centimetres
-    assert radius("marble") == pytest.approx((0.0439,) * 3, rel=1e-6)
+    # marble's distance (Jensen 2001, ≈ 0.42 mm) in centimetres, per channel (× its scale)
+    assert radius("marble") == pytest.approx(_radius_cm("marble"), rel=1e-6)
     assert radius("blend_2012") == pytest.approx((0.1,) * 3)  # 1 mm, named as a loss
     assert "1 mm" in result.losses["blend_2012"]["mtlx"]
     assert "1 mm" not in result.losses["marble"].get("mtlx", "")
@@ -189,3 +190,70 @@ def test_proof_context_universal_renders_both(cli, tmp_path):
     assert result.code == 0, result.err
     names = {p["material"] for p in json.loads(result.out)["proofs"]}
     assert names == {"gold", "gold-universal"}
+
+
+def _radius_cm(name: str) -> list[float]:
+    params = lookdev.load(name).params
+    return [100.0 * params.scatter_distance * s for s in params.scatter_distance_scale]
+
+
+def _inputs(stage, name, shader):
+    prim = stage.GetPrimAtPath(f"/Materials/{name}/{shader}")
+    return {a.GetName().split(":", 1)[1]: a.Get() for a in prim.GetAttributes()
+            if a.GetName().startswith("inputs:")}  # fmt: skip
+
+
+def test_a_solid_with_a_distance_exports_a_scattering_subsurface(tmp_path):
+    """skin has subsurface 0 and a distance: the model sends its whole diffuse into the
+    interior, so each Disney target gets weight 1, the per-channel radius in scene
+    units, and (RenderMan) the base colour as its subsurface colour."""
+    out = tmp_path / "s.usda"
+    result = api.export_usd(["skin"], out, ("universal", "mtlx", "ri"), meters_per_unit=0.01)
+    stage = Usd.Stage.Open(str(out))
+    radius = _radius_cm("skin")  # ≈ 0.86 mm × (1, 0.49, 0.27), in centimetres
+    mtlx = _inputs(stage, "skin", "mtlx_surface")
+    assert mtlx["subsurface"] == 1.0
+    assert tuple(mtlx["subsurfaceDistance"]) == pytest.approx(radius, rel=1e-6)
+    ri = _inputs(stage, "skin", "ri_surface")
+    assert ri["subsurface"] == 1.0
+    assert tuple(ri["scatterDistances"]) == pytest.approx(radius, rel=1e-6)
+    skin = lookdev.load("skin").params
+    assert tuple(ri["subsurfaceColor"]) == pytest.approx(skin.base_color, rel=1e-6)
+    # The per-channel distance is expressed: no loss names it, but the preview has none.
+    for context in ("mtlx", "ri"):
+        assert "scatter_distance" not in result.losses["skin"].get(context, "")
+    assert "has no subsurface" in result.losses["skin"]["universal"]
+    assert "subsurface" not in _inputs(stage, "skin", "preview_surface")
+
+
+@pytest.mark.parametrize("contexts", [("mtlx",), ("ri",), ("universal", "mtlx", "ri")])
+def test_the_per_channel_distance_comes_back(tmp_path, contexts):
+    from lookdev.pipeline.export.usd.network import source_from_params
+    from lookdev.pipeline.export.usd.reader import import_usd
+    from lookdev.pipeline.export.usd.writer import export_usd
+
+    params = DisneyParams(
+        base_color=(0.6, 0.4, 0.2),
+        subsurface=0.3,  # ignored by a solid with a distance: not read back
+        scatter_distance=0.002,
+        scatter_distance_scale=(0.5, 1.0, 0.25),
+    )
+    out = tmp_path / "rt.usda"
+    export_usd(
+        [source_from_params("m", "disney", params)], out, contexts=contexts, meters_per_unit=0.01
+    )
+    (found,) = import_usd(out)
+    assert found.params["scatter_distance"] == pytest.approx(0.002, rel=1e-6)
+    assert found.params["scatter_distance_scale"] == pytest.approx((0.5, 1.0, 0.25), rel=1e-6)
+    assert "subsurface" not in found.params
+
+
+def test_thin_and_distance_free_subsurface_keep_the_2012_weight(tmp_path):
+    out = tmp_path / "s.usda"
+    thin = BlendedMaterial.of_params(
+        DisneyParams(subsurface=0.4, thin=True, scatter_distance=0.01), name="thin"
+    )
+    api.export_usd([thin], out, ("mtlx", "ri"))
+    stage = Usd.Stage.Open(str(out))
+    assert _inputs(stage, "thin", "mtlx_surface")["subsurface"] == pytest.approx(0.4)
+    assert _inputs(stage, "thin", "ri_surface")["subsurface"] == pytest.approx(0.4)

@@ -193,6 +193,37 @@ def test_openpbr_and_standard_surface_are_read(tmp_path, shader_id, inputs, want
         assert any("emission_luminance" in line for line in found.loss)
 
 
+@pytest.mark.parametrize(
+    ("shader_id", "radius", "scale"),
+    [
+        ("ND_open_pbr_surface_surfaceshader", (T.Float, 0.2), (T.Color3f, (1.0, 0.5, 0.25))),
+        ("ND_standard_surface_surfaceshader", (T.Color3f, (1.0, 0.5, 0.25)), (T.Float, 0.2)),
+    ],
+)
+def test_a_foreign_radius_is_read_per_channel_only_where_it_scatters(
+    tmp_path, shader_id, radius, scale
+):
+    weight = "subsurface_weight" if "open_pbr" in shader_id else "subsurface"
+    scale_name = "subsurface_radius_scale" if "open_pbr" in shader_id else "subsurface_scale"
+    found = {}
+    for w in (0.0, 0.5):
+        path = tmp_path / f"sss{w}.usda"
+        stage = _stage(path)
+        _, shader = _surface(stage, "/Looks/M", shader_id, output="mtlx:surface")
+        shader.CreateInput(weight, T.Float).Set(w)
+        shader.CreateInput("subsurface_radius", radius[0]).Set(radius[1])
+        shader.CreateInput(scale_name, scale[0]).Set(scale[1])
+        stage.Save()
+        (found[w],) = import_usd(path)
+    # weight 0 (the DCCs' default): the radius shows nothing, so no interior
+    assert "scatter_distance" not in found[0.0].params
+    params = found[0.5].params
+    # 0.2 units at USD's fallback metersPerUnit 0.01 (the stage authors none)
+    assert params["scatter_distance"] == pytest.approx(0.002, rel=1e-6)
+    assert params["scatter_distance_scale"] == pytest.approx((1.0, 0.5, 0.25), rel=1e-6)
+    assert any("subsurface weight 0.5" in line for line in found[0.5].loss)
+
+
 def test_a_texture_feeding_an_input_is_kept_as_a_texture_input(tmp_path):
     path = tmp_path / "tex.usda"
     stage = _stage(path)

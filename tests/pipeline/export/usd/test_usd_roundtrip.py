@@ -24,9 +24,7 @@ from lookdev.pipeline.export.usd.writer import export_usd  # noqa: E402
 
 PREVIEW_PARAMS = {s.param for s in PREVIEW_DISNEY} | {"specular"}
 """What UsdPreviewSurface expresses: its table, with both spellings of the F0."""
-# scatter_distance_scale: no single DCC input takes it (the per-channel distance is one
-# colour there); the loss notes name it.
-UNEXPRESSIBLE = {"sheen_model", "sheen_roughness", "flatness", "scatter_distance_scale"}
+UNEXPRESSIBLE = {"sheen_model", "sheen_roughness", "flatness"}
 
 PIXAR_PREVIEW = {"surface_color", "metallic", "roughness", "clear", "normal_fresnel", "ior"}
 """What a Pixar material is read back from: UsdPreviewSurface (the F0 as the surface's
@@ -57,7 +55,9 @@ disney = st.fixed_dictionaries(
         "diff_trans": edge_unit,
         "flatness": edge_unit,
         # 0 (no medium) or at least 1e-6: a tinier one made σt infinite (issue 13)
-        "scatter_distance": st.sampled_from([0.0]) | st.floats(1e-6, 10.0),
+        "scatter_distance": st.sampled_from([0.0]) | st.floats(1e-4, 10.0),
+        # per channel, as the RGB radius of ND_disney_principled / PxrDisneyBsdf
+        "scatter_distance_scale": st.tuples(*[st.sampled_from([1.0]) | st.floats(0.01, 1.0)] * 3),
         "thin": st.booleans(),
     },
     optional={"ior": st.floats(1.0, 3.0), "specular": st.floats(0.0, 2.0)},
@@ -315,3 +315,19 @@ def test_exact_sheen_lambda_names_its_loss_and_round_trips(tmp_path):
     (found,) = import_usd(fit)
     assert "sheen_lambda" not in found.params
     assert not any("sheen_lambda" in line for line in found.loss)
+
+
+def test_energy_compensation_is_a_named_loss_carried_through_custom_data(tmp_path):
+    # No target has the switch (MaterialX's pbrlib has energy_compensation on the
+    # Oren-Nayar diffuse only): every context names the loss, customData carries it back.
+    params = DisneyParams(metallic=1.0, roughness=0.6, energy_compensation=True)
+    out = tmp_path / "ms.usda"
+    export_usd([source_from_params("m", "disney", params)], out)
+    (found,) = import_usd(out)
+    assert found.params == {"metallic": 1.0, "roughness": 0.6, "energy_compensation": True}
+    assert len(found.loss) == 3
+    assert all("energy_compensation=True" in line for line in found.loss)
+    off = tmp_path / "off.usda"
+    export_usd([source_from_params("m", "disney", params.replace(energy_compensation=False))], off)
+    (plain,) = import_usd(off)
+    assert "energy_compensation" not in plain.params and not plain.loss
