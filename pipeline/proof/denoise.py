@@ -57,8 +57,9 @@ __all__ = [
 ]
 
 GUIDE_SPP = 16
-"""Samples per pixel of the albedo and normal guides (first-hit only: cheap; measured
-share of a frame's time in ``lookdev bench error``)."""
+"""Most samples per pixel of the albedo and normal guides; a frame of fewer samples gets
+guides of its own count (first-hit only: ≈ 1/5 of a path sample; their share of a
+denoised frame's time is measured by ``lookdev bench error --item denoise``)."""
 AOVS = "albedo:albedo,normal:sh_normal"
 """Mitsuba ``aov`` integrator channels: RGB albedo, then the XYZ shading normal."""
 
