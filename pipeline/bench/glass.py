@@ -4,24 +4,36 @@ For each glass preset the proof shader ball (:mod:`lookdev.pipeline.proof.shader
 sphere and a cup of the material on a ground plane, under one IBL) is rendered twice
 over: with our plugin and with the nearest Mitsuba built-in (:func:`builtin_dict`:
 ``dielectric`` for a smooth solid, ``roughdielectric`` with the same GGX α for a rough
-one, ``thindielectric`` for a thin sheet). Each renderer is measured against its *own*
-converged reference (``reference_spp``), so the two models need not be identical, only
+one, ``thindielectric`` for a thin sheet). The two models need not be identical, only
 near: what is compared is the work each needs for a given noise.
 
-Per renderer: the relative MSE (:func:`.measure.relative_mse`) of a ``spp`` render against
-its reference, averaged over ``repeat`` seeds (16 by default: caustic fireflies make a
-single render's relMSE vary by tens of per cent, measured: ice at 4 seeds 1.69×, at 12
-1.32× the noise of ``roughdielectric``, whose eval, pdf and sample weights ours equals to
-float32 rounding), and the best wall time of those renders,
-taken in interleaved rounds (ours, built-in, ours, …) after one warm-up render each, so
-compilation is not counted and a busy machine slows both alike. Monte Carlo error falls
-as 1/spp while time grows as spp, so relMSE × seconds is the cost at equal noise, and
+Per renderer, ``repeat`` frames of ``spp`` samples with independent seeds, taken in
+interleaved rounds (ours, built-in, built-in, ours, …: ABBA, so a load that rises or
+falls through the run slows both alike) after one warm-up render each, so compilation is
+not counted:
+
+* **noise** (:func:`noise`): the relMSE of one frame, estimated as the per-pixel variance
+  over the frames over (ref² + ε), ref the two renderers' ``reference_spp`` references pooled, one
+  denominator for both sides. An unbiased renderer's MSE is its variance, so no
+  reference enters the numerator. (Measuring each frame against its own renderer's
+  reference, as this bench first did, adds that one reference's error, fireflies
+  included, to every frame of one side only, and the reference's seed was fixed, so
+  every run repeated it: on the same 16 frames of ``ice`` three 1024-spp reference
+  seeds gave ours/``roughdielectric`` 1.58, 1.53 and 1.27, the variance over the frames
+  0.88.) A 90 % bootstrap interval over the seeds comes with the ratio: caustic
+  fireflies make it wide.
+* **time**: the median CPU time of a frame (every thread of this process, so time the
+  scheduler gives other programs on a shared machine is not counted; wall time is
+  reported beside it), and the quartiles of the per-round ratio.
+
+Monte Carlo error falls as 1/spp while time grows as spp, so relMSE × seconds is the
+cost at equal noise, and
 
     ratio = (relMSE × s)_ours / (relMSE × s)_built-in     (target ≤ 1.5, issue 16).
 
-The references' own noise adds about spp/reference_spp of a render's relMSE to both
-sides alike. ``reference_difference`` is the relative difference of the two references'
-mean luminance (how near the models are), for the record.
+``reference_difference`` is the relative difference of the two renderers' mean luminance
+over every sample rendered (frames and reference pooled), with its standard error
+(``reference_difference_se``, from the frames' spread): how near the models are.
 """
 
 from __future__ import annotations
@@ -38,9 +50,15 @@ from lookdev.materials.disney_prepare import ETA_MIN
 from lookdev.materials.errors import LookdevError
 from lookdev.materials.microfacet import ALPHA_MIN, is_delta
 
-from .measure import relative_mse
-
-__all__ = ["DEFAULT_PRESETS", "TARGET", "BenchGlassError", "Settings", "builtin_dict", "run"]
+__all__ = [
+    "DEFAULT_PRESETS",
+    "TARGET",
+    "BenchGlassError",
+    "Settings",
+    "builtin_dict",
+    "noise",
+    "run",
+]
 
 DEFAULT_PRESETS = (
     "glass_clear",
@@ -57,6 +75,12 @@ TARGET = 1.5
 """The cost ratio ours / built-in at equal noise that issue 16 asks for, per preset."""
 
 
+RELMSE_EPS = 1e-2
+"""ε of relMSE's denominator (:func:`.measure.relative_mse`'s default)."""
+BOOTSTRAP = 400
+"""Resamplings of the seeds for the noise ratio's interval."""
+
+
 class BenchGlassError(LookdevError):
     """The glass benchmark cannot run as asked."""
 
@@ -66,9 +90,9 @@ class Settings:
     presets: tuple[str, ...] = DEFAULT_PRESETS
     ibl: str = "sky"
     spp: int = 16
-    reference_spp: int = 1024
+    reference_spp: int = 256
     resolution: tuple[int, int] = (128, 64)
-    repeat: int = 16
+    repeat: int = 24
     ibl_width: int = 256
 
     @classmethod
@@ -106,6 +130,52 @@ def builtin_dict(params: Any) -> dict[str, Any]:
     return {"type": "roughdielectric", "distribution": "ggx", "alpha": alpha, **out}
 
 
+def _render_timed(scene: Any, spp: int, seed: int) -> tuple[np.ndarray, float, float]:
+    """(image, wall seconds, CPU seconds): the CPU time of every thread of this process,
+    so time the scheduler gives to other programs on a shared machine is not counted."""
+    import mitsuba as mi
+
+    c0, t0 = time.process_time(), time.perf_counter()
+    image = np.array(mi.render(scene, spp=spp, seed=seed), dtype=np.float64)
+    return image, time.perf_counter() - t0, time.process_time() - c0
+
+
+def noise(frames: np.ndarray, denominator: np.ndarray) -> float:
+    """The relMSE of one frame, from independent frames (axis 0) of an unbiased renderer:
+    the per-pixel sample variance over the frames (Bessel-corrected) over ``denominator``
+    (ref² + ε, Rousselle et al. 2011 §6), averaged over pixels.
+
+    MSE = variance for an unbiased renderer, so no converged reference enters the
+    numerator: a reference's own fireflies (one realisation, shared by every frame
+    compared with it) would otherwise add the same error to every frame of one side only.
+    """
+    return float(np.mean(np.var(frames, axis=0, ddof=1) / denominator))
+
+
+def _interval(ours: np.ndarray, builtin: np.ndarray, den: np.ndarray, draws: int) -> list[float]:
+    """A 90 % bootstrap interval of the noise ratio: the seeds (pairs of frames, one per
+    renderer, taken in the same round) resampled with replacement."""
+    rng = np.random.default_rng(0)
+    n = len(ours)
+    ratios = []
+    for _ in range(draws):
+        pick = rng.integers(0, n, n)
+        if len(set(pick.tolist())) < 2:
+            continue
+        ratios.append(noise(ours[pick], den) / max(noise(builtin[pick], den), 1e-300))
+    return [float(q) for q in np.quantile(ratios, (0.05, 0.95))]
+
+
+def _brightness(frames: np.ndarray, reference: np.ndarray, spp: int, ref_spp: int):
+    """(mean luminance of every sample rendered, its standard error): the frames and the
+    reference pooled by their sample counts; the error from the frames' spread."""
+    means = np.array([float(luminance(f).mean()) for f in frames])
+    total = spp * len(frames) + ref_spp
+    mean = (spp * means.sum() + ref_spp * float(luminance(reference).mean())) / total
+    per_sample_var = float(np.var(means, ddof=1)) * spp
+    return mean, math.sqrt(per_sample_var / total)
+
+
 def measure(preset: str, s: Settings) -> dict[str, Any]:
     """Cost at equal noise of one preset, ours against the built-in (see the module doc)."""
     from lookdev.pipeline.variant import use_mitsuba
@@ -128,31 +198,46 @@ def measure(preset: str, s: Settings) -> dict[str, Any]:
         k: mi.load_dict(shaderball.scene_dict(b, env, s.resolution, depth))
         for k, b in bsdfs.items()
     }
-
-    def render(key: str, spp: int, seed: int) -> np.ndarray:
-        return np.array(mi.render(scenes[key], spp=spp, seed=seed), dtype=np.float64)
-
-    for key in scenes:
-        render(key, 1, 0)  # compiles the kernels
-    refs = {k: render(k, s.reference_spp, 1_000_003) for k in scenes}
-    seconds: dict[str, list[float]] = {k: [] for k in scenes}
-    errors: dict[str, list[float]] = {k: [] for k in scenes}
+    keys = tuple(scenes)
+    for key in keys:
+        _render_timed(scenes[key], 1, 0)  # compiles the kernels
+    refs = {k: _render_timed(scenes[k], s.reference_spp, 1_000_003)[0] for k in keys}
+    frames: dict[str, list[np.ndarray]] = {k: [] for k in keys}
+    wall: dict[str, list[float]] = {k: [] for k in keys}
+    cpu: dict[str, list[float]] = {k: [] for k in keys}
     for r in range(s.repeat):
-        for key in scenes:
-            t0 = time.perf_counter()
-            image = render(key, s.spp, 1 + r)
-            seconds[key].append(time.perf_counter() - t0)
-            errors[key].append(relative_mse(image, refs[key]))
+        # ABBA order: a load that rises or falls through the run slows both alike.
+        for key in keys if r % 2 == 0 else keys[::-1]:
+            image, w, c = _render_timed(scenes[key], s.spp, 1 + r)
+            frames[key].append(image)
+            wall[key].append(w)
+            cpu[key].append(c)
+    stacks = {k: np.stack(v) for k, v in frames.items()}
+    # One denominator for both sides: the two references pooled.
+    den = (0.5 * (refs["ours"] + refs["builtin"])) ** 2 + RELMSE_EPS
     out: dict[str, Any] = {"preset": preset, "builtin": bsdfs["builtin"]["type"], "depth": depth}
-    for key in scenes:
-        out[f"{key}_relmse"] = float(np.mean(errors[key]))
-        out[f"{key}_seconds"] = min(seconds[key])
+    for key in keys:
+        out[f"{key}_relmse"] = noise(stacks[key], den)
+        out[f"{key}_seconds"] = float(np.median(cpu[key]))
+        out[f"{key}_wall_seconds"] = min(wall[key])
         out[f"{key}_cost"] = out[f"{key}_relmse"] * out[f"{key}_seconds"]
     out["ratio"] = out["ours_cost"] / max(out["builtin_cost"], 1e-300)
     out["time_ratio"] = out["ours_seconds"] / out["builtin_seconds"]
+    out["wall_time_ratio"] = out["ours_wall_seconds"] / out["builtin_wall_seconds"]
+    # Per round: the spread of the time ratio the machine allowed.
+    rounds = np.array(cpu["ours"]) / np.array(cpu["builtin"])
+    out["time_ratio_quartiles"] = [float(q) for q in np.quantile(rounds, (0.25, 0.75))]
     out["noise_ratio"] = out["ours_relmse"] / max(out["builtin_relmse"], 1e-300)
-    y_ours, y_builtin = (float(luminance(refs[k]).mean()) for k in ("ours", "builtin"))
-    out["reference_difference"] = y_ours / max(y_builtin, 1e-12) - 1.0
+    out["noise_ratio_interval"] = (
+        _interval(stacks["ours"], stacks["builtin"], den, BOOTSTRAP) if s.repeat > 2 else None
+    )
+    (y_o, se_o), (y_b, se_b) = (
+        _brightness(stacks[k], refs[k], s.spp, s.reference_spp) for k in keys
+    )
+    out["reference_difference"] = y_o / max(y_b, 1e-12) - 1.0
+    out["reference_difference_se"] = (y_o / max(y_b, 1e-12)) * math.hypot(
+        se_o / max(y_o, 1e-12), se_b / max(y_b, 1e-12)
+    )
     out["met"] = bool(out["ratio"] <= TARGET)
     return out
 

@@ -215,7 +215,7 @@ def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
         clamp=s.clamp,
         interior=material_interior(job.material),
     )
-    guides = denoise.guide_renderer(table, s.spp) if s.denoise else None
+    guides = denoise.guide_renderer(table) if s.denoise else None
     for frame in todo:
         r = render_frame(table, frame, **s.sampling())
         stem = job.folder / f"frame_{frame.index:03d}"
@@ -225,7 +225,7 @@ def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
         timings = None
         if guides is not None:  # at the pose just rendered: the raw frame stays beside
             written, timings = denoise.write_denoised(
-                guides, r.image, stem, s.exposure, frame.index
+                guides, r.image, stem, s.exposure, frame.index, r.spp
             )
             images |= written
         entry = frame_entry(r, images, s)

@@ -16,9 +16,11 @@ neighbouring pixels, the noise is no longer independent per pixel and the denois
 removes almost none of it (issue 16: plastic at 32 spp, 0.023 → 0.018 relative MSE with
 the Gaussian against 0.0023 with a box).
 
-The guides are rendered with :data:`GUIDE_SPP` samples (anti-aliased, nearly noise-free:
-they are first-hit quantities) whatever the frame's count, and ``cleanAux`` stays off (a
-few samples leave some noise in them at edges and in textures). Their cost and the
+The guides are rendered with as many samples as the frame, at most :data:`GUIDE_SPP`
+(anti-aliased, nearly noise-free: they are first-hit quantities), and ``cleanAux`` stays
+off (a few samples leave some noise in them at edges and in textures). A guide sample costs
+≈ 1/5 of a path-traced one, so guides of the frame's count add ≈ 20 % to it; fewer
+guide samples trade error for time about evenly (README, "Denoised proofs"). Their cost and the
 denoiser's are returned with every frame (:class:`Denoised`), so a manifest can state
 them; ``lookdev bench error`` weighs them against the samples they replace.
 
@@ -55,8 +57,9 @@ __all__ = [
 ]
 
 GUIDE_SPP = 16
-"""Samples per pixel of the albedo and normal guides (first-hit only: cheap; measured
-share of a frame's time in ``lookdev bench error``)."""
+"""Most samples per pixel of the albedo and normal guides; a frame of fewer samples gets
+guides of its own count (first-hit only: ≈ 1/5 of a path sample; their share of a
+denoised frame's time is measured by ``lookdev bench error --item denoise``)."""
 AOVS = "albedo:albedo,normal:sh_normal"
 """Mitsuba ``aov`` integrator channels: RGB albedo, then the XYZ shading normal."""
 
@@ -80,7 +83,9 @@ class Guides:
 
     albedo: np.ndarray
     normal: np.ndarray
-    seconds: float
+    seconds: float  # wall time of their render
+    cpu_seconds: float = 0.0  # process time (all threads) of their render
+    spp: int = GUIDE_SPP
 
 
 @dataclass(frozen=True)
@@ -90,10 +95,17 @@ class Denoised:
     image: np.ndarray
     aov_seconds: float
     denoise_seconds: float
+    aov_cpu_seconds: float = 0.0  # process time (all threads): less hurt by a shared machine
+    denoise_cpu_seconds: float = 0.0
+    guide_spp: int = GUIDE_SPP
 
     def timings(self) -> dict[str, float]:
-        """The manifest's ``denoise`` entry: ``{"aov_s", "denoise_s"}``."""
-        return {"aov_s": round(self.aov_seconds, 4), "denoise_s": round(self.denoise_seconds, 4)}
+        """The manifest's ``denoise`` entry: ``{"aov_s", "denoise_s", "guide_spp"}``."""
+        return {
+            "aov_s": round(self.aov_seconds, 4),
+            "denoise_s": round(self.denoise_seconds, 4),
+            "guide_spp": self.guide_spp,
+        }
 
 
 class GuideRenderer:
@@ -106,6 +118,8 @@ class GuideRenderer:
     """
 
     def __init__(self, scene: Any, sensor: int = 0, spp: int = GUIDE_SPP, freeze: bool = True):
+        """``spp``: the guides' samples per pixel, and the most a frame's own count
+        (:meth:`render`'s ``spp``) may raise them to."""
         import drjit as dr
         import mitsuba as mi
 
@@ -114,32 +128,35 @@ class GuideRenderer:
         self.sensor = sensor
         self.spp = int(spp)
         self.integrator = mi.load_dict({"type": "aov", "aovs": AOVS})
-        spp = self.spp
 
         # The integrator is an argument, not a closure: a frozen function must see every
-        # Dr.Jit value it reads among its inputs.
-        def launch(scene: Any, integrator: Any, seed: Any) -> Any:
+        # Dr.Jit value it reads among its inputs (a new spp is a new recording).
+        def launch(scene: Any, integrator: Any, spp: int, seed: Any) -> Any:
             return mi.render(scene, sensor=sensor, integrator=integrator, spp=spp, seed=seed)
 
         self._launch = dr.freeze(launch) if freeze and dr.is_jit_v(mi.Float) else launch
 
-    def render(self, seed: int = 0) -> Guides:
-        """The guides at the scene's current pose (the same seed gives the same images)."""
+    def render(self, seed: int = 0, spp: int | None = None) -> Guides:
+        """The guides at the scene's current pose (the same seed gives the same images),
+        with ``min(spp, self.spp)`` samples (``self.spp`` when ``spp`` is None)."""
         import mitsuba as mi
 
-        t0 = time.perf_counter()
-        image = self._launch(self.scene, self.integrator, mi.UInt32(seed))
+        n = self.spp if spp is None else max(1, min(int(spp), self.spp))
+        t0, c0 = time.perf_counter(), time.process_time()
+        image = self._launch(self.scene, self.integrator, n, mi.UInt32(seed))
         out = np.array(image, dtype=np.float32)
         albedo = np.clip(out[..., 0:3], 0.0, 1.0)
         normal = np.clip(np.nan_to_num(out[..., 3:6]), -1.0, 1.0)
-        return Guides(albedo, normal, time.perf_counter() - t0)
+        return Guides(albedo, normal, time.perf_counter() - t0, time.process_time() - c0, n)
 
-    def denoise(self, image: np.ndarray, seed: int = 0) -> Denoised:
-        """``image`` (rendered at the current pose) denoised with freshly rendered guides."""
-        guides = self.render(seed)
-        t0 = time.perf_counter()
+    def denoise(self, image: np.ndarray, seed: int = 0, spp: int | None = None) -> Denoised:
+        """``image`` (rendered at the current pose with ``spp`` samples) denoised with
+        freshly rendered guides of as many samples, at most ``self.spp``."""
+        guides = self.render(seed, spp)
+        t0, c0 = time.perf_counter(), time.process_time()
         out = denoise(image, guides)
-        return Denoised(out, guides.seconds, time.perf_counter() - t0)
+        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+        return Denoised(out, guides.seconds, wall, guides.cpu_seconds, cpu, guides.spp)
 
 
 def denoise(image: np.ndarray, guides: Guides | None = None) -> np.ndarray:
@@ -164,26 +181,32 @@ def denoise(image: np.ndarray, guides: Guides | None = None) -> np.ndarray:
 
 
 # -- proofs ------------------------------------------------------------------------------
-def guide_renderer(table: Any, spp: int | None) -> GuideRenderer:
+def guide_renderer(table: Any) -> GuideRenderer:
     """The guides of a :class:`~.turntable.Turntable` (its single-frame camera), rendered
-    with ``min(spp, GUIDE_SPP)`` samples (GUIDE_SPP under a noise target): a 4-spp
-    preview does not pay for 16-spp guides."""
-    n = GUIDE_SPP if spp is None else min(int(spp), GUIDE_SPP)
+    per frame with the frame's own samples, at most GUIDE_SPP (:func:`write_denoised`):
+    an 8-spp frame under a noise target does not pay for 16-spp guides, and the proofs
+    run what ``lookdev bench error`` measures."""
     # Not frozen: tracing the aov integrator is cheap (≈ 0.03-0.1 s a frame, measured on
     # 32×16 proofs), and a second frozen launch over the turntable's scene is one more
     # recording that can fail (see GuideRenderer); lookdev bench error times frozen guides.
-    return GuideRenderer(table.scene, table.camera_index, n, freeze=False)
+    return GuideRenderer(table.scene, table.camera_index, GUIDE_SPP, freeze=False)
 
 
 def write_denoised(
-    guides: GuideRenderer, image: np.ndarray, stem: Path, exposure: float, seed: int
+    guides: GuideRenderer,
+    image: np.ndarray,
+    stem: Path,
+    exposure: float,
+    seed: int,
+    spp: int | None = None,
 ) -> tuple[dict[str, Path], dict[str, float]]:
-    """Denoise a frame at the pose it was just rendered in; write ``<stem>_denoised.exr``
-    and ``.png`` beside the raw ``<stem>.exr``. Returns the written files by manifest
-    role (``denoised``, ``denoised_png``) and the manifest's ``denoise`` timings."""
+    """Denoise a frame (of ``spp`` samples) at the pose it was just rendered in; write
+    ``<stem>_denoised.exr`` and ``.png`` beside the raw ``<stem>.exr``. Returns the
+    written files by manifest role (``denoised``, ``denoised_png``) and the manifest's
+    ``denoise`` entry (:meth:`Denoised.timings`)."""
     from . import contact, tonemap
 
-    d = guides.denoise(image, seed=seed)
+    d = guides.denoise(image, seed=seed, spp=spp)
     exr = contact.write_exr(d.image, stem.with_name(stem.name + "_denoised.exr"))
     display = tonemap.view(d.image, exposure)
     png = contact.write_png(display, stem.with_name(stem.name + "_denoised.png"))

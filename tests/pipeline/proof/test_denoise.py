@@ -93,7 +93,16 @@ def test_guides_have_the_frames_shape_and_are_finite(mi, flat):
     np.testing.assert_allclose(guides.albedo[12, 3], (0.8, 0.3, 0.1), rtol=1e-4)
     np.testing.assert_allclose(guides.albedo[12, 20], (0.1, 0.4, 0.8), rtol=1e-4)
     np.testing.assert_allclose(guides.normal, np.broadcast_to([0, 0, 1], (24, 24, 3)), atol=1e-5)
-    assert guides.seconds > 0
+    assert guides.seconds > 0 and guides.spp == 4
+
+
+def test_guides_take_the_frames_samples_up_to_the_cap(mi, flat):
+    scene, _ = flat
+    renderer = denoise.GuideRenderer(scene, 0, 4, freeze=False)
+    assert [renderer.render(seed=1, spp=n).spp for n in (1, 2, 8, None)] == [1, 2, 4, 4]
+    # One guide sample per pixel: the same first hits, only less anti-aliased.
+    one = renderer.render(seed=1, spp=1)
+    np.testing.assert_allclose(one.albedo[12, 3], (0.8, 0.3, 0.1), rtol=1e-4)
 
 
 def test_denoised_frame_is_closer_to_the_reference_than_raw(mi, flat):
@@ -107,7 +116,11 @@ def test_denoised_frame_is_closer_to_the_reference_than_raw(mi, flat):
         assert raw_err > 0.02  # the frame is noisy: the comparison means something
         assert den_err < 0.5 * raw_err
         assert d.aov_seconds > 0 and d.denoise_seconds > 0
-        assert set(d.timings()) == {"aov_s", "denoise_s"}
+        assert d.timings() | {"aov_s": 0, "denoise_s": 0} == {
+            "aov_s": 0,
+            "denoise_s": 0,
+            "guide_spp": 4,
+        }
 
 
 def test_denoise_without_guides_and_with_bad_pixels_stays_finite():
@@ -140,6 +153,7 @@ def test_a_denoised_job_writes_both_exrs_and_records_timings(mi, tmp_path):
         assert (folder / f["images"]["denoised_png"]).is_file()
         assert f["files"]["denoised"]["size"] == den.stat().st_size
         assert f["denoise"]["aov_s"] > 0 and f["denoise"]["denoise_s"] > 0
+        assert f["denoise"]["guide_spp"] == 4  # the frame's own count (under GUIDE_SPP)
     assert (folder / "contact_denoised.png").is_file()
     again = batch.run_job(job)  # the denoised files are vouched for like the raw ones
     assert again["rendered"] == 0 and again["skipped"] == doc["rendered"]
