@@ -64,7 +64,7 @@ def cost(s: CostSettings) -> list[dict[str, Any]]:
             for cap in s.caps:
                 with Clock() as c:
                     table = proof_table(hub, env, s.resolution, "box")
-                    guides = denoise.guide_renderer(table, None) if s.denoise else None
+                    guides = denoise.guide_renderer(table) if s.denoise else None
                 setup, frames = c.timing, []
                 for frame in poses:
                     stem = Path(tmp) / f"frame_{frame.index:03d}"
@@ -77,7 +77,7 @@ def cost(s: CostSettings) -> list[dict[str, Any]]:
                     write, dn = c.timing, Timing()
                     if guides is not None:
                         with Clock() as c:
-                            denoise.write_denoised(guides, r.image, stem, 0.0, frame.index)
+                            denoise.write_denoised(guides, r.image, stem, 0.0, frame.index, r.spp)
                         dn = c.timing
                     frames.append(
                         {

@@ -166,7 +166,7 @@ def _measure(
         }
         if guides is not None:
             with Clock() as c:
-                d = guides.denoise(r.image, seed=frame.index)
+                d = guides.denoise(r.image, seed=frame.index, spp=r.spp)
             run["denoise_time"] = c.timing.to_json()
             run["denoised_rel_mse"] = relative_mse(d.image.astype(np.float64), image_ref)
         runs.append(run)
@@ -224,7 +224,7 @@ def error_case(
     old = _measure(table, {"spp": s.old_spp}, s.seeds, ref, None)
     progress(f"{preset} × {ibl_name}: new default and its reference")
     table = proof_table(hub, env, tuple(new.resolution), new.pixel_filter)
-    guides = denoise.guide_renderer(table, new.spp) if new.denoise else None
+    guides = denoise.guide_renderer(table) if new.denoise else None
     ref = _reference(table, pose, s.reference_spp, s.reference_pass)
     fresh = _measure(table, new.sampling(), s.seeds, ref, guides)
     others = {
