@@ -133,3 +133,12 @@ def test_a_user_config_s_file_rules_name_a_colour_map_s_space(tmp_path):
         assert colour.texture_space(False, False, None, "/a/r_acescg.exr") == "Raw"
     # lookdev's own default config: its plate rules (EXR → ACES2065-1) are not consulted
     assert colour.texture_space(False, True, None, "/a/wall.exr") == colour.working_space()
+
+
+def test_a_large_frame_goes_through_the_view_in_blocks_with_the_same_codes():
+    frame = np.random.default_rng(3).lognormal(-1.5, 1.5, (300, 480, 3)).astype(np.float32)
+    rows = colour.PARALLEL_PIXELS // 480 // 2  # each slice below the threshold: one block
+    serial = np.concatenate(
+        [colour.to_display(frame[k : k + rows]) for k in range(0, 300, rows)], axis=0
+    )
+    assert np.array_equal(colour.to_display(frame), serial)
