@@ -467,7 +467,7 @@ def to_display(pixels: Any, exposure: float = 0.0) -> np.ndarray:
     return np.clip(out, 0.0, 1.0)
 
 
-PARALLEL_PIXELS = 1 << 16
+PARALLEL_PIXELS = 1 << 15
 """From this many pixels up, a view transform runs in row blocks on every core."""
 
 
