@@ -8,9 +8,10 @@
 (function () {
   const data = JSON.parse(document.getElementById("lookdev-data").textContent);
   const FPS = 6;
-  const state = { denoised: false };
-  const views = []; // everything that shows frames: redrawn when the toggle changes
   const hasDenoised = data.proofs.some((p) => p.frames.some((f) => f.denoised));
+  // a batch that was denoised (the main job's default) opens on the denoised frames
+  const state = { denoised: hasDenoised };
+  const views = []; // everything that shows frames: redrawn when the toggle changes
 
   function el(tag, attrs, ...children) {
     const e = document.createElement(tag);
@@ -301,7 +302,9 @@
   }
 
   function toolbar() {
-    const box = el("input", { type: "checkbox", id: "denoised", disabled: !hasDenoised });
+    const box = el("input", {
+      type: "checkbox", id: "denoised", disabled: !hasDenoised, checked: state.denoised,
+    });
     box.addEventListener("change", () => {
       state.denoised = box.checked;
       views.forEach((v) => v.redraw());

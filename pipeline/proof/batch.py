@@ -561,12 +561,14 @@ def merge_entries(out: Path, entries: list[dict[str, Any]]) -> list[dict[str, An
 
 
 def _first_png(out: Path, entry: dict[str, Any]) -> Path | None:
-    """The first frame's PNG of a batch entry, from its own manifest; None when gone."""
+    """The first frame's PNG of a batch entry (denoised where it was), from its own
+    manifest; None when gone."""
     folder = out / entry["folder"]
     try:
         doc = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
-        first = folder / doc["frames"][0]["images"]["png"]
-    except (OSError, ValueError, KeyError, IndexError, TypeError):
+        images = doc["frames"][0]["images"]
+        first = folder / images.get("denoised_png", images["png"])
+    except (OSError, ValueError, KeyError, IndexError, TypeError, AttributeError):
         return None
     return first if first.is_file() else None
 

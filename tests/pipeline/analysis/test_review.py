@@ -174,6 +174,10 @@ def test_review_page_plays_scrubs_toggles_and_compares(batch, tmp_path):
         headings = page.js("[...document.querySelectorAll('.material h2')].map(h => h.textContent)")
         assert headings == sorted(MATERIALS)  # the batch order: by name
         img = f"{PLAYER} img.frame"
+        # a denoised batch opens on its denoised frames; the rest starts from the raw ones
+        assert page.js("document.querySelector('#denoised').checked") is True
+        assert _close(_shown(page, img), colour(0, 0, 0, True))
+        page.js("document.querySelector('#denoised').click()")
         assert _close(_shown(page, img), colour(0, 0, 0, False))
         (shots / "player.png").write_bytes(page.screenshot(PLAYER))
 
