@@ -212,8 +212,11 @@ def test_lookdev_proof_report_writes_a_page_that_opens_cleanly(cli, tmp_path):
     (out / "report" / "screenshot.png").write_bytes(seen["screenshot"])
     for problem in ("console", "exceptions", "log", "failed", "remote", "broken"):
         assert not seen[problem], (problem, seen[problem])
-    # 2 contact sheets, 2 players, the comparison's 2 materials under studio, 2 × 4 plots
-    assert len(seen["images"]) == 2 + 2 + 2 + 8
+    # 2 contact sheets and their 2 denoised twins (denoising is the default), 2 players,
+    # the comparison's 2 materials under studio (both on denoised frames), 2 × 4 plots
+    assert len(seen["images"]) == 2 + 2 + 2 + 2 + 8
+    shown = [src for src, *_ in seen["images"] if "/frame_" in src]
+    assert shown and all(src.endswith("_denoised.png") for src in shown)
     # the batch recorded each material's parameters, source and USD loss notes
     data = json.loads(text.split('id="lookdev-data">', 1)[1].split("</script>", 1)[0])
     assert data["materials"]["gold"]["parameters"]["metallic"] == 1.0

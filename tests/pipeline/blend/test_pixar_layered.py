@@ -378,8 +378,9 @@ def test_proof_of_a_layered_pixar_preset(cli, tmp_path):
     r = cli("proof", "pixar_rusty_metal", "--ibl", "studio", "--frames", "2", "--light-frames",
             "0", "--spp", "4", "--resolution", "32", "32", "-o", str(out), "-j", "1")  # fmt: skip
     assert r.code == 0, r.err
-    frames = sorted((out / "pixar_rusty_metal" / "studio").glob("frame_*.exr"))
-    assert len(frames) == 2
+    folder = out / "pixar_rusty_metal" / "studio"
+    assert len(list(folder.glob("frame_???.exr"))) == 2  # the raw frames
+    assert len(list(folder.glob("frame_???_denoised.exr"))) == 2  # denoised by default
 
 
 @pytest.mark.slow
