@@ -46,6 +46,8 @@ CASES = [
     ("disney", {"spec_trans": 0.5, "roughness": 0.0, "ior": 1.5}, "disney-smooth-mix", None),
     ("disney", {"diff_trans": 0.7, "thin": True, "flatness": 0.5}, "disney-leaf", 0.25),
     ("disney", {"sheen": 1.0, "sheen_tint": 0.5, "subsurface": 1.0}, "disney-sheen", 0.25),
+    # a solid with a scatter distance: the diffuse's Lambertian part enters the interior
+    ("disney", {"scatter_distance": 0.01, "roughness": 0.5}, "disney-subsurface", 0.25),
     (
         "disney",
         {"sheen": 1.0, "sheen_model": "conty_kulla", "sheen_roughness": 0.5},
@@ -116,7 +118,8 @@ def _plugin(mi, params):
 
 
 def _views(values):
-    transmits = any(values.get(k) for k in ("spec_trans", "diff_trans", "clear", "back"))
+    keys = ("spec_trans", "diff_trans", "clear", "back", "scatter_distance")
+    transmits = any(values.get(k) for k in keys)
     return [v for v in VIEWS if v != "below" or transmits]
 
 
