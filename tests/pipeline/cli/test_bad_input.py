@@ -116,6 +116,25 @@ def test_nan_inf_and_huge_values_are_one_line_naming_field_and_range(schema, nam
 
 
 @pytest.mark.parametrize(
+    "schema, values, words",
+    [
+        (DisneyParams, {"sheen_lambda": "approx"}, "'fit' or 'exact'"),
+        (SheenParams, {"sheen_lambda": 3}, "'fit' or 'exact'"),
+        (DisneyParams, {"energy_compensation": "sometimes"}, "valid boolean"),
+        (DisneyParams, {"energy_compensation": 2}, "valid boolean"),
+    ],
+)
+def test_the_sheen_lambda_and_energy_compensation_switches_reject_in_one_line(
+    schema, values, words
+):
+    (name,) = values
+    with pytest.raises(ParameterError) as info:
+        schema.parse(values, where="p.toml")
+    text = str(info.value)
+    assert text.startswith(f"p.toml: {name}: ") and words in text and "\n" not in text
+
+
+@pytest.mark.parametrize(
     "mask, words",
     [
         ({"kind": "texture", "path": "m.png", "uv_scale": [1e9, 1.0]}, "allowed [-4096, 4096]"),
