@@ -14,7 +14,7 @@ Explorer (and Schutte's and Mitsuba's ``principled``), is the smallest α a *glo
 lobe takes: at it the peak D(n) = 1/(π α²) ≈ 3·10⁵ is still finite in float32, and
 ``sample``, ``pdf`` and ``eval`` all see the same α. Roughness used to be clamped up to it,
 so every roughness below √10⁻³ ≈ 0.0316 already rendered alike, as a lobe 0.06° wide that
-a renderer had to treat as glossy (sample lights at every vertex for nothing, issue 16).
+a renderer had to treat as glossy (sample lights at every vertex for nothing).
 The rule now (:func:`is_delta`): a GGX lobe whose larger α (roughness²/aspect, computed
 from the float32 roughness and anisotropy every consumer stores) is below ``ALPHA_MIN``
 is the α → 0 limit itself, a Dirac delta (mirror reflection, Snell refraction), sampled

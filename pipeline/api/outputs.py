@@ -672,7 +672,7 @@ def check(
 ) -> Stability:
     """Sweep every reflectance model (or those named) over its stiff and extreme cases.
 
-    Parameters at both ends of their ranges and DESIGN.md's combinations, directions at
+    Parameters at both ends of their ranges and the named stiff combinations, directions at
     and beyond grazing, ``wi = −wo``, uniforms at 0, ½ and 1 − 2⁻²⁴, in float32 and
     float64; white-furnace albedos against each model's energy allowance.
     ``progress(done, total, model, case)`` is called after each parameter set.

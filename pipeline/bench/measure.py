@@ -289,7 +289,7 @@ def _drjit_lambdas(batch: np.ndarray) -> dict[str, dict[str, Callable[..., Any]]
 
 # -- float32 against float64 -----------------------------------------------------------
 def direction_pairs(n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """Random (wi, wo) pairs over both hemispheres, plus the edge cases DESIGN.md lists:
+    """Random (wi, wo) pairs over both hemispheres, plus the edge cases :doc:`/design` lists:
     normal incidence, grazing (cos θ = 1e-4), retro-reflection and wi = −wo."""
     rng = np.random.default_rng(seed)
     v = rng.normal(size=(2, n, 3))

@@ -2,7 +2,7 @@
 
 Commands are verbs; each group lives in its own module beside this one and is added in
 :func:`_register`. Bad input anywhere ends in one line on stderr and exit code 2
-(DESIGN.md, Errors): commands raise :class:`~lookdev.materials.errors.LookdevError` and
+(:doc:`/design`, Errors): commands raise :class:`~lookdev.materials.errors.LookdevError` and
 :func:`main` turns it into that line.
 """
 
@@ -145,7 +145,7 @@ INTERRUPTED = "interrupted: run the same command again to resume"
 def main(argv: list[str] | None = None) -> None:
     """Entry point of the ``lookdev`` script; ``argv`` defaults to ``sys.argv[1:]``.
 
-    The one place errors become what a user sees (DESIGN.md, Errors): a
+    The one place errors become what a user sees (:doc:`/design`, Errors): a
     :class:`LookdevError`, Click's own usage errors (bad option values, unknown commands
     and options, missing arguments) and an ``OSError`` end in one line on stderr and exit
     2; exit 1 stays "checked and found problems"; Ctrl-C ends in one line and exit 130.
