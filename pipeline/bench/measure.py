@@ -172,8 +172,9 @@ def bench_lambda(
     reference_nodes: int = 2048,
 ) -> list[Row]:
     """The Λ fit, and the projected-area integral at a ladder of Gauss-Legendre nodes,
-    against that integral converged (:func:`lookdev.pipeline.analysis.sheen_fit.
-    lambda_integrated`, Heitz 2014: 1 + Λ(ω) = ∫ ⟨ω·m⟩ D(m) dm / cos θ)."""
+    against that integral converged
+    (:func:`~lookdev.pipeline.analysis.sheen_fit.lambda_integrated`, Heitz 2014: 1 + Λ(ω) =
+    ∫ ⟨ω·m⟩ D(m) dm / cos θ)."""
     from lookdev.pipeline.analysis.sheen_fit import lambda_integrated
 
     rows = []
