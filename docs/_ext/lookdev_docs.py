@@ -106,7 +106,8 @@ def _find_obj_nearest(self, env, modname, classname, name, type, searchmode=0): 
 class JsonTable(SphinxDirective):
     """``{json-table} data/file.json`` with ``:rows: key.path`` and ``:columns:``.
 
-    ``:columns:`` is one ``key = Heading`` a line; a key may be a dotted path into the row.
+    ``:columns:`` is ``key = Heading`` pairs separated by ``;``; a key may be a dotted path
+    into the row.
     ``:format:`` gives a Python format per key (``key = {:.3g}``); ``:sort: key`` (``-key``
     descending) and ``:limit: N`` pick the rows shown. The file is a dependency of the
     page, so a regenerated file rebuilds it.
@@ -135,12 +136,12 @@ class JsonTable(SphinxDirective):
             ]
         columns = [
             tuple(s.strip() for s in c.split("=", 1))
-            for c in self.options["columns"].splitlines()
+            for c in re.split(r"[;\n]", self.options["columns"])
             if c.strip()
         ]
         formats = dict(
             tuple(s.strip() for s in f.split("=", 1))
-            for f in self.options.get("format", "").splitlines()
+            for f in re.split(r"[;\n]", self.options.get("format", ""))
             if f.strip()
         )
         if "sort" in self.options:
