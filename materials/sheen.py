@@ -1,4 +1,4 @@
-"""Conty Estevez & Kulla 2017, "Production Friendly Microfacet Sheen BRDF".
+"""The Conty–Kulla microfacet sheen :cite:p:`Conty2017`.
 
 A microfacet lobe for cloth, written once over the array shim (:mod:`.arrays`):
 
