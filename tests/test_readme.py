@@ -23,6 +23,8 @@ README = (ROOT / "README.md").read_text()
 SHRINK = {
     "lookdev proof": "--frames 1 --light-frames 1 --resolution 32 16 --ibl-width 64 --spp 2",
     "lookdev plot": "--resolution 16",
+    # The designer serves a page until stopped; here only its command line is checked.
+    "lookdev designer": "--help",
 }
 
 
