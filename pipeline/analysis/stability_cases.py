@@ -204,8 +204,31 @@ def plausible(params: Any) -> bool:
     return True
 
 
+def measured_cases() -> list[tuple[str, Any]]:
+    """The measured model's cases: every shipped measurement (their values as read,
+    negative noise included) at scale 1 and at its ceiling, and two synthetic tables on
+    the periodic MERL grid: all zero, and a white Lambertian 0.999/π (the furnace's edge)."""
+    from lookdev.library.measured import builtin_measured, read_measured
+    from lookdev.materials.measured import MeasuredParams, MeasuredTable
+
+    lambert = np.full((5, 5, 7, 3), 0.999 / np.pi, dtype=np.float32)
+    tables = [read_measured(p) for p in builtin_measured()]
+    tables += [MeasuredTable.constant(0.0), MeasuredTable("merl", lambert, source="white")]
+    cases = [(t.source, MeasuredParams(table=t)) for t in tables]
+    ceiling = MeasuredParams.model_fields["scale"].metadata[-1].le
+    cases += [
+        (f"{t.source}, scale={ceiling:g}", MeasuredParams(table=t, scale=ceiling))
+        for t in tables[:1]
+    ]
+    return cases
+
+
 def parameter_cases(params_type: type) -> list[tuple[str, Any]]:
     """(label, params): defaults, each field at each extreme, and the named combinations."""
+    from lookdev.materials.measured import MeasuredParams
+
+    if params_type is MeasuredParams:
+        return measured_cases()
     cases = [("defaults", params_type())]
     fields = params_type.model_fields
     for name, info in fields.items():
