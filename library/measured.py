@@ -40,6 +40,7 @@ __all__ = [
     "read_mbsdf",
     "read_measured",
     "read_merl",
+    "resolve_measured",
     "write_mbsdf",
     "write_merl",
 ]
@@ -62,6 +63,21 @@ def builtin_measured() -> list[Path]:
 
     folder = builtin_folder() / "measured"
     return sorted(p for p in folder.glob("*") if p.suffix.lower() in MEASURED_SUFFIXES)
+
+
+def resolve_measured(path: str | os.PathLike) -> Path:
+    """``path`` as given where it exists, else the shipped measurement of that file name
+    (``carpaint_red.mbsdf``); a :class:`MeasuredFileError` naming both otherwise."""
+    p = Path(path)
+    if p.exists():
+        return p
+    for shipped in builtin_measured():
+        if shipped.name == p.name or shipped.stem == p.name:
+            return shipped
+    known = ", ".join(q.name for q in builtin_measured())
+    raise MeasuredFileError(
+        f"no such file, nor a shipped measurement (shipped: {known})", where=str(p)
+    )
 
 
 def read_measured(path: str | os.PathLike) -> MeasuredTable:

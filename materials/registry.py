@@ -46,8 +46,7 @@ __all__ = [
 ]
 
 MODELS: dict[str, Model] = {
-    m.name: m
-    for m in (disney.MODEL, sheen.MODEL, pixar.MODEL, pixar.LAYERED_MODEL, measured.MODEL)
+    m.name: m for m in (disney.MODEL, sheen.MODEL, pixar.MODEL, pixar.LAYERED_MODEL, measured.MODEL)
 }
 """Every model by name; each renders in Mitsuba as the plugin ``lookdev_<name>``. A new
 model adds itself here (tests add toy models the same way)."""
