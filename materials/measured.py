@@ -32,11 +32,10 @@ that).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import ConfigDict, Field, field_validator
+from pydantic import BeforeValidator, ConfigDict, Field, field_validator
 
 from .bsdf import Lobe, Model
 from .params import Params
@@ -48,6 +47,7 @@ __all__ = [
     "MeasuredParams",
     "MeasuredTable",
     "grid_directions",
+    "table_by_key",
     "table_coordinates",
 ]
 
@@ -56,25 +56,32 @@ HALF_PI = 0.5 * math.pi
 _COS_FLOOR = 1e-6  # below this a direction is tangent: no reflection
 
 
-@dataclass(frozen=True, eq=False)
 class MeasuredTable:
     """f on a grid: ``values`` of shape (n0, n1, n2, 3), float32, 1/sr.
 
     Axes: ``"mbsdf"`` (θi, θo, φ); ``"merl"`` (θh, θd, φd). ``source`` names the file.
     ``negative`` counts the samples below zero the reader found (clamped when evaluated).
+    A plain class, not a dataclass, so that a schema dump keeps it whole.
     """
 
-    grid: Literal["mbsdf", "merl"]
-    values: np.ndarray
-    source: str = ""
-    negative: int = 0
+    __slots__ = ("grid", "values", "source", "negative")
 
-    def __post_init__(self) -> None:
-        if self.grid not in GRIDS:
-            raise ValueError(f"unknown grid {self.grid!r}; known: {', '.join(GRIDS)}")
-        v = np.asarray(self.values)
+    def __init__(
+        self,
+        grid: Literal["mbsdf", "merl"],
+        values: np.ndarray,
+        source: str = "",
+        negative: int = 0,
+    ):
+        if grid not in GRIDS:
+            raise ValueError(f"unknown grid {grid!r}; known: {', '.join(GRIDS)}")
+        v = np.asarray(values, dtype=np.float32)
         if v.ndim != 4 or v.shape[-1] != 3 or min(v.shape[:3]) < 2:
             raise ValueError(f"a table has shape (n0, n1, n2, 3), n ≥ 2; got {v.shape}")
+        self.grid, self.values, self.source, self.negative = grid, v, source, negative
+
+    def __repr__(self) -> str:
+        return f"MeasuredTable({self.grid!r}, shape={self.shape}, source={self.source!r})"
 
     @classmethod
     def constant(cls, f: float, shape: tuple[int, int, int] = (4, 4, 4)) -> MeasuredTable:
@@ -87,7 +94,26 @@ class MeasuredTable:
 
     def flat(self) -> np.ndarray:
         """The values clamped at zero, (n0·n1·n2, 3), in the order the model reads them."""
-        return np.maximum(np.asarray(self.values, dtype=np.float32), 0).reshape(-1, 3)
+        return np.maximum(self.values, 0).reshape(-1, 3)
+
+    def key(self) -> str:
+        """A name for this table in this process (:func:`table_by_key` finds it): what a
+        scene description that holds only strings (a Mitsuba plugin's properties) passes."""
+        name = f"measured:{self.source}:{id(self):x}"
+        _TABLES[name] = self
+        return name
+
+
+_TABLES: dict[str, MeasuredTable] = {}
+
+
+def table_by_key(value: Any) -> Any:
+    """The table a :meth:`MeasuredTable.key` names; anything else as it is."""
+    if isinstance(value, str):
+        if value not in _TABLES:
+            raise ValueError(f"no measured table {value!r} in this process")
+        return _TABLES[value]
+    return value
 
 
 class MeasuredParams(Params):
@@ -96,7 +122,7 @@ class MeasuredParams(Params):
     model_config = ConfigDict(
         extra="forbid", allow_inf_nan=False, frozen=True, arbitrary_types_allowed=True
     )
-    table: MeasuredTable
+    table: Annotated[MeasuredTable, BeforeValidator(table_by_key)]
     scale: float = Field(1.0, ge=0.0, le=1e3, description="multiplies every value")
 
     @field_validator("table")
