@@ -84,9 +84,11 @@ class MeasuredTable:
         return f"MeasuredTable({self.grid!r}, shape={self.shape}, source={self.source!r})"
 
     @classmethod
-    def constant(cls, f: float, shape: tuple[int, int, int] = (4, 4, 4)) -> MeasuredTable:
+    def constant(
+        cls, f: float, shape: tuple[int, int, int] = (4, 4, 4), source: str = "constant"
+    ) -> MeasuredTable:
         """A table of one value (a tabulated Lambertian of albedo π·f)."""
-        return cls("mbsdf", np.full((*shape, 3), f, dtype=np.float32), source="constant")
+        return cls("mbsdf", np.full((*shape, 3), f, dtype=np.float32), source=source)
 
     @property
     def shape(self) -> tuple[int, int, int]:
@@ -120,9 +122,16 @@ class MeasuredParams(Params):
     """A measured BRDF as a material: its table and a scale (1 reproduces the file)."""
 
     model_config = ConfigDict(
-        extra="forbid", allow_inf_nan=False, frozen=True, arbitrary_types_allowed=True
+        extra="forbid",
+        allow_inf_nan=False,
+        frozen=True,
+        validate_default=True,
+        arbitrary_types_allowed=True,
     )
-    table: Annotated[MeasuredTable, BeforeValidator(table_by_key)]
+    table: Annotated[MeasuredTable, BeforeValidator(table_by_key)] = Field(
+        default_factory=lambda: MeasuredTable.constant(0.18 / math.pi, source="grey"),
+        description="the measurement; by default an 18 % grey Lambertian, tabulated",
+    )
     scale: float = Field(1.0, ge=0.0, le=1e3, description="multiplies every value")
 
     @field_validator("table")
