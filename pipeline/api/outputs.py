@@ -686,10 +686,12 @@ def check(
     """
     import time
 
+    from lookdev.library.measured import builtin_measured, read_measured
     from lookdev.pipeline.analysis import stability
 
     names = list(models) if models else None
-    total = stability.case_count(names) if progress is not None else 0
+    measured = [read_measured(p) for p in builtin_measured()]  # the shipped measurements
+    total = stability.case_count(names, measured) if progress is not None else 0
     done = 0
 
     def advance(name: str, label: str) -> None:
@@ -699,5 +701,5 @@ def check(
             progress(done, total, name, label)
 
     started = time.perf_counter()
-    reports = stability.run(names, advance)
+    reports = stability.run(names, advance, measured)
     return Stability(reports, time.perf_counter() - started)
