@@ -591,6 +591,7 @@ def plot(
     library: Any = None,
     vary: tuple[str, Sequence[float]] | None = None,
     uv: tuple[float, float] | None = None,
+    overlay: bool = False,
 ) -> Plot:
     """Draw materials side by side as one BRDF-explorer view (Burley §3.2) to an image.
 
@@ -601,7 +602,8 @@ def plot(
     channel), ``polar`` (f in the plane of incidence) or ``sphere`` (a lit sphere, also
     under ``ibl`` when given). ``path`` ends in ``.png``, ``.pdf`` or ``.svg``.
     ``vary`` = (parameter, values) draws each material once per value
-    (``("specular_gamma", [1, 1.5, 2, 3])``).
+    (``("specular_gamma", [1, 1.5, 2, 3])``). ``overlay``: the albedo and polar views draw
+    every material on one axes (a measurement over its fit).
     """
     from lookdev.pipeline.analysis import plots
 
@@ -637,6 +639,7 @@ def plot(
         environment=environment,
         ibl_name=ibl or "",
         resolution=resolution,
+        overlay=overlay,
     )
     plots.save_figure(fig, output)
     return Plot(output, view, [h.name for h in hubs])

@@ -106,3 +106,25 @@ def test_bad_fit_input_is_one_line_and_exit_2(tmp_path, monkeypatch, cli, args, 
     assert out.code == 2 and message in out.err, out.err
     assert len(out.err.strip().splitlines()) == 1
     assert not (tmp_path / "x.toml").exists()
+
+
+@pytest.mark.parametrize("view", ["polar", "albedo"])
+def test_a_measurement_and_a_preset_overlay_on_one_axes(tmp_path, monkeypatch, cli, view):
+    from PIL import Image
+
+    monkeypatch.chdir(tmp_path)
+    out = cli(
+        "plot",
+        "carpaint_red.mbsdf",
+        "car_paint_red",
+        "--view",
+        view,
+        "--overlay",
+        "-o",
+        "o.png",
+        "--json",
+    )
+    assert out.code == 0, out.err
+    assert json.loads(out.out)["materials"] == ["carpaint_red.mbsdf", "car_paint_red"]
+    width, height = Image.open(tmp_path / "o.png").size
+    assert width < 1.5 * height  # one axes, not two columns side by side
