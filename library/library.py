@@ -35,7 +35,7 @@ from .preset import (
 )
 
 ENV_PATH = "LOOKDEV_LIBRARY_PATH"
-BUILTIN_OTHER_DATA = ("ibl",)
+BUILTIN_OTHER_DATA = ("ibl", "measured")
 """Sub-folders of the built-in ``presets/`` that hold other data, not material presets."""
 
 

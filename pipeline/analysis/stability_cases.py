@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import itertools
 import typing
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -204,8 +205,32 @@ def plausible(params: Any) -> bool:
     return True
 
 
-def parameter_cases(params_type: type) -> list[tuple[str, Any]]:
-    """(label, params): defaults, each field at each extreme, and the named combinations."""
+def measured_cases(measured: Sequence[Any] = ()) -> list[tuple[str, Any]]:
+    """The measured model's cases: each measurement given (as read, negative noise
+    included: ``lookdev check`` gives the shipped ones) at scale 1 and the first at the
+    scale's ceiling, and two synthetic tables on the periodic MERL grid: all zero, and a
+    white Lambertian 0.999/π (the furnace's edge)."""
+    from lookdev.materials.measured import MeasuredParams, MeasuredTable
+
+    lambert = np.full((5, 5, 7, 3), 0.999 / np.pi, dtype=np.float32)
+    tables = list(measured)
+    tables += [MeasuredTable.constant(0.0), MeasuredTable("merl", lambert, source="white")]
+    cases = [(t.source, MeasuredParams(table=t)) for t in tables]
+    ceiling = MeasuredParams.model_fields["scale"].metadata[-1].le
+    cases += [
+        (f"{t.source}, scale={ceiling:g}", MeasuredParams(table=t, scale=ceiling))
+        for t in tables[:1]
+    ]
+    return cases
+
+
+def parameter_cases(params_type: type, measured: Sequence[Any] = ()) -> list[tuple[str, Any]]:
+    """(label, params): defaults, each field at each extreme, and the named combinations;
+    for the measured model, :func:`measured_cases` of the tables ``measured``."""
+    from lookdev.materials.measured import MeasuredParams
+
+    if params_type is MeasuredParams:
+        return measured_cases(measured)
     cases = [("defaults", params_type())]
     fields = params_type.model_fields
     for name, info in fields.items():

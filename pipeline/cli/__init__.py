@@ -109,7 +109,7 @@ def _root(
 
 
 def _register() -> None:
-    from . import bench, check, export, export_usd, plot, presets, proof
+    from . import bench, check, export, export_usd, fit, plot, presets, proof
     from . import blend as blend_cli
     from . import colour as colour_cli
 
@@ -122,6 +122,7 @@ def _register() -> None:
     app.add_typer(export_usd.validate_app, name="validate")
     app.add_typer(presets.app, name="presets")
     app.command("plot")(plot.plot)
+    app.command("fit")(fit.fit)
     app.command("proof")(proof.proof)
     app.add_typer(colour_cli.app, name="colour")
     _reflow_help(app)

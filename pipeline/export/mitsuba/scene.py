@@ -216,6 +216,10 @@ def _plugin_dict(hub: BlendedMaterial, texture_dir: str | Path | None) -> dict[s
 
 
 def _constant(value: Any) -> Any:
+    from lookdev.materials.measured import MeasuredTable
+
+    if isinstance(value, MeasuredTable):  # properties hold strings: the table by its key
+        return value.key()
     if isinstance(value, tuple):
         return {"type": "rgb", "value": [float(c) for c in value]}
     if isinstance(value, bool | str):
