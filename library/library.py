@@ -140,9 +140,18 @@ class Library:
         )
 
     def read(self, name: str) -> tuple[PresetFile, Path]:
-        """The parsed file that ``name`` resolves to, and its path."""
+        """The parsed file that ``name`` resolves to, and its path; its relative texture
+        paths stay inside its library (:mod:`.containment`)."""
         path = self.find(name)
-        return read_preset(path), path
+        return self._contained(read_preset(path), path), path
+
+    def _contained(self, preset: PresetFile, path: Path) -> PresetFile:
+        from .containment import check_contained
+
+        plain = Path(os.path.abspath(path))
+        root = next((f for f in self.folders if plain.is_relative_to(os.path.abspath(f))), None)
+        check_contained(preset, path, root)
+        return preset
 
     def load(self, name: str) -> Material:
         """The resolved material ``name`` (extends chains and layer references followed)."""
@@ -154,7 +163,7 @@ class Library:
         """Resolve a preset file that need not be on the path; its parents are looked up."""
         from .material import resolve
 
-        preset = read_preset(path)
+        preset = self._contained(read_preset(path), path)
         return resolve(preset.name, self._lookup_with(preset, path))
 
     # -- writing -----------------------------------------------------------------------

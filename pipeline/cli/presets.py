@@ -276,6 +276,10 @@ def _texture_set(given: list[str], target: Path, where: str) -> tuple[str, list[
     pattern, folder = from_files(paths)
     found = expand(pattern, folder, where=where)
     rel = os.path.relpath(folder.resolve(), target.resolve())
+    if rel == ".." or rel.startswith(".." + os.sep):
+        # maps kept outside the library: a relative path would leave it (lookdev.library.
+        # containment), so the preset names them absolutely and stays valid when copied
+        return Path(folder.resolve(), pattern).as_posix(), found.notes
     return Path(rel, pattern).as_posix(), found.notes
 
 
