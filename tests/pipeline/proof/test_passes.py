@@ -157,7 +157,8 @@ def test_settings_default_to_a_noise_target_with_a_cap_and_spp_to_a_fixed_count(
     assert s.resolution == settings.DEFAULT_RESOLUTION and s.pixel_filter == "box"
     fixed = settings.Settings(spp=16)
     assert (fixed.noise, fixed.max_spp) == (None, None) and fixed.sampling() == {"spp": 16}
-    with pytest.raises(settings.ProofError, match="^spp: spp is a fixed count; noise go with a noise target"):
+    fixed_count = "^spp: spp is a fixed count; noise go with a noise target"
+    with pytest.raises(settings.ProofError, match=fixed_count):
         settings.Settings(spp=16, noise=0.1)
 
 
