@@ -44,7 +44,7 @@ def check_texture_reference(path: str, uv_scale: tuple[float, float]) -> None:
     >>> try:
     ...     check_texture_reference("wood.png", (0.0, 1.0))
     ... except ValueError as exc:
-    ...     print(str(exc)[:34])
+    ...     print(str(exc)[:35])
     uv_scale [0.0, 1.0] is zero along u
     """
     if "\x00" in path:
