@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import json
 import math
+import subprocess
+import sys
 
 import numpy as np
 import OpenImageIO as oiio
@@ -204,3 +206,20 @@ def test_value_checks_read_every_component():
     assert _value_problem("UsdPreviewSurface", "roughness", 0.5) is None
     assert _value_problem("UsdPreviewSurface", "file", "wood.png") is None
     assert _value_problem("PxrDisneyBsdf", "roughness", -1.0) is None  # no range known
+
+
+def test_a_truncated_png_texture_prints_one_line_and_no_libpng_line(tmp_path):
+    lib = tmp_path / "lib"
+    good = _image(tmp_path / "good.png", 3)
+    _preset(lib, "cut", '[params]\nbase_color = { texture = "cut.png" }\n')
+    (lib / "cut.png").write_bytes(good.read_bytes()[:100])
+    code = "import sys; from lookdev.pipeline.cli import main; main(sys.argv[1:])"
+    r = subprocess.run(
+        [sys.executable, "-c", code, "presets", "show", "cut", "-L", str(lib), "-r"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    lines = r.stderr.strip().splitlines()
+    assert r.returncode == 2 and len(lines) == 1, r.stderr
+    assert lines[0].startswith("lookdev: error: ") and "cannot decode" in lines[0]
