@@ -63,6 +63,7 @@ __all__ = [
     "scratch_folder",
     "signals_unwind",
     "write_error",
+    "quiet_c_stderr",
 ]
 
 TEMP_MARK = ".tmp"
@@ -435,3 +436,25 @@ def scratch_folder(beside: str | os.PathLike | None) -> Iterator[Path]:
 def cache_root() -> Path:
     """``$LOOKDEV_CACHE``, default ``~/.cache/lookdev``: caches of read-only data live here."""
     return Path(os.environ.get("LOOKDEV_CACHE") or Path.home() / ".cache" / "lookdev")
+
+
+@contextlib.contextmanager
+def quiet_c_stderr() -> Iterator[None]:
+    """File descriptor 2 goes to /dev/null for the block: libpng and OpenImageIO print
+    some decode errors ("libpng error: …", "An ImageBuf was destroyed with a pending
+    error …") straight to it, beside the one line lookdev reports for the same problem."""
+    import sys
+
+    try:
+        sys.stderr.flush()
+        saved = os.dup(2)
+    except (OSError, ValueError, AttributeError):
+        yield
+        return
+    try:
+        with open(os.devnull, "wb") as null:
+            os.dup2(null.fileno(), 2)
+            yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)

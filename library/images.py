@@ -20,6 +20,7 @@ import numpy as np
 import OpenImageIO as oiio
 
 from .errors import TextureError
+from .files import quiet_c_stderr
 
 __all__ = [
     "RANDOM_ACCESS",
@@ -107,7 +108,8 @@ class TextureFile:
         self.nbytes = spec.height * spec.width * count * np.dtype(self.dtype).itemsize
 
     def _open(self) -> oiio.ImageInput:
-        image = oiio.ImageInput.open(str(self.path), _AS_DATA)
+        with quiet_c_stderr():  # libpng prints its own line beside ours: keep ours only
+            image = oiio.ImageInput.open(str(self.path), _AS_DATA)
         if image is None or image.spec().nchannels == 0:
             raise TextureError(f"cannot decode {self.path}: {oiio_error()}", where=self.where)
         return image
@@ -142,7 +144,8 @@ class TextureFile:
         for top in range(0, n, step):  # top: rows from the run's top edge, in file order
             rows = min(step, n - top)
             y = self.y0 + h - lo - n + top
-            pixels = image.read_scanlines(0, 0, y, y + rows, 0, c0, c0 + count, self.format)
+            with quiet_c_stderr():
+                pixels = image.read_scanlines(0, 0, y, y + rows, 0, c0, c0 + count, self.format)
             if pixels is None or np.size(pixels) == 0:
                 raise TextureError(
                     f"cannot read pixels of {self.path}: {oiio_error(image)}", where=self.where

@@ -29,10 +29,11 @@ from pathlib import Path
 from typing import Any, NamedTuple
 
 from lookdev.materials.errors import LookdevError
+from lookdev.materials.model_names import PRESET_MODELS
 
 from . import files
 from .errors import PresetError
-from .preset import MODELS, NAME_RE, parse_toml
+from .toml_file import NAME_RE, parse_toml
 
 INDEX_NAME = ".lookdev-index.json"
 INDEX_VERSION = 3
@@ -184,7 +185,7 @@ def _header_fields(doc: dict[str, Any], name: str, where: str) -> tuple:
         raise PresetError(f"no name; add name = {name!r}", where=where, field="name")
     if got["name"] != name or not NAME_RE.fullmatch(name):
         raise PresetError(f"name {got['name']!r} differs from the file name", where=where)
-    if got["model"] is not None and got["model"] not in (*MODELS, "layered"):
+    if got["model"] is not None and got["model"] not in (*PRESET_MODELS, "layered"):
         raise PresetError(f"unknown model {got['model']!r}", where=where, field="model")
     if got["model"] is None and not isinstance(got["extends"], str):
         raise PresetError("'model' is required unless 'extends' is given", where=where)

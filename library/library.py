@@ -15,7 +15,7 @@ from __future__ import annotations
 import os
 from collections.abc import Iterable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import lookdev.presets
 from lookdev.materials.errors import LookdevError
@@ -23,16 +23,14 @@ from lookdev.materials.errors import LookdevError
 from . import store
 from .errors import LibraryError, PresetError, PresetNotFoundError, did_you_mean
 from .index import SUFFIX, Header, scan_folder
-from .material import Material, resolve
-from .preset import (
-    METADATA,
-    PresetFile,
-    build_preset,
-    check_name,
-    dump_preset,
-    parse_preset,
-    preset_document,
-)
+from .toml_file import check_name
+
+if TYPE_CHECKING:
+    from .material import Material
+    from .preset import PresetFile
+
+# The schemas (.preset) and materials (.material) bring pydantic and the models: they are
+# imported where a preset is parsed, so listing headers (`presets list`) needs neither.
 
 ENV_PATH = "LOOKDEV_LIBRARY_PATH"
 BUILTIN_OTHER_DATA = ("ibl", "measured")
@@ -48,12 +46,10 @@ def builtin_folder() -> Path:
 
 
 def read_preset(path: Path) -> PresetFile:
-    """Parse one preset file (its name must match the file name)."""
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise PresetError(f"cannot read ({exc.strerror or exc})", where=str(path)) from None
-    return parse_preset(data, where=str(path), stem=path.name.removesuffix(SUFFIX))
+    """Parse one preset file (:func:`.preset.read_preset`, imported when first needed)."""
+    from .preset import read_preset as read
+
+    return read(path)
 
 
 class Library:
@@ -144,17 +140,30 @@ class Library:
         )
 
     def read(self, name: str) -> tuple[PresetFile, Path]:
-        """The parsed file that ``name`` resolves to, and its path."""
+        """The parsed file that ``name`` resolves to, and its path; its relative texture
+        paths stay inside its library (:mod:`.containment`)."""
         path = self.find(name)
-        return read_preset(path), path
+        return self._contained(read_preset(path), path), path
+
+    def _contained(self, preset: PresetFile, path: Path) -> PresetFile:
+        from .containment import check_contained
+
+        plain = Path(os.path.abspath(path))
+        root = next((f for f in self.folders if plain.is_relative_to(os.path.abspath(f))), None)
+        check_contained(preset, path, root)
+        return preset
 
     def load(self, name: str) -> Material:
         """The resolved material ``name`` (extends chains and layer references followed)."""
+        from .material import resolve
+
         return resolve(name, self.read)
 
     def load_file(self, path: Path) -> Material:
         """Resolve a preset file that need not be on the path; its parents are looked up."""
-        preset = read_preset(path)
+        from .material import resolve
+
+        preset = self._contained(read_preset(path), path)
         return resolve(preset.name, self._lookup_with(preset, path))
 
     # -- writing -----------------------------------------------------------------------
@@ -286,6 +295,9 @@ class Library:
 
     def _write(self, preset: PresetFile, path: Path) -> None:
         """Check that ``preset`` resolves in place at ``path``, then write it atomically."""
+        from .material import resolve
+        from .preset import dump_preset
+
         resolve(preset.name, self._lookup_with(preset, path))
         store.atomic_write(path, dump_preset(preset).encode("utf-8"))
 
@@ -336,6 +348,8 @@ def apply_changes(preset: PresetFile, changes: dict[str, Any], *, where: str) ->
 
     A value of ``None`` removes the key (a parameter is then inherited again).
     """
+    from .preset import METADATA, build_preset, preset_document
+
     data = preset_document(preset)
     params = dict(preset.params)
     for key, value in changes.items():
@@ -352,14 +366,6 @@ def apply_changes(preset: PresetFile, changes: dict[str, Any], *, where: str) ->
             bucket[field] = value
     data["params"] = params
     return build_preset(data, where=where)
-
-
-def set_by(material: Material) -> dict[str, Path]:
-    """For each parameter a file of the extends chain gives: the file that wins (the child's)."""
-    out: dict[str, Path] = {}
-    for path in material.chain:
-        out |= {key: path for key in read_preset(path).params if key not in out}
-    return out
 
 
 def _with_model(h: Header, winners: dict[str, Header]) -> Header:

@@ -68,6 +68,17 @@ class Material(BaseModel):
         default_factory=list, description="What the preset's texture set left out, and why."
     )
 
+    def __repr__(self) -> str:
+        from .display import material_repr
+
+        return material_repr(self)
+
+    def _repr_html_(self) -> str:
+        """The notebook view: parameters, the file of the chain that set each, a swatch."""
+        from .display import material_html
+
+        return material_html(self)
+
     @model_validator(mode="after")
     def _params_fit_the_model(self) -> Material:
         expected = MODELS.get(self.model)

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import re
 import tomllib
+from pathlib import Path
 from typing import Any, Literal
 
 import tomli_w
@@ -33,33 +34,19 @@ from lookdev.materials.params import Params
 from lookdev.materials.textures import TextureInput, is_texture_input, texturable
 
 from .errors import PresetError
+from .index import SUFFIX
+from .toml_file import MAX_BYTES as MAX_BYTES  # re-exported
+from .toml_file import NAME_RE as NAME_RE
+from .toml_file import check_name as check_name
+from .toml_file import parse_toml as parse_toml
 
 MODELS: dict[str, type[Params]] = {
     name: registry.MODELS[name].params_type for name in registry.PRESET_MODELS
 }
 """Parameter schema of each reflectance model a preset may name (from the registry)."""
 
-MAX_BYTES = 1 << 20  # presets are hand-written text; anything larger is not one
-NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]{0,99}")  # whole names: fullmatch
 METADATA = ("description", "tags", "source", "extends")
 """Top-level fields that ``--set`` may change (everything else it sets is a parameter)."""
-
-
-def check_name(name: str, *, field: str | None = "name") -> str:
-    """``name`` if it is a safe preset name: a file name in its library and nothing more.
-
-    Letters, digits, ``_`` and ``-``; no path separators, no ``..``, not absolute.
-
-    >>> check_name("gold_leaf")
-    'gold_leaf'
-    """
-    if not isinstance(name, str) or not NAME_RE.fullmatch(name):
-        raise PresetError(
-            f"preset name {short_repr(name)} is not allowed; use 1-100 letters, digits, '_' or '-' "
-            "(no path separators, no '..')",
-            field=field,
-        )
-    return name
 
 
 @register_schema
@@ -150,29 +137,6 @@ def build_preset(doc: dict[str, Any], *, where: str, stem: str | None = None) ->
         if layer.model is not None:
             check_params(layer.model, layer.params, where=where, prefix=f"layers[{i}].params")
     return preset
-
-
-def parse_toml(data: bytes, *, where: str) -> dict[str, Any]:
-    """The TOML document in ``data``, or a :class:`PresetError` naming the line."""
-    if len(data) > MAX_BYTES:
-        raise PresetError(
-            f"file is {len(data)} bytes; a preset is a small text file (at most {MAX_BYTES})",
-            where=where,
-        )
-    try:
-        # A byte-order mark (some Windows editors write one) is accepted and ignored.
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise PresetError(f"not UTF-8 text (bad byte at offset {exc.start})", where=where) from None
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        # tomllib says "at end of document" without a line; editors want one.
-        at_end = f"at end of document, line {text.count(chr(10)) + 1}"
-        msg = str(exc).replace("at end of document", at_end)
-        raise PresetError(f"malformed TOML: {msg}", where=where) from None
-    except RecursionError:
-        raise PresetError("malformed TOML: values nested too deeply", where=where) from None
 
 
 def check_params(model: str, params: dict[str, Any], *, where: str | None, prefix: str = "params"):
@@ -353,3 +317,12 @@ def parse_value(text: str) -> Any:
         return tomllib.loads(f"v = {text}")["v"]
     except tomllib.TOMLDecodeError:
         return text
+
+
+def read_preset(path: Path) -> PresetFile:
+    """Parse one preset file (its name must match the file name)."""
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise PresetError(f"cannot read ({exc.strerror or exc})", where=str(path)) from None
+    return parse_preset(data, where=str(path), stem=path.name.removesuffix(SUFFIX))

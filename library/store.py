@@ -24,8 +24,6 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 
-from filelock import FileLock, Timeout
-
 from . import files
 from .errors import LibraryError
 
@@ -37,6 +35,8 @@ LOCK_TIMEOUT_S = 60.0
 @contextlib.contextmanager
 def locked(folder: Path) -> Iterator[None]:
     """Hold the library's lock; an unwritable folder or a stuck lock is a LibraryError."""
+    from filelock import FileLock, Timeout  # only writes lock: reading pays nothing for it
+
     lock = FileLock(str(folder / LOCK_NAME), timeout=LOCK_TIMEOUT_S)
     try:
         lock.acquire()

@@ -9,7 +9,8 @@ and its values checked against the parameter's range. Pixels come from the one r
 **Channels.** ``channel`` names one channel (``"r"``, ``"a"``, ``"Y"``, ``"diffuse.R"``, an
 index) or a run of them (``"rgb"``, ``"xyz"``, consecutive in the file). A colour takes
 three channels: by default the file's first three, or one channel repeated as grey when
-the file (or ``channel``) gives one. A scalar takes one: by default the first.
+the file (or ``channel``) gives one; a file of two channels (grey and alpha, or two data
+channels) must name the one it means. A scalar takes one: by default the first.
 
 **Tiles.** A UDIM set is the files matching the pattern; every tile must agree on how its
 pixels are stored (all integer or all float, one channel layout): a set mixing a 16-bit
@@ -143,6 +144,11 @@ class ParamTexture:
         """(first channel, how many to read) for ``tex.channel`` in ``probe``'s file."""
         names, channel = probe.channel_names, self.tex.channel
         if channel is None:
+            if self.count == 3 and len(names) == 2:  # grey and alpha? two data channels?
+                raise self.error(
+                    f"{probe.path} has 2 channels ({', '.join(names)}); a colour takes 3, or 1 "
+                    f"as grey: say which, e.g. channel = {names[0]!r}"
+                )
             return 0, 3 if self.count == 3 and len(names) >= 3 else 1
         single = channel_index(channel, names)
         if single is not None:

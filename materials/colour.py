@@ -57,7 +57,7 @@ from typing import Any
 import numpy as np
 import PyOpenColorIO as ocio
 
-from .errors import LookdevError
+from .errors import LookdevError, argument
 
 __all__ = [
     "DEFAULT_CONFIG",
@@ -181,11 +181,31 @@ def use(
     _load(new.config_name)  # fail here, with the name, not at the first conversion
     _current.append(new)
     try:
-        canonical(WORKING_SPACES.get(new.working_space, new.working_space))
+        _scene_linear(canonical(WORKING_SPACES.get(new.working_space, new.working_space)))
         _view_names()
         yield new
     finally:
         _current.pop()
+
+
+def _scene_linear(name: str) -> str:
+    """``name`` if it can be a working space: scene-referred, linear, not data.
+
+    Parameters are blended, rendered and exported as light, so a display space
+    (``sRGB - Display``), an encoded one (``sRGB Encoded Rec.709``, ACEScct) or ``Raw``
+    would make every sum wrong. A config that declares no encoding is trusted.
+    """
+    cs = config().getColorSpace(name)
+    display = cs.getReferenceSpaceType() == ocio.REFERENCE_SPACE_DISPLAY
+    encoding = cs.getEncoding()
+    if display or cs.isData() or encoding not in ("", "scene-linear"):
+        kind = "display-referred" if display else "data" if cs.isData() else f"{encoding}-encoded"
+        raise ColourError(
+            f"{name!r} is {kind}, not a scene-linear working space (e.g. lin_rec709, acescg; "
+            "`lookdev colour spaces` lists them)",
+            field=argument("working_space"),
+        )
+    return name
 
 
 def _pick(given: str | None, old: str, same_config: bool) -> str:
@@ -414,7 +434,13 @@ def _view_names() -> tuple[str, str, tuple[str, ...]]:
     disp = _one_of("display", s.display, displays(), "views") if s.display else displays()[0]
     known = list(config().getViews(disp))
     v = _one_of("view", s.view, known, "views", f" of {disp!r}") if s.view else known[0]
-    names = tuple(n.strip() for n in s.look.split(",") if n.strip())
+    names = tuple(n.strip() for n in s.look.split(",")) if s.look.strip() else ()
+    if "" in names:
+        raise ColourError(
+            f"look {s.look!r} has an empty name; give look names separated by commas "
+            "(`lookdev colour views` lists them)",
+            field=argument("look"),
+        )
     return disp, v, tuple(_one_of("look", n, looks(), "views") for n in names)
 
 

@@ -8,9 +8,30 @@ allowed, so the CLI can print it as it is and exit with code 2.
 from __future__ import annotations
 
 import difflib
-from typing import Any, TypeVar
+import re
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any, TypeVar
 
-from pydantic import BaseModel, ValidationError
+if TYPE_CHECKING:  # pydantic costs a command line a tenth of a second: only for types here
+    from pydantic import BaseModel, ValidationError
+
+
+_ARGUMENT = re.compile("\ue000([A-Za-z_][A-Za-z0-9_]*)\ue001")
+
+
+def argument(name: str) -> str:
+    """``name``, a Python argument of the call that failed, marked for its reader.
+
+    A message says ``argument("noise")`` where it names what the caller passed:
+    ``str(error)`` (what Python shows) reads ``noise``, and the CLI, which knows which
+    option fed which argument, reads ``--noise`` (:meth:`LookdevError.one_line` with
+    ``options``). One message, two readers; nothing is written twice.
+
+    >>> err = LookdevError("0 is out of range", field=argument("max_spp"))
+    >>> str(err), err.one_line({"max_spp": "--max-spp"})
+    ('max_spp: 0 is out of range', '--max-spp: 0 is out of range')
+    """
+    return f"\ue000{name}\ue001"
 
 
 class LookdevError(Exception):
@@ -26,9 +47,18 @@ class LookdevError(Exception):
         self.field = field
         super().__init__(self.one_line())
 
-    def one_line(self) -> str:
+    def one_line(self, options: Mapping[str, str] | None = None) -> str:
+        """The error as one line. Arguments (:func:`argument`) read as Python names, or,
+        given ``options`` (argument → the option that feeds it), as those options; an
+        argument no option feeds reads ``--its-name``."""
         parts = [p for p in (self.where, self.field) if p]
-        return ": ".join([*parts, self.message])
+        text = ": ".join([*parts, self.message])
+        if options is None:
+            return _ARGUMENT.sub(r"\1", text)
+        return _ARGUMENT.sub(lambda m: options.get(m[1], "--" + m[1].replace("_", "-")), text)
+
+    def __str__(self) -> str:
+        return self.one_line()
 
 
 class ParameterError(LookdevError, ValueError):
@@ -36,7 +66,7 @@ class ParameterError(LookdevError, ValueError):
 
 
 E = TypeVar("E", bound=LookdevError)
-M = TypeVar("M", bound=BaseModel)
+M = TypeVar("M", bound="BaseModel")
 
 
 # -- pydantic's ValidationError as one line --------------------------------------------------
@@ -66,7 +96,7 @@ def one_line(
     value and its allowed range, that a field is unknown (and, at the top of a registered
     schema, which are allowed), missing, not finite, or what the validator said.
 
-    >>> from pydantic import Field
+    >>> from pydantic import BaseModel, Field, ValidationError
     >>> class P(BaseModel):
     ...     spp: int = Field(64, ge=1, le=4096)
     >>> try:

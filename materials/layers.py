@@ -34,6 +34,29 @@ from .params import Params, register_schema
 UV_MAX = 4096.0
 """Ceiling of ``|uv_scale|`` and ``|uv_offset|`` of a texture (repeats of the UV square)."""
 UV = Annotated[float, Field(ge=-UV_MAX, le=UV_MAX)]
+
+
+def check_texture_reference(path: str, uv_scale: tuple[float, float]) -> None:
+    """What every texture reference must be, as a ``ValueError`` (pydantic's one line):
+    a file name an operating system can open (no NUL byte), and a UV scale that spreads
+    the image over the surface (a zero scale would show one texel everywhere).
+
+    >>> try:
+    ...     check_texture_reference("wood.png", (0.0, 1.0))
+    ... except ValueError as exc:
+    ...     print(str(exc)[:35])
+    uv_scale [0.0, 1.0] is zero along u
+    """
+    if "\x00" in path:
+        raise ValueError(f"texture path {path!r} holds a NUL byte; no file can have that name")
+    for axis, s in zip("uv", uv_scale, strict=True):
+        if s == 0:
+            raise ValueError(
+                f"uv_scale {list(uv_scale)} is zero along {axis}; a texture needs a nonzero "
+                "scale (a constant is one value everywhere)"
+            )
+
+
 SEED_MAX = 2**32 - 1
 """Largest noise seed: the lattice hash is 32-bit."""
 RAMP_MAX = 1024.0
@@ -87,6 +110,7 @@ class TextureMask(Params):
 
     @model_validator(mode="after")
     def _channel_not_negative(self) -> TextureMask:
+        check_texture_reference(str(self.path), self.uv_scale)
         if isinstance(self.channel, int) and self.channel < 0:
             raise ValueError(f"channel {self.channel} is negative; use an index from 0 or a name")
         return self

@@ -31,6 +31,7 @@ from . import disney, measured, pixar, sheen
 from .arrays import NumpyOps
 from .bsdf import Model
 from .errors import LookdevError
+from .model_names import PRESET_MODELS
 
 __all__ = [
     "LAYERED",
@@ -51,8 +52,6 @@ MODELS: dict[str, Model] = {
 """Every model by name; each renders in Mitsuba as the plugin ``lookdev_<name>``. A new
 model adds itself here (tests add toy models the same way)."""
 
-PRESET_MODELS: tuple[str, ...] = ("disney", "pixar")
-"""Models a preset file may name (besides ``layered``, a stack of them)."""
 
 LAYERED: Mapping[str, str] = types.MappingProxyType({"pixar": "pixar_layered"})
 """Preset model → the model that takes its composited layer stack where blending does not

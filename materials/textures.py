@@ -28,7 +28,7 @@ from annotated_types import Ge, Le
 from pydantic import Field, model_validator
 
 from . import colour
-from .layers import UV, Wrap
+from .layers import UV, Wrap, check_texture_reference
 from .params import Params
 
 __all__ = [
@@ -77,6 +77,7 @@ class TextureInput(Params):
 
     @model_validator(mode="after")
     def _range_not_empty(self) -> TextureInput:
+        check_texture_reference(self.texture, self.uv_scale)
         if self.range is not None and self.range[0] == self.range[1]:
             raise ValueError(f"range {list(self.range)} is empty; give two different values")
         if isinstance(self.channel, int) and self.channel < 0:

@@ -34,7 +34,7 @@ import numpy as np  # noqa: E402
 from lookdev.library import files  # noqa: E402
 from lookdev.materials.bsdf import Model, evaluate  # noqa: E402
 from lookdev.materials.colour import luminance  # noqa: E402
-from lookdev.materials.errors import LookdevError  # noqa: E402
+from lookdev.materials.errors import LookdevError, argument  # noqa: E402
 from lookdev.pipeline.blend.result import BlendedMaterial  # noqa: E402
 from lookdev.pipeline.proof import tonemap  # noqa: E402
 
@@ -313,11 +313,13 @@ def varied(hubs: Sequence[BlendedMaterial], field: str, values: Sequence[float])
     out = []
     for hub in hubs:
         if hub.maps or hub.normal_map is not None:
-            raise PlotError(f"{hub.name} varies across its surface; --vary takes uniform presets")
+            raise PlotError(
+                f"{hub.name} varies across its surface; {argument('vary')} takes uniform presets"
+            )
         if field not in type(hub.params).model_fields:
             known = ", ".join(type(hub.params).model_fields)
             raise PlotError(
-                f"{hub.name} has no parameter {field!r}; known: {known}", field="--vary"
+                f"{hub.name} has no parameter {field!r}; known: {known}", field=argument("vary")
             )
         switch = type(hub.params).model_fields[field].annotation is bool
         for value in values:
@@ -327,7 +329,7 @@ def varied(hubs: Sequence[BlendedMaterial], field: str, values: Sequence[float])
             try:
                 params = hub.params.replace(**{field: v})
             except LookdevError as exc:
-                raise PlotError(str(exc), where=hub.name, field="--vary") from None
+                raise PlotError(str(exc), where=hub.name, field=argument("vary")) from None
             out.append(BlendedMaterial.of_params(params, name=f"{hub.name} {field}={label}"))
     return out
 

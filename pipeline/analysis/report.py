@@ -313,8 +313,7 @@ def render_page(
         f"<title>lookdev proof: {esc(batch_dir.name)}</title>",
         f'<link rel="stylesheet" href="{REPORT_DIR}/review.css"></head><body>',
         f"<h1>lookdev proof — {esc(batch_dir.name)}</h1>",
-        f"<p>{len(materials)} material(s), {len(entries)} proof(s) under "
-        f"{len(data['ibls'])} IBL(s): " + ", ".join(esc(m) for m in materials) + ".</p>",
+        f"<p>{esc(summary(materials, data['ibls'], len(entries)))}</p>",
         "<noscript><p>The players and the comparison need JavaScript; the table and the "
         "contact sheets below do not.</p></noscript>",
         '<main id="review"></main>',
@@ -337,6 +336,27 @@ def render_page(
     parts.append(f'<script src="{REPORT_DIR}/review.js"></script>')
     parts.append("</body></html>")
     return "\n".join(parts)
+
+
+def _count(n: int, word: str) -> str:
+    return f"{n} {word}" + ("" if n == 1 else "s")
+
+
+def summary(materials: list[str], ibls: list[str], proofs: int) -> str:
+    """The page's first line: what was proofed under what, by name.
+
+    >>> summary(["gold", "jade"], ["studio", "sky"], 4)
+    '2 materials, each under 2 IBLs (4 proofs). Materials: gold, jade. IBLs: studio, sky.'
+    >>> summary(["gold"], ["studio", "sky"], 1)
+    '1 proof of 1 material under 2 IBLs. Materials: gold. IBLs: studio, sky.'
+    """
+    if proofs == len(materials) * len(ibls):
+        head = f"{_count(len(materials), 'material')}, each under {_count(len(ibls), 'IBL')}"
+        head += f" ({_count(proofs, 'proof')})"
+    else:  # a batch re-proofed in part: not every material under every IBL
+        head = f"{_count(proofs, 'proof')} of {_count(len(materials), 'material')} under "
+        head += _count(len(ibls), "IBL")
+    return f"{head}. Materials: {', '.join(materials)}. IBLs: {', '.join(ibls)}."
 
 
 def write_report(

@@ -34,18 +34,44 @@
     return Number.isInteger(v) ? String(v) : String(Number(v.toPrecision(digits || 3)));
   }
 
+  function percent(v) {
+    return v === null || v === undefined ? null : num(100 * v, 2) + " %";
+  }
+
+  /* A frame in words a look-dev artist reads: did it converge, how noisy, how long. */
   function statsText(f) {
+    const noise = percent(f.noise), target = percent(f.noise_target);
+    const samples = f.spp === null ? null : num(f.spp) + " samples per pixel";
+    const time = f.time_s === null ? null : num(f.time_s) + " s";
+    const noiseText = noise === null ? "noise not recorded" : "noise " + noise +
+      (target === null ? "" : " (target " + target + ")");
+    let head;
+    if (f.stop === "target") head = "Converged: " + noiseText;
+    else if (f.stop === "max_spp") head = "Not converged: " + noiseText + " at the sample cap";
+    else if (f.stop === "time_budget") head = "Not converged: " + noiseText + " when the time budget ran out";
+    else if (f.stop === "spp") head = "Fixed sample count (no noise target): " + noiseText;
+    else head = noiseText;
+    return [head, samples, time].filter(Boolean).join(", ") + ".";
+  }
+
+  /* The numbers behind the caption, for whoever asks (inside "details"). */
+  function detailText(f) {
     const parts = [];
-    parts.push(f.spp === null ? "spp –" : num(f.spp) + " spp");
-    let noise = "noise " + num(f.noise);
-    if (f.noise_target !== null) noise += " (target " + num(f.noise_target) + ")";
-    parts.push(noise);
-    parts.push(f.time_s === null ? "time –" : num(f.time_s) + " s");
-    if (f.stop !== null) parts.push("stopped: " + f.stop);
     if (f.firefly_share !== null)
-      parts.push("hottest 0.1 %: " + num(100 * f.firefly_share, 2) + " % of error");
-    parts.push(f.clamp === null ? "no clamp" : "clamped at " + num(f.clamp));
-    return parts.join(" · ");
+      parts.push("the brightest 0.1 % of pixels hold " + num(100 * f.firefly_share, 2) +
+        " % of the remaining error" + (f.firefly_share > 0.5 ? " (fireflies)" : ""));
+    parts.push(f.clamp === null ? "radiance not clamped" : "radiance clamped at " + num(f.clamp) + " (biased)");
+    if (f.stop !== null) parts.push("stopped by: " + f.stop);
+    return parts.join("; ");
+  }
+
+  /* What a turntable shows: how many frames turn the element, how many the light. */
+  function turnText(frames) {
+    const count = (kind) => frames.filter((f) => f.kind === kind).length;
+    const element = count("element"), light = count("light");
+    if (!element && !light) return frames.length + " frames";
+    return [element ? element + " frames turning the object" : null,
+      light ? light + " turning the light" : null].filter(Boolean).join(", ");
   }
 
   /* Frames are fetched once by a cached Image and put on screen only when loaded: the
@@ -54,6 +80,7 @@
   const cache = new Map();
   function setFrame(img, src) {
     img.dataset.want = src;
+    if (img.dataset.lazy === "wait") return; // not scrolled to yet: nothing fetched
     if (img.getAttribute("src") === src) return;
     let pre = cache.get(src);
     if (!pre) {
@@ -72,6 +99,23 @@
   function source(f) {
     const denoised = state.denoised && f.denoised;
     return { src: denoised ? f.denoised : f.raw, which: denoised ? "denoised" : "raw" };
+  }
+
+  /* Players fetch their frames when first scrolled near the view: a batch of many proofs
+   * opens at once and loads only what is looked at. */
+  const watcher = "IntersectionObserver" in window
+    ? new IntersectionObserver((seen) => {
+      for (const e of seen) {
+        if (!e.isIntersecting) continue;
+        watcher.unobserve(e.target);
+        e.target.lookdevSeen();
+      }
+    }, { rootMargin: "200px 0px" })
+    : null;
+  function whenSeen(node, load) {
+    if (watcher === null) { load(); return; }
+    node.lookdevSeen = load;
+    watcher.observe(node);
   }
 
   /* A clock stepping a view's frame at FPS while playing. */
@@ -108,13 +152,27 @@
     return out;
   }
 
+  /* A frame's image, its shape held before it is fetched, so the page does not move as
+   * frames arrive (and players further down stay unfetched until scrolled to). */
+  function frameImage(proof, attrs) {
+    return el("img", { class: "frame", ...attrs });
+  }
+  function stage(proof, img, which) {
+    const box = el("div", { class: "stage" }, img, which);
+    const [w, h] = proof.size || [2, 1];
+    box.style.aspectRatio = w + " / " + h;
+    return box;
+  }
+
   /* One proof's turntable player. */
   function player(proof) {
     const frames = proof.frames;
-    const img = el("img", { class: "frame", alt: proof.material + " × " + proof.ibl });
+    const img = frameImage(proof, { alt: proof.material + " under " + proof.ibl,
+      "data-lazy": "wait" });
     const which = el("span", { class: "which" });
     const label = el("span", { class: "label" });
     const stats = el("div", { class: "stats" });
+    const detail = el("div", { class: "detail" });
     const scrub = el("input", {
       type: "range", class: "scrub", min: 0, max: Math.max(0, frames.length - 1), value: 0,
       "aria-label": "frame of " + proof.id,
@@ -150,6 +208,7 @@
         scrub.value = String(p.index);
         label.textContent = f.label + "  (" + (p.index + 1) + "/" + frames.length + ")";
         stats.textContent = statsText(f);
+        detail.textContent = detailText(f);
         rows.forEach((r, k) => r.classList.toggle("current", k === p.index));
       },
       redraw() { p.show(p.index); },
@@ -161,15 +220,20 @@
     scrub.addEventListener("input", () => { p.clock.pause(); p.show(Number(scrub.value)); });
     loop.addEventListener("change", () => p.show((segs[loop.value] || segs.all)[0]));
     const info = [proof.filter ? "pixel filter " + proof.filter : "pixel filter not recorded",
-      proof.rig ? "rig " + proof.rig : null, proof.variant].filter(Boolean).join(" · ");
+      proof.rig ? "calibration rig: " + proof.rig : null,
+      proof.variant ? "Mitsuba variant " + proof.variant : null].filter(Boolean).join("; ");
     p.node = el("div", { class: "player", "data-proof": proof.id },
-      el("h3", {}, proof.ibl),
-      el("div", { class: "stage" }, img, which),
+      el("h3", {}, proof.material + " under " + proof.ibl),
+      el("div", { class: "what" }, "Turntable: " + turnText(frames)),
+      stage(proof, img, which),
       el("div", { class: "controls" }, play, scrub, loop, label),
-      stats, el("div", { class: "meta" }, info), table);
+      stats,
+      el("details", { class: "more" }, el("summary", {}, "details"),
+        detail, el("div", { class: "meta" }, info), table));
     views.push(p);
     if (!frames.length) p.node.append(el("p", { class: "none" }, "no frames on disk"));
     p.show(0);
+    whenSeen(p.node, () => { delete img.dataset.lazy; p.redraw(); });
     return p;
   }
 
@@ -199,12 +263,12 @@
         const proofs = data.proofs.filter((p) =>
           mode.value === "ibl" ? p.ibl === pick.value : p.material === pick.value);
         cells = proofs.map((proof) => {
-          const img = el("img", { class: "frame", alt: proof.id });
+          const img = frameImage(proof, { alt: proof.id });
           const stats = el("div", { class: "stats" });
           const which = el("span", { class: "which" });
           const caption = mode.value === "ibl" ? proof.material : proof.ibl;
           const node = el("figure", { "data-proof": proof.id },
-            el("div", { class: "stage" }, img, which), el("figcaption", {}, caption), stats);
+            stage(proof, img, which), el("figcaption", {}, caption), stats);
           return { proof, img, stats, which, node };
         });
         grid.replaceChildren(...cells.map((x) => x.node));
@@ -284,11 +348,37 @@
     return box;
   }
 
+  const materialNames = [...new Set(data.proofs.map((p) => p.material))];
+  const sectionId = (i) => "material-" + i; // names are user input: ids are indices
+
+  /* A table of contents of the materials, and a filter by name over it and the page. */
+  function contents() {
+    const filter = el("input", { type: "search", id: "filter", placeholder: "filter materials",
+      "aria-label": "filter materials by name" });
+    const items = materialNames.map((name, i) =>
+      el("li", { "data-material": name }, el("a", { href: "#" + sectionId(i) }, name)));
+    const count = el("span", { class: "note", id: "filter-count" });
+    const apply = () => {
+      const want = filter.value.trim().toLowerCase();
+      let shown = 0;
+      materialNames.forEach((name, i) => {
+        const hit = !want || name.toLowerCase().includes(want);
+        items[i].hidden = !hit;
+        document.getElementById(sectionId(i)).hidden = !hit;
+        shown += hit;
+      });
+      count.textContent = shown + " of " + materialNames.length + " materials";
+    };
+    filter.addEventListener("input", apply);
+    const nav = el("nav", { id: "toc", "aria-label": "materials" },
+      el("div", { class: "controls" }, filter, count), el("ol", {}, ...items));
+    return { node: nav, apply };
+  }
+
   function materials() {
     const root = el("section", { id: "materials" });
-    const names = [...new Set(data.proofs.map((p) => p.material))];
-    for (const name of names) {
-      const section = el("section", { class: "material", "data-material": name },
+    for (const [i, name] of materialNames.entries()) {
+      const section = el("section", { class: "material", id: sectionId(i), "data-material": name },
         el("h2", {}, name), materialInfo(name));
       const plots = data.plots[name];
       if (plots) section.append(el("div", { class: "plots" },
@@ -317,5 +407,7 @@
   }
 
   const main = document.getElementById("review");
-  main.append(toolbar(), comparison().node, materials());
+  const toc = contents();
+  main.append(toolbar(), toc.node, comparison().node, materials());
+  toc.apply();
 })();

@@ -129,8 +129,18 @@ def proof_data(entry: Any, web: Any, base: Path) -> dict[str, Any]:
         "rig": (data.get("rig") or {}).get("rig") if isinstance(data.get("rig"), dict) else None,
         "variant": data.get("variant"),
         "orientation": data.get("ibl_orientation"),
+        "size": _size(settings.get("resolution")),
         "frames": frames,
     }
+
+
+def _size(value: Any) -> list[int] | None:
+    """A frame's [width, height] from the proof's settings (the page reserves the space
+    before the frame is fetched), or None."""
+    if isinstance(value, list | tuple) and len(value) == 2:
+        if all(isinstance(v, int) and v > 0 for v in value):
+            return [int(v) for v in value]
+    return None
 
 
 def page_data(

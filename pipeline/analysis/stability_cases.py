@@ -49,7 +49,7 @@ import numpy as np
 
 from lookdev.materials import registry
 from lookdev.materials.bsdf import Model
-from lookdev.materials.errors import LookdevError
+from lookdev.materials.errors import LookdevError, argument
 from lookdev.materials.params import SCATTER_DISTANCE_MAX, SCATTER_DISTANCE_MIN
 
 ALLOWANCE = {"disney": 0.79, "sheen": 0.002, "pixar": 0.0, "pixar_layered": 0.0}
@@ -166,7 +166,8 @@ def models_named(names: list[str] | None = None) -> dict[str, Model]:
     unknown = [n for n in wanted if n not in registry.MODELS]
     if unknown:
         raise CheckError(
-            f"unknown model {unknown[0]!r}; known: {', '.join(registry.MODELS)}", field="--model"
+            f"unknown model {unknown[0]!r}; known: {', '.join(registry.MODELS)}",
+            field=argument("models"),
         )
     return {name: registry.MODELS[name] for name in wanted}
 

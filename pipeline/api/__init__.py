@@ -44,6 +44,7 @@ Heavy dependencies (Mitsuba, usd-core, matplotlib) are imported by the functions
 need them, never by ``import lookdev``.
 """
 
+from lookdev.library.display import register_swatch
 from lookdev.materials.colour import use as colour_settings
 
 from .materials import (
@@ -75,6 +76,7 @@ from .outputs import (
     proof,
     representative_presets,
 )
+from .preview import swatch_png
 
 __all__ = [
     "EVALUATE_RESOLUTION",
@@ -104,3 +106,6 @@ __all__ = [
     "representative_presets",
     "sample",
 ]
+
+# A material shown in a notebook draws its swatch with the pipeline's numpy sphere.
+register_swatch(swatch_png)

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from lookdev.materials.errors import LookdevError, check_range
+from lookdev.materials.errors import LookdevError, argument, check_range
 
 from .materials import PathLike, _materials, hub, library_for
 
@@ -157,7 +157,7 @@ def export_usd(
         if context not in CONTEXTS:
             raise ExportError(
                 f"unknown render context {context!r}; allowed: {', '.join(CONTEXTS)}",
-                field="--context",
+                field=argument("contexts"),
             )
     if isinstance(materials, str | os.PathLike) or hasattr(materials, "model"):
         materials = [materials]
@@ -313,11 +313,13 @@ def export_mitsuba(
     from lookdev.pipeline.export.mitsuba.scene import files_of, uses_our_plugins
 
     if len(tuple(resolution)) != 2:
-        raise MitsubaExportError(f"{tuple(resolution)} is not W H", field="--resolution")
+        raise MitsubaExportError(f"{tuple(resolution)} is not W H", field=argument("resolution"))
     for side in resolution:
-        check_range(side, 1, FILM_MAX_SIDE, field="--resolution", error=MitsubaExportError)
-    check_range(spp, 1, 2**20, field="--spp", error=MitsubaExportError)
-    check_range(ibl_rotation, -360.0, 360.0, field="--ibl-rotation", error=MitsubaExportError)
+        check_range(side, 1, FILM_MAX_SIDE, field=argument("resolution"), error=MitsubaExportError)
+    check_range(spp, 1, 2**20, field=argument("spp"), error=MitsubaExportError)
+    check_range(
+        ibl_rotation, -360.0, 360.0, field=argument("ibl_rotation"), error=MitsubaExportError
+    )
     material = hub(material, map_resolution, library)
     env = _in_working_space(_environment_file(ibl), Path(path))
     scene = export_scene(
@@ -431,8 +433,9 @@ def proof(
         The calibrated rig beside the material (:mod:`lookdev.pipeline.proof.rig`):
         ``full`` (chrome ball, 18 % grey ball, ColorChecker chart), ``balls``, ``none``.
     jobs
-        Local worker processes (default 1: each renders on every core). They are spawned,
-        so a script calling :func:`proof` does so under ``if __name__ == "__main__":``.
+        Local worker processes (default 1: each renders on every core). They are spawned
+        without re-running the caller's script (:mod:`lookdev.pipeline.proof.spawn`), so a
+        plain script needs no ``if __name__ == "__main__":`` guard.
     scheduler
         A Dask scheduler address (``tcp://host:8786``): run the proofs on that cluster.
     executor
@@ -518,7 +521,7 @@ def proof(
     loaded = [hub(m, batch.MAP_RESOLUTION, lib) for m in chosen]
     if context not in (None, "source", "universal"):
         raise batch.ProofError(
-            f"unknown context {context!r}; allowed: universal", field="--context"
+            f"unknown context {context!r}; allowed: universal", field=argument("context")
         )
     if context == "universal":
         from lookdev.pipeline.export.usd.fidelity import preview_hub
@@ -617,8 +620,9 @@ def plot(
         raise plots.PlotError(f"unknown view {view!r}; allowed {', '.join(PLOT_VIEWS)}")
     from lookdev.pipeline.proof.tonemap import EXPOSURE_MAX
 
-    check_range(exposure, -EXPOSURE_MAX, EXPOSURE_MAX, field="--exposure", error=plots.PlotError)
-    check_range(resolution, 8, 1024, field="--resolution", error=plots.PlotError)
+    limit = EXPOSURE_MAX
+    check_range(exposure, -limit, limit, field=argument("exposure"), error=plots.PlotError)
+    check_range(resolution, 8, 1024, field=argument("resolution"), error=plots.PlotError)
     lib = library_for(library)
     if isinstance(materials, str | os.PathLike):
         materials = [materials]
@@ -630,7 +634,10 @@ def plot(
     environment = None
     if ibl is not None:
         if view != "sphere":
-            raise plots.PlotError("--ibl only applies to --view sphere", field="--ibl")
+            raise plots.PlotError(
+                f"{argument('ibl')} only applies to {argument('view')} sphere",
+                field=argument("ibl"),
+            )
         environment = plots.load_environment(ibl)
     fig = plots.figure(
         hubs,

@@ -1,25 +1,45 @@
 """The ``lookdev`` command line (Typer).
 
-Commands are verbs; each group lives in its own module beside this one and is added in
-:func:`_register`. Bad input anywhere ends in one line on stderr and exit code 2
-(:doc:`/design`, Errors): commands raise :class:`~lookdev.materials.errors.LookdevError` and
-:func:`main` turns it into that line.
+Commands are verbs; each group lives in its own module beside this one, listed in
+:data:`COMMANDS` and imported only when it runs (:mod:`.lazy`). Bad input anywhere ends
+in one line on stderr and exit code 2 (:doc:`/design`, Errors): commands raise
+:class:`~lookdev.materials.errors.LookdevError` and :func:`main` turns it into that line.
 """
 
 from __future__ import annotations
 
 import os
 import sys
-from importlib import metadata
+import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 import typer
 
 from lookdev.materials.errors import LookdevError
 
-from .common import quiet_numerics
+from .lazy import Lazy, lazy_group
+
+COMMANDS = {
+    "presets": Lazy(".presets:app", "Browse, show, create, edit and validate presets."),
+    "plot": Lazy(".plot:plot", "Draw presets as one BRDF-explorer view, to an image."),
+    "fit": Lazy(".fit:fit", "Fit a Disney or Pixar preset to a measured BRDF (MBSDF, MERL)."),
+    "blend": Lazy(".blend:blend", "Blend a preset's layers into EXR maps and JSON."),
+    "export": Lazy(".export:app", "Write presets for other tools: Mitsuba scenes, USD."),
+    "import": Lazy(".export_usd:import_app", "Read materials written by other tools back."),
+    "validate": Lazy(".export_usd:validate_app", "Check exported files as their readers will."),
+    "proof": Lazy(".proof:proof", "Render turntable proofs: every preset under every IBL."),
+    "check": Lazy(".check:check", "Sweep every model over its stiff and extreme cases."),
+    "colour": Lazy(".colour:app", "List the OCIO config's colour spaces, views and looks."),
+    "bench": Lazy(".bench:app", "Measure performance targets against baselines run alongside."),
+}
+"""The commands of ``lookdev``: each module is imported only when its command runs."""
 
 app = typer.Typer(
     name="lookdev",
+    cls=lazy_group(COMMANDS),
+    # markdown: help paragraphs reflow to the terminal (rich mode keeps every line break)
+    rich_markup_mode="markdown",
     help="Author, blend, export and proof Disney and Pixar materials.\n\n"
     "Colour is managed by OpenColorIO. Colour options go before the command and hold for "
     "all of it: `lookdev --working-space acescg --view Un-tone-mapped proof gold`. "
@@ -32,6 +52,8 @@ app = typer.Typer(
 
 def _version(value: bool) -> None:
     if value:
+        from importlib import metadata
+
         typer.echo(f"lookdev {metadata.version('lookdev')}")
         raise typer.Exit()
 
@@ -108,35 +130,17 @@ def _root(
         ctx.with_resource(colour.use(**given))
 
 
-def _register() -> None:
-    from . import bench, check, export, export_usd, fit, plot, presets, proof
-    from . import blend as blend_cli
-    from . import colour as colour_cli
+@contextmanager
+def quiet_numerics() -> Iterator[None]:
+    """numpy's ``RuntimeWarning`` (overflow, invalid value, divide by zero) stays off stderr.
 
-    app.add_typer(bench.app, name="bench")
-    app.command("check")(check.check)
-    app.command("blend")(blend_cli.blend)
-    app.add_typer(export.app, name="export")
-    export.app.command("usd")(export_usd.export_usd)
-    app.add_typer(export_usd.import_app, name="import")
-    app.add_typer(export_usd.validate_app, name="validate")
-    app.add_typer(presets.app, name="presets")
-    app.command("plot")(plot.plot)
-    app.command("fit")(fit.fit)
-    app.command("proof")(proof.proof)
-    app.add_typer(colour_cli.app, name="colour")
-    _reflow_help(app)
-
-
-def _reflow_help(typer_app: typer.Typer) -> None:
-    # Rich mode keeps every docstring line break, so help wraps raggedly in narrow
-    # terminals; markdown mode reflows paragraphs and keeps blank-line breaks.
-    typer_app.rich_markup_mode = "markdown"
-    for group in typer_app.registered_groups:
-        _reflow_help(group.typer_instance)
-
-
-_register()
+    Parameters are range-checked at load so that no derived quantity overflows; the
+    stability sweep (``lookdev check``) reports non-finite values as findings. A warning
+    on stderr in between would only break the one-line rule.
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        yield
 
 
 INTERRUPTED = "interrupted: run the same command again to resume"
@@ -167,7 +171,7 @@ def main(argv: list[str] | None = None) -> None:
         error(exc.format_message())
         code = 2
     except LookdevError as exc:
-        error(str(exc))
+        error(exc.one_line(_options(exc)))
         code = 2
     except typer.Abort:  # a prompt interrupted (Ctrl-C / EOF)
         code = 130
@@ -180,6 +184,31 @@ def main(argv: list[str] | None = None) -> None:
         _line(INTERRUPTED)
     if isinstance(code, int) and code:
         sys.exit(code)
+
+
+def _options(exc: BaseException) -> dict[str, str]:
+    """Argument name → the option (or ``ARGUMENT``) of the command that raised ``exc``,
+    its groups' too: how :meth:`LookdevError.one_line` names a Python argument here.
+
+    The command is read from the traceback (the innermost frame holding a Click context),
+    so no command registers anything: the API names ``noise``, the user reads ``--noise``.
+    """
+    context_type = type.mro(typer.Context)[1]  # Click's Context, which Typer's derives
+    ctx, tb = None, exc.__traceback__
+    while tb is not None:
+        found = tb.tb_frame.f_locals.get("ctx")
+        ctx = found if isinstance(found, context_type) else ctx
+        tb = tb.tb_next
+    names: dict[str, str] = {}
+    while ctx is not None:
+        for param in ctx.command.params:
+            if param.name and param.opts:
+                opts = [o for o in param.opts if o.startswith("--")] or param.opts
+                is_option = opts[0].startswith("-")
+                label = max(opts, key=len) if is_option else (param.metavar or param.name.upper())
+                names.setdefault(param.name, label)
+        ctx = ctx.parent
+    return names
 
 
 def _click_exceptions():

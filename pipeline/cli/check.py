@@ -19,7 +19,7 @@ _MODEL_HELP = f"Only this model (repeatable): {', '.join(registry.MODELS)}."
 
 
 def check(
-    model: Annotated[
+    models: Annotated[
         list[str] | None,
         typer.Option("--model", "-m", metavar="NAME", help=_MODEL_HELP, show_default=False),
     ] = None,
@@ -57,7 +57,7 @@ def check(
         def advance(done: int, total: int, name: str, label: str) -> None:
             bar.update(task, completed=done, total=total, model=name, case=label)
 
-        result = api.check(model, progress=advance)
+        result = api.check(models, progress=advance)
     if json_out:
         print_json(result.to_json())
     else:

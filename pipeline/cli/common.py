@@ -4,29 +4,18 @@ from __future__ import annotations
 
 import json
 import sys
-import warnings
-from collections.abc import Iterator
-from contextlib import contextmanager
-from typing import Any
+from typing import Annotated, Any
 
+import typer
 from rich.console import Console
 from rich.table import Table
 
 console = Console()
 err_console = Console(stderr=True)
 
-
-@contextmanager
-def quiet_numerics() -> Iterator[None]:
-    """numpy's ``RuntimeWarning`` (overflow, invalid value, divide by zero) stays off stderr.
-
-    Parameters are range-checked at load so that no derived quantity overflows; the
-    stability sweep (``lookdev check``) reports non-finite values as findings. A warning
-    on stderr in between would only break the one-line rule.
-    """
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        yield
+JsonOut = Annotated[bool, typer.Option("--json", help="Print one JSON object.")]
+"""The ``--json`` flag of every command that prints figures."""
+Repeat = Annotated[int, typer.Option(min=1, max=20, help="Timed runs; the best counts.")]
 
 
 def print_json(obj: Any) -> None:

@@ -8,8 +8,12 @@ from typing import Annotated
 import typer
 
 from .common import console, print_json
+from .lazy import Lazy, lazy_group
 
 app = typer.Typer(
+    cls=lazy_group(
+        {"usd": Lazy(".export_usd:export_usd", "Write presets as UsdShade materials for DCCs.")}
+    ),
     help="Write presets for other tools: Mitsuba scenes, USD shading networks.",
     no_args_is_help=True,
 )

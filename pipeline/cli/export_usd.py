@@ -41,7 +41,7 @@ def export_usd(
         Path,
         typer.Option("--output", "-o", help="USD file: .usda, .usdc, .usd, or .usdz (packaged)."),
     ] = Path("materials.usda"),
-    context: Annotated[
+    contexts: Annotated[
         list[Context] | None,
         typer.Option(
             "--context",
@@ -165,7 +165,7 @@ def export_usd(
         result = api.export_usd(
             presets or [],
             output,
-            tuple(c.value for c in context) if context else api.USD_CONTEXTS,
+            tuple(c.value for c in contexts) if contexts else api.USD_CONTEXTS,
             mtlx=mtlx_file,
             bake=bake_maps,
             map_resolution=resolution,

@@ -8,17 +8,16 @@ from pathlib import Path
 from typing import Annotated, Any
 
 import typer
-from rich.syntax import Syntax
 
-from lookdev.library import Library, PresetError, listing, read_preset
-from lookdev.library.errors import TextureError
-from lookdev.library.library import apply_changes
-from lookdev.library.preset import PresetFile, check_name, parse_value, preset_document
-from lookdev.library.schema import preset_schema
-from lookdev.materials.errors import LookdevError
+from lookdev.library import PresetError
+from lookdev.library.library import Library, apply_changes, read_preset
+from lookdev.library.toml_file import check_name
 
 from .common import console, err_console, print_json
-from .presets_view import material_json, print_resolved, text_table
+
+# `presets list` reads headers only: the schemas (pydantic and the models, through
+# lookdev.library.preset), Rich's syntax highlighting and the resolved views are imported
+# by the commands that show or change a preset.
 
 app = typer.Typer(
     help="Browse and edit material presets. Presets are TOML files found, in order, in each "
@@ -77,6 +76,10 @@ def list_(
         raise PresetError(
             f"unknown model {model!r}; allowed: disney, pixar, layered", field="--model"
         )
+    from lookdev.library import listing
+
+    from .presets_view import text_table
+
     lib = Library(library)
     entries = lib.entries()
     broken = [h for h in entries if h.error]
@@ -116,6 +119,10 @@ def show(
 
       lookdev presets show brushed_steel --resolved
     """
+    from lookdev.library.preset import preset_document
+
+    from .presets_view import material_json, print_resolved
+
     lib = Library(library)
     path = Path(name) if name.endswith(".toml") else lib.find(name)
     preset = read_preset(path)
@@ -151,6 +158,8 @@ def show(
     for link, dest in links:
         console.print(f"  read through the symlink {link} -> {dest}", style="dim", highlight=False)
     if material is None:
+        from rich.syntax import Syntax
+
         text = path.read_text(encoding="utf-8-sig")
         console.print(Syntax(text, "toml", theme="ansi_dark", word_wrap=True))
     else:
@@ -162,6 +171,9 @@ def _textures_checked(lib: Library, path: Path) -> None:
     spaces, ranges) even when it is shown as written: a bad map is one line and exit 2
     here as in `proof` and `export`. Other problems of resolving (a missing parent) are
     left to --resolved, so a preset can still be shown as written."""
+    from lookdev.library.errors import TextureError
+    from lookdev.materials.errors import LookdevError
+
     try:
         lib.load_file(path)
     except TextureError:
@@ -229,6 +241,8 @@ def new(
     if parent is not None:
         lib.find(parent)
     where = str(lib.target() / f"{name}.toml")
+    from lookdev.library.preset import PresetFile
+
     fields = {"name": name, "model": model, "extends": parent, "params": {}}
     notes: list[str] = []
     if textures:
@@ -262,6 +276,10 @@ def _texture_set(given: list[str], target: Path, where: str) -> tuple[str, list[
     pattern, folder = from_files(paths)
     found = expand(pattern, folder, where=where)
     rel = os.path.relpath(folder.resolve(), target.resolve())
+    if rel == ".." or rel.startswith(".." + os.sep):
+        # maps kept outside the library: a relative path would leave it (lookdev.library.
+        # containment), so the preset names them absolutely and stays valid when copied
+        return Path(folder.resolve(), pattern).as_posix(), found.notes
     return Path(rel, pattern).as_posix(), found.notes
 
 
@@ -354,6 +372,8 @@ def schema(
     Example (Taplo / Even Better TOML): lookdev presets schema -o preset.schema.json, then
     start a preset with the line  #:schema ./preset.schema.json
     """
+    from lookdev.library.schema import preset_schema
+
     text = json.dumps(preset_schema(), indent=2) + "\n"
     if output is None:
         typer.echo(text, nl=False)
@@ -366,6 +386,8 @@ def schema(
 
 def parse_assignments(items: list[str]) -> dict[str, Any]:
     """``["roughness=0.3", "sheen_model=conty_kulla"]`` → a dict; ``"k="`` maps k to None."""
+    from lookdev.library.preset import parse_value
+
     out: dict[str, Any] = {}
     for item in items:
         key, sep, value = item.partition("=")

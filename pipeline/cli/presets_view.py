@@ -2,16 +2,14 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rich.table import Table
 
-from lookdev.library import Material
-from lookdev.library.library import set_by
-from lookdev.materials.layers import children
-
 from .common import console, table
+
+if TYPE_CHECKING:  # listing presets reads headers only: no materials imported for it
+    from lookdev.library import Material
 
 
 def text_table(title: str, columns: list[str], rows: list[list[str]]) -> Table:
@@ -38,49 +36,18 @@ def material_json(m: Material) -> dict[str, Any]:
 
 
 def print_resolved(m: Material) -> None:
+    from lookdev.library.display import layer_rows, parameter_rows
+
     if m.params is not None:
-        origin = {k: p.name for k, p in set_by(m).items()}
-        values = m.params.model_dump()
-        if getattr(m.params, "uses_ior", False):  # Disney: one parameter, two spellings
-            values["specular"], origin["specular"] = m.params.effective_specular, "(from ior)"
-        values |= {k: f"texture {t.texture}" for k, t in m.textures.items()}
-        rows = [[k, value_text(v), origin.get(k, "default")] for k, v in values.items()]
+        rows = [list(r) for r in parameter_rows(m)]
         console.print(
             table(f"{m.name} ({m.model}, resolved)", ["parameter", "value", "set by"], rows)
         )
         return
-    rows = [
-        [
-            i,
-            layer.name,
-            layer.material.name,
-            layer.material.model,
-            mask_text(layer.mask),
-            layer.presence,
-        ]
-        for i, layer in enumerate(m.layers)
-    ]
     console.print(
         table(
             f"{m.name} (layered, bottom to top)",
             ["#", "layer", "material", "model", "mask", "presence"],
-            rows,
+            [list(r) for r in layer_rows(m)],
         )
     )
-
-
-def value_text(v: Any) -> str:
-    if isinstance(v, tuple | list):
-        return "[" + ", ".join(f"{x:.4g}" for x in v) + "]"
-    return f"{v:.4g}" if isinstance(v, float) else str(v)
-
-
-def mask_text(mask: Any) -> str:
-    """A mask tree as a call expression: ``levels(noise(scale=6.0, seed=7), low=0.42)``."""
-    fields = mask.model_dump(
-        mode="json", exclude_defaults=True, exclude={"kind", "input", "inputs"}
-    )
-    if "path" in fields:
-        fields["path"] = Path(fields["path"]).name
-    args = [mask_text(c) for c in children(mask)] + [f"{k}={v}" for k, v in fields.items()]
-    return f"{mask.kind}({', '.join(args)})"

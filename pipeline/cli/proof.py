@@ -167,7 +167,7 @@ def proof(
             "output folder must be shared with its workers.",
         ),
     ] = None,
-    workers: Annotated[
+    jobs: Annotated[
         int | None,
         typer.Option(
             "--workers",
@@ -287,7 +287,7 @@ def proof(
             exposure=exposure,
             ibl_width=ibl_width,
             rig=rig.value,
-            jobs=workers,
+            jobs=jobs,
             scheduler=scheduler,
             report=report,
             library=library,

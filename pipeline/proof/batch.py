@@ -30,7 +30,6 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
-import multiprocessing
 import os
 import time
 import traceback
@@ -348,8 +347,9 @@ def executor_for(scheduler: str | None, workers: int | None) -> Iterator[Executo
         finally:
             client.close()
         return
-    ctx = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=workers or default_workers(), mp_context=ctx) as pool:
+    from .spawn import CONTEXT  # spawned, and without re-running the caller's script
+
+    with ProcessPoolExecutor(max_workers=workers or default_workers(), mp_context=CONTEXT) as pool:
         yield pool
 
 

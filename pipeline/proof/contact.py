@@ -8,14 +8,12 @@ still labels every frame, so a sheet is never unlabelled.
 
 from __future__ import annotations
 
-import os
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 
 from lookdev.library import files
+from lookdev.library.files import quiet_c_stderr
 from lookdev.materials.errors import LookdevError
 
 BACKGROUND = 0.08
@@ -179,28 +177,6 @@ def write_png(display: np.ndarray, path: Path) -> Path:
 
     buf = oiio.ImageBuf(np.ascontiguousarray(to_8bit(display)))
     return _atomic_write(path, ".png", lambda tmp: None if buf.write(tmp) else buf.geterror())
-
-
-@contextmanager
-def quiet_c_stderr() -> Iterator[None]:
-    """File descriptor 2 goes to /dev/null for the block: libpng and OpenImageIO print
-    some decode errors ("libpng error: …", "An ImageBuf was destroyed with a pending
-    error …") straight to it, beside the one line lookdev reports for the same problem."""
-    import sys
-
-    try:
-        sys.stderr.flush()
-        saved = os.dup(2)
-    except (OSError, ValueError, AttributeError):
-        yield
-        return
-    try:
-        with open(os.devnull, "wb") as null:
-            os.dup2(null.fileno(), 2)
-            yield
-    finally:
-        os.dup2(saved, 2)
-        os.close(saved)
 
 
 def read_rgb(path: Path) -> np.ndarray:

@@ -338,7 +338,7 @@ def file_space(path: Path) -> str:
     HDRI sites publish them."""
     import OpenImageIO as oiio
 
-    from .contact import quiet_c_stderr
+    from lookdev.library.files import quiet_c_stderr
 
     with quiet_c_stderr():
         inp = oiio.ImageInput.open(str(path))

@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass, field
 from typing import Any
 
 from lookdev.materials import colour
-from lookdev.materials.errors import LookdevError, check_range
+from lookdev.materials.errors import LookdevError, argument, check_range
 
 from . import shaderball
 from .rig import DEFAULT_RIG, RIGS
@@ -68,15 +68,16 @@ MAX_SAMPLES = 2**32 - 1
 wavefront with 32-bit integers (a noise-target pass is small; a fixed ``spp`` is one)."""
 MAX_SPP = 65536
 RANGES: dict[str, tuple[float, float]] = {
-    "--frames": (1, 360),
-    "--light-frames": (0, 360),
-    "--spp": (2, MAX_SPP),
-    "--noise": (1e-4, 10.0),
-    "--max-spp": (2, 2**20),
-    "--time-budget": (0.01, 86400.0),
-    "--clamp": (1e-3, 1e9),
+    "frames": (1, 360),
+    "light_frames": (0, 360),
+    "spp": (2, MAX_SPP),
+    "noise": (1e-4, 10.0),
+    "max_spp": (2, 2**20),
+    "time_budget": (0.01, 86400.0),
+    "clamp": (1e-3, 1e9),
 }
-"""Allowed ranges of the numeric proof options, inclusive (NaN and infinity never)."""
+"""Allowed ranges of the numeric proof arguments (:func:`lookdev.proof`'s names; the CLI
+shows its options), inclusive (NaN and infinity never)."""
 
 
 class ProofError(LookdevError):
@@ -116,17 +117,17 @@ class Settings:
             extra = [
                 name
                 for name, value in (
-                    ("--noise", self.noise),
-                    ("--max-spp", self.max_spp),
-                    ("--time-budget", self.time_budget),
+                    (argument("noise"), self.noise),
+                    (argument("max_spp"), self.max_spp),
+                    (argument("time_budget"), self.time_budget),
                 )
                 if value is not None
             ]
             if extra:
                 raise ProofError(
-                    f"--spp is a fixed count; {', '.join(extra)} go with a noise target "
-                    "(drop --spp)",
-                    field="--spp",
+                    f"{argument('spp')} is a fixed count; {', '.join(extra)} go with a noise "
+                    f"target (drop {argument('spp')})",
+                    field=argument("spp"),
                 )
             return
         if self.noise is None:
@@ -154,44 +155,45 @@ def check(settings: Settings, jobs: int | None = None) -> Settings:
 
     s = settings
     if len(tuple(s.resolution)) != 2:
-        raise ProofError(f"{tuple(s.resolution)} is not W H", field="--resolution")
+        raise ProofError(f"{tuple(s.resolution)} is not W H", field=argument("resolution"))
     for side in s.resolution:
-        check_range(side, MIN_SIDE, MAX_SIDE, field="--resolution", error=ProofError)
+        check_range(side, MIN_SIDE, MAX_SIDE, field=argument("resolution"), error=ProofError)
     values = {
-        "--frames": s.element_frames,
-        "--light-frames": s.light_frames,
-        "--spp": s.spp,
-        "--noise": s.noise,
-        "--max-spp": s.max_spp,
-        "--time-budget": s.time_budget,
-        "--clamp": s.clamp,
+        "frames": s.element_frames,
+        "light_frames": s.light_frames,
+        "spp": s.spp,
+        "noise": s.noise,
+        "max_spp": s.max_spp,
+        "time_budget": s.time_budget,
+        "clamp": s.clamp,
     }
     for name, value in values.items():
         if value is not None:
-            check_range(value, *RANGES[name], field=name, error=ProofError)
+            check_range(value, *RANGES[name], field=argument(name), error=ProofError)
     if jobs is not None:
-        check_range(jobs, 1, 1024, field="--workers", error=ProofError)
+        check_range(jobs, 1, 1024, field=argument("jobs"), error=ProofError)
     check_range(
         s.exposure,
         -tonemap.EXPOSURE_MAX,
         tonemap.EXPOSURE_MAX,
-        field="--exposure",
+        field=argument("exposure"),
         error=ProofError,
     )
     if s.rig not in RIGS:
-        raise ProofError(f"unknown rig {s.rig!r}; use {', '.join(RIGS)}", field="--rig")
+        raise ProofError(f"unknown rig {s.rig!r}; use {', '.join(RIGS)}", field=argument("rig"))
     if s.pixel_filter not in shaderball.PIXEL_FILTERS:
         raise ProofError(
             f"{s.pixel_filter!r} is not one of {', '.join(shaderball.PIXEL_FILTERS)}",
-            field="--pixel-filter",
+            field=argument("pixel_filter"),
         )
     spp = s.spp if s.spp is not None else min(s.max_spp, _pass_spp())
     samples = s.resolution[0] * s.resolution[1] * spp
     if samples > MAX_SAMPLES:
         raise ProofError(
             f"{s.resolution[0]}×{s.resolution[1]} at {spp} spp is {samples:.3g} samples a "
-            f"frame; allowed ≤ {MAX_SAMPLES:.3g} (lower --spp or --resolution)",
-            field="--resolution",
+            f"frame; allowed ≤ {MAX_SAMPLES:.3g} (lower {argument('spp')} or "
+            f"{argument('resolution')})",
+            field=argument("resolution"),
         )
     return s
 

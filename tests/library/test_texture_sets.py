@@ -156,8 +156,10 @@ def test_presets_new_builds_a_preset_from_a_folder_of_maps(cli, tmp_path):
     r = cli("presets", "new", "hero", "--textures", str(maps / "hero_*.png"), "-L", str(lib))
     assert r.code == 0, r.err
     text = (lib / "hero.toml").read_text()
-    assert 'textures = "../maps/hero_<channel>.<UDIM>.png"' in text
+    # the maps sit outside the library: named absolutely, as relative paths stay inside
+    assert f'textures = "{maps.resolve().as_posix()}/hero_<channel>.<UDIM>.png"' in text
     assert "Emissive" in r.err
+    assert cli("presets", "show", "hero", "-L", str(lib), "--resolved").code == 0
 
 
 def test_presets_new_textures_bad_input_is_one_line(cli, tmp_path):

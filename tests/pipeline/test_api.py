@@ -290,9 +290,9 @@ def test_proof_returns_the_manifest_and_resumes(tmp_path):
 def test_proof_rejects_bad_settings_before_rendering(tmp_path):
     # resolutions now have a documented maximum too, so the message names the range (issue 13)
     with pytest.raises(
-        lookdev.LookdevError, match=r"--resolution: 4 is out of range; allowed \[8, 8192\]"
+        lookdev.LookdevError, match=r"^resolution: 4 is out of range; allowed \[8, 8192\]"
     ):
         lookdev.proof("gold", "studio", tmp_path, resolution=(4, 4), ibl_width=64)
-    with pytest.raises(lookdev.LookdevError, match="--frames"):
+    with pytest.raises(lookdev.LookdevError, match="^frames: "):
         lookdev.proof("gold", "studio", tmp_path, frames=0, ibl_width=64)
     assert not (tmp_path / "manifest.json").exists()

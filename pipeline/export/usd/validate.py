@@ -11,11 +11,16 @@ because renderers ignore an input they do not know, silently: ``Pxr*`` against
 RenderMan's input names kept in ``renderman_inputs.json``, ``ND_*`` against MaterialX's
 node definitions (``getActiveInputs``), and Sdr-registered ids (``UsdPreviewSurface``,
 ``UsdUVTexture``, ``UsdPrimvarReader_*``) against usd-core's Sdr registry. An unknown
-input is an error naming the prim and the input.
+input is an error naming the prim and the input. So is an authored value that is not a
+finite number (NaN or infinite, in any component), or one outside the input's range:
+below MaterialX's ``uimin`` for ``ND_*`` nodes (above ``uimax``, where the UI's slider
+ends, is a warning), outside the UsdPreviewSurface specification's range for that surface
+(:data:`PREVIEW_SURFACE_RANGES`).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
@@ -24,6 +29,16 @@ from .network import ExportError
 
 ALLOWED = "MissingShaderIdInRegistry"
 FOREIGN_ID_PREFIXES = ("ND_", "Pxr")
+PREVIEW_SURFACE_RANGES: dict[str, tuple[float, float]] = {
+    **dict.fromkeys(("diffuseColor", "emissiveColor", "specularColor", "ior"), (0.0, math.inf)),
+    **dict.fromkeys(
+        ("metallic", "roughness", "clearcoat", "clearcoatRoughness", "opacity"), (0.0, 1.0)
+    ),
+    **dict.fromkeys(("opacityThreshold", "occlusion"), (0.0, 1.0)),
+}
+"""UsdPreviewSurface inputs' valid values (UsdPreviewSurface specification 2.x): colours
+and ``ior`` non-negative, the weights, roughnesses and opacity in [0, 1]; Sdr carries no
+ranges, so they are written here."""
 
 
 @dataclass
@@ -87,6 +102,88 @@ def _check_inputs(stage, report: Report) -> None:
                 report.errors.append(
                     f"UnknownShaderInput: {prim.GetPath()} ({ident}) has no input '{name}'"
                 )
+        for given in shader.GetInputs():
+            # the value a renderer reads: the input's own, or a material interface input's
+            # it is connected to (a texture's output is no authored value)
+            for attr in given.GetValueProducingAttributes():
+                if not UsdShade.Input.IsInput(attr) or not attr.HasAuthoredValue():
+                    continue
+                problem = _value_problem(ident, given.GetBaseName(), attr.Get())
+                if problem:
+                    kind, text, fails = problem
+                    via = "" if attr.GetPrim() == prim else f" (from {attr.GetPath()})"
+                    found = report.errors if fails else report.warnings
+                    found.append(f"{kind}: {prim.GetPath()} ({ident}) {text}{via}")
+
+
+def _numbers(value) -> list[float] | None:
+    """The components of a numeric input value (scalar, vector, colour); None otherwise."""
+    if isinstance(value, bool) or value is None or isinstance(value, str):
+        return None
+    if isinstance(value, int | float):
+        return [float(value)]
+    try:
+        items = list(value)
+    except TypeError:
+        return None
+    if items and all(isinstance(v, int | float) and not isinstance(v, bool) for v in items):
+        return [float(v) for v in items]
+    return None
+
+
+def _value_problem(ident: str, name: str, value) -> tuple[str, str, bool] | None:
+    """(kind, text, is an error) when ``value`` of input ``name`` is not finite or out of its
+    range. Above a MaterialX ``uimax`` is a warning: that is where the UI's slider ends, and
+    Burley's parameters may go beyond it on purpose (a diamond's ``specular`` > 1)."""
+    numbers = _numbers(value)
+    if numbers is None:
+        return None
+    shown = ", ".join(f"{v:g}" for v in numbers)
+    if not all(math.isfinite(v) for v in numbers):
+        return "NonFiniteShaderInput", f"input '{name}' is ({shown}): not a finite number", True
+    bounds = input_range(ident, name)
+    if bounds is None:
+        return None
+    low, high = bounds
+    text = f"input '{name}' is ({shown}): allowed [{low:g}, {high:g}]"
+    if any(v < low for v in numbers) or (ident == "UsdPreviewSurface" and max(numbers) > high):
+        return "ShaderInputOutOfRange", text, True
+    if max(numbers) > high:
+        return "ShaderInputAboveUiMax", text, False
+    return None
+
+
+def input_range(ident: str, name: str) -> tuple[float, float] | None:
+    """The valid range of input ``name`` of node ``ident``, where a definition gives one."""
+    if ident == "UsdPreviewSurface":
+        return PREVIEW_SURFACE_RANGES.get(name)
+    if ident.startswith("ND_"):
+        return _mtlx_range(ident, name)
+    return None
+
+
+@cache
+def _mtlx_range(ident: str, name: str) -> tuple[float, float] | None:
+    from .mtlx import _library
+
+    nodedef = _library().getNodeDef(ident)
+    found = nodedef.getActiveInput(name) if nodedef is not None else None
+    if found is None:
+        return None
+    low, high = (_first(found.getAttribute(a)) for a in ("uimin", "uimax"))
+    if low is None and high is None:
+        return None
+    return (-math.inf if low is None else low, math.inf if high is None else high)
+
+
+def _first(text: str) -> float | None:
+    """A MaterialX ``uimin``/``uimax`` value ("0.0", "0,0,0") as one bound; None if absent."""
+    parts = {p.strip() for p in text.split(",") if p.strip()}
+    try:
+        values = {float(p) for p in parts}
+    except ValueError:
+        return None
+    return values.pop() if len(values) == 1 else None
 
 
 def known_inputs(ident: str) -> frozenset[str] | None:

@@ -174,6 +174,7 @@ def test_review_page_plays_scrubs_toggles_and_compares(batch, tmp_path):
         headings = page.js("[...document.querySelectorAll('.material h2')].map(h => h.textContent)")
         assert headings == sorted(MATERIALS)  # the batch order: by name
         img = f"{PLAYER} img.frame"
+        page.js(f"document.querySelector('{PLAYER}').scrollIntoView()")  # players load when seen
         # a denoised batch opens on its denoised frames; the rest starts from the raw ones
         assert page.js("document.querySelector('#denoised').checked") is True
         assert _close(_shown(page, img), colour(0, 0, 0, True))
@@ -190,7 +191,7 @@ def test_review_page_plays_scrubs_toggles_and_compares(batch, tmp_path):
         label = page.js(f"document.querySelector('{PLAYER} .label').textContent")
         assert label.startswith("light 0°")
         stats = page.js(f"document.querySelector('{PLAYER} .stats').textContent")
-        assert "192 spp" in stats and "target 0.02" in stats and "3.5 s" in stats
+        assert stats == "Converged: noise 1.8 % (target 2 %), 192 samples per pixel, 3.5 s."
 
         # play: the frame advances; pause: it stays
         page.js(f"document.querySelector('{PLAYER} .play').click()")
@@ -252,6 +253,63 @@ def test_review_page_plays_scrubs_toggles_and_compares(batch, tmp_path):
         none = page.js("document.querySelectorAll('.material')[0].textContent")
         assert "not recorded by this batch" in none
         (shots / "page.png").write_bytes(page.screenshot())
+        seen = page.problems()
+    for problem in PROBLEMS:
+        assert not seen[problem], (problem, seen[problem])
+
+
+@needs_chromium
+def test_review_page_speaks_plainly_filters_and_loads_players_when_seen(batch, tmp_path):
+    index = R.write_report(batch, plots=False)
+    header = index.read_text().split("<p>", 1)[1].split("</p>", 1)[0]
+    assert header.startswith("2 materials, each under 2 IBLs (4 proofs). Materials: ")
+    assert header.endswith("IBLs: studio, sunset.")
+    with Page(index.as_uri(), tmp_path / "profile") as page:
+        # the first frame did not converge: it says so, and why
+        first = page.js(f"document.querySelector('{PLAYER} .stats').textContent")
+        assert first == (
+            "Not converged: noise 2 % (target 2 %) at the sample cap, 64 samples per pixel, 1.5 s."
+        )
+        detail = page.js(f"document.querySelector('{PLAYER} details.more').open")
+        assert detail is False  # the numbers behind it wait behind "details"
+        text = page.js(f"document.querySelector('{PLAYER} .detail').textContent")
+        assert "0.1 % of pixels hold 30 %" in text and "not clamped" in text
+        what = page.js(f"document.querySelector('{PLAYER} .what').textContent")
+        assert what == "Turntable: 2 frames turning the object, 2 turning the light"
+        # players below the fold have fetched nothing yet; scrolled to, they load
+        tops = page.js(
+            "[...document.querySelectorAll('.player')].map(p => "
+            "[p.getBoundingClientRect().top > innerHeight + 200, "
+            "p.querySelector('img.frame').getAttribute('src') !== null])"
+        )
+        assert tops[-1][0], "the test batch must reach below the fold"
+        assert all(below != loaded for below, loaded in tops), tops
+        last = "document.querySelectorAll('.player')[3]"
+        assert page.js(f"{last}.querySelector('img.frame').getAttribute('src')") is None
+        page.js(f"{last}.scrollIntoView()")
+        _wait(page, f"{last}.querySelector('img.frame').getAttribute('src') !== null")
+        # the table of contents links every material; the filter hides the others
+        links = page.js("[...document.querySelectorAll('#toc a')].map(a => a.textContent)")
+        assert links == sorted(MATERIALS)
+        page.js(
+            "(f => { f.value = 'GOL'; f.dispatchEvent(new Event('input')); })"
+            "(document.querySelector('#filter'))"
+        )
+        visible = page.js(
+            "[...document.querySelectorAll('.material')].filter(s => !s.hidden)"
+            ".map(s => s.dataset.material)"
+        )
+        assert visible == ["gold"]
+        assert page.js("document.querySelector('#filter-count').textContent") == (
+            "1 of 2 materials"
+        )
+        page.js(
+            "(f => { f.value = ''; f.dispatchEvent(new Event('input')); })"
+            "(document.querySelector('#filter'))"
+        )
+        assert (
+            page.js("[...document.querySelectorAll('.material')].filter(s => s.hidden).length") == 0
+        )
         seen = page.problems()
     for problem in PROBLEMS:
         assert not seen[problem], (problem, seen[problem])

@@ -131,8 +131,11 @@ def test_run_measures_every_item_and_writes_outputs(tmp_path):
     assert paths["plot"].read_bytes()[:4] == b"\x89PNG"
 
 
-@pytest.mark.slow
-def test_cli_prints_one_json_object(cli, tmp_path):
+def test_cli_prints_one_json_object(cli, tmp_path, monkeypatch):
+    # The command's own work (options, JSON, files) at the unit tests' TINY settings: the
+    # numbers themselves are checked above. (With the real --quick settings this test
+    # took 102 s of a loaded machine for what test_lambda_rows_… shows in 1.4 s.)
+    monkeypatch.setattr(E.Settings, "quick", classmethod(lambda cls: TINY))
     res = cli("bench", "error", "--quick", "--item", "lambda", "-o", str(tmp_path), "--json")
     assert res.code == 0, res.err
     data = json.loads(res.out)

@@ -157,27 +157,30 @@ def test_settings_default_to_a_noise_target_with_a_cap_and_spp_to_a_fixed_count(
     assert s.resolution == settings.DEFAULT_RESOLUTION and s.pixel_filter == "box"
     fixed = settings.Settings(spp=16)
     assert (fixed.noise, fixed.max_spp) == (None, None) and fixed.sampling() == {"spp": 16}
-    with pytest.raises(settings.ProofError, match="--noise go with a noise target"):
+    fixed_count = "^spp: spp is a fixed count; noise go with a noise target"
+    with pytest.raises(settings.ProofError, match=fixed_count):
         settings.Settings(spp=16, noise=0.1)
 
 
 @pytest.mark.parametrize(
     ("given", "field"),
     [
-        ({"noise": 0.0}, "--noise"),
-        ({"noise": -0.1}, "--noise"),
-        ({"noise": float("nan")}, "--noise"),
-        ({"max_spp": 1}, "--max-spp"),
-        ({"time_budget": 0.0}, "--time-budget"),
-        ({"time_budget": float("inf")}, "--time-budget"),
-        ({"clamp": -1.0}, "--clamp"),
-        ({"pixel_filter": "tent"}, "--pixel-filter"),
+        ({"noise": 0.0}, "noise"),
+        ({"noise": -0.1}, "noise"),
+        ({"noise": float("nan")}, "noise"),
+        ({"max_spp": 1}, "max_spp"),
+        ({"time_budget": 0.0}, "time_budget"),
+        ({"time_budget": float("inf")}, "time_budget"),
+        ({"clamp": -1.0}, "clamp"),
+        ({"pixel_filter": "tent"}, "pixel_filter"),
     ],
 )
-def test_bad_settings_are_one_line_errors_naming_the_option(given, field):
+def test_bad_settings_are_one_line_errors_naming_the_argument(given, field):
     with pytest.raises(settings.ProofError) as info:
         settings.check(settings.Settings(**given))
-    assert str(info.value).startswith(field) and "\n" not in str(info.value)
+    assert str(info.value).startswith(field + ": ") and "\n" not in str(info.value)
+    option = "--" + field.replace("_", "-")  # what the CLI, whose options these are, says
+    assert info.value.one_line({field: option}).startswith(option + ": ")
 
 
 def test_the_proof_camera_uses_a_box_filter_unless_asked(tmp_path, monkeypatch):

@@ -1,0 +1,96 @@
+"""The CPU time of the quick commands against the floor of ``import typer``.
+
+Every command line is a fresh interpreter, so its start-up *is* its cost: the modules
+it imports. Each command runs as a child process and is charged the user + system CPU
+seconds the kernel accounts to that child (``os.wait4``), which, unlike wall time,
+does not grow when other work shares the cores. Rounds interleave the floor and the
+commands (one of each per round, in a rotating order), so a slow spell of the machine
+falls on all of them alike; the median over rounds is reported, with each command's
+ratio to the floor taken within its round.
+"""
+
+from __future__ import annotations
+
+import os
+import statistics
+import subprocess
+import sys
+from collections.abc import Callable, Sequence
+from typing import Any
+
+__all__ = ["COMMANDS", "FLOOR", "TARGET", "cpu_seconds", "run"]
+
+FLOOR = ("-c", "import typer")
+"""The baseline: an interpreter that imports Typer and does nothing with it."""
+COMMANDS = {
+    "--help": ("--help",),
+    "--version": ("--version",),
+    "presets list": ("presets", "list"),
+    "presets show gold": ("presets", "show", "gold"),
+}
+"""The commands measured: what a newcomer types first."""
+TARGET = 3.0
+"""Each command within this many times the floor's CPU time."""
+_ENTRY = "import sys; from lookdev.pipeline.cli import main; main(sys.argv[1:])"
+
+
+def cpu_seconds(argv: Sequence[str], env: dict[str, str] | None = None) -> float:
+    """User + system CPU seconds of one child process running ``argv`` (output dropped).
+
+    >>> cpu_seconds([sys.executable, "-c", "pass"]) > 0
+    True
+    """
+    child = subprocess.Popen(
+        list(argv), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env
+    )
+    _, status, usage = os.wait4(child.pid, 0)
+    child.returncode = os.waitstatus_to_exitcode(status)
+    if child.returncode != 0:
+        raise RuntimeError(f"{' '.join(argv)} exited {child.returncode}")
+    return usage.ru_utime + usage.ru_stime
+
+
+def run(rounds: int = 7, progress: Callable[[int], None] | None = None) -> dict[str, Any]:
+    """Time :data:`COMMANDS` and :data:`FLOOR` in ``rounds`` interleaved rounds.
+
+    Returns the floor's median CPU seconds, and per command its median CPU seconds, its
+    median ratio to the floor (each ratio within one round), the range of those ratios,
+    and whether the median meets :data:`TARGET`; with the load average before and after.
+    """
+    # One console width for every child: Rich lays the help out for it, and a terminal's
+    # width would otherwise change what is measured.
+    env = {**os.environ, "COLUMNS": "100", "PYTHONWARNINGS": "ignore"}
+    python = sys.executable
+    jobs = {"floor": [python, *FLOOR]}
+    jobs |= {name: [python, "-c", _ENTRY, *args] for name, args in COMMANDS.items()}
+    for argv in jobs.values():  # warm the file cache and the byte-code once
+        cpu_seconds(argv, env)
+    load_before = os.getloadavg()
+    times: dict[str, list[float]] = {name: [] for name in jobs}
+    names = list(jobs)
+    for r in range(rounds):
+        order = names[r % len(names) :] + names[: r % len(names)]
+        for name in order:
+            times[name].append(cpu_seconds(jobs[name], env))
+        if progress is not None:
+            progress(r + 1)
+    floor = times["floor"]
+    result: dict[str, Any] = {
+        "rounds": rounds,
+        "python": sys.version.split()[0],
+        "floor": "python -c 'import typer'",
+        "floor_cpu_s": statistics.median(floor),
+        "target_ratio": TARGET,
+        "commands": {},
+        "load_average": [round(load_before[0], 2), round(os.getloadavg()[0], 2)],
+    }
+    for name in COMMANDS:
+        ratios = [t / f for t, f in zip(times[name], floor, strict=True)]
+        result["commands"][f"lookdev {name}"] = {
+            "cpu_s": statistics.median(times[name]),
+            "ratio": statistics.median(ratios),
+            "ratio_min": min(ratios),
+            "ratio_max": max(ratios),
+            "met": statistics.median(ratios) <= TARGET,
+        }
+    return result

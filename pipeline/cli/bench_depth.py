@@ -1,0 +1,83 @@
+"""``lookdev bench depth`` (registered in :mod:`.bench`; the measuring is
+:mod:`lookdev.pipeline.bench.depth`)."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import typer
+from rich.progress import Progress
+
+from lookdev.pipeline.bench import depth
+
+from .common import JsonOut, console, print_json, table
+
+__all__ = ["depth_"]
+
+
+def depth_(
+    presets: Annotated[
+        list[str] | None,
+        typer.Argument(help="Presets to measure (default: one per depth class)."),
+    ] = None,
+    ibl: Annotated[str, typer.Option("--ibl", help="Built-in IBL name or an .exr/.hdr.")] = (
+        "studio"
+    ),
+    spp: Annotated[int, typer.Option("--spp", min=1, help="Samples per pixel.")] = 64,
+    resolution: Annotated[
+        tuple[int, int], typer.Option("--resolution", help="Width and height in pixels.")
+    ] = (160, 80),
+    reference_depth: Annotated[
+        int, typer.Option("--reference-depth", min=2, help="Depth of the reference renders.")
+    ] = 32,
+    repeat: Annotated[int, typer.Option("--repeat", min=1, help="Timed rounds.")] = 3,
+    as_json: JsonOut = False,
+) -> None:
+    """Time the proof scene at each material's chosen path depth against a deep reference.
+
+    Example:
+
+      lookdev bench depth gold glass_clear --spp 32 --json
+    """
+    if min(resolution) < 8:
+        raise depth.BenchDepthError(
+            f"{resolution[0]} {resolution[1]}: at least 8", field="--resolution"
+        )
+    settings = depth.Settings(
+        presets=tuple(presets or depth.DEFAULT_PRESETS),
+        ibl=ibl,
+        spp=spp,
+        resolution=resolution,
+        reference_depth=reference_depth,
+        repeat=repeat,
+    )
+    with Progress(console=console, transient=True, disable=as_json) as bar:
+        task = bar.add_task("rendering", total=len(settings.presets))
+        result = depth.run(settings, progress=lambda: bar.advance(task))
+    if as_json:
+        print_json(result)
+        return
+    columns = [
+        "preset",
+        "depth",
+        "s",
+        "ref depth",
+        "ref s",
+        "speed-up",
+        "mean loss %",
+        "p99 loss %",
+    ]
+    rows = [
+        [
+            r["preset"],
+            r["depth"],
+            r["seconds"],
+            r["reference_depth"],
+            r["reference_seconds"],
+            r["speedup"],
+            100 * r["mean_loss"],
+            100 * r["p99_pixel_loss"],
+        ]
+        for r in result["presets"]
+    ]
+    console.print(table(f"path depth per material ({spp} spp, {ibl})", columns, rows))

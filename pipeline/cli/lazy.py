@@ -1,0 +1,104 @@
+"""Command groups whose sub-commands are imported only when they run.
+
+A group built by :func:`lazy_group` knows its sub-commands from a table of
+:class:`Lazy` entries: the module and attribute that hold each one, and the line its
+parent's ``--help`` lists it with. ``lookdev --help`` (or ``lookdev bench --help``)
+shows the table without importing a single command module; ``lookdev presets list``
+imports ``presets.py`` and nothing of the benchmarks, Mitsuba or USD. A command module is
+imported when the group resolves that command's name: to run it, or to show its own
+``--help``.
+
+An entry's attribute is either a :class:`typer.Typer` (a sub-group, e.g. ``presets``) or
+a plain function (a command, e.g. ``proof``), exactly what ``app.add_typer`` or
+``app.command`` would have been given.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import typer
+from typer.core import TyperCommand, TyperGroup
+
+__all__ = ["Lazy", "LazyGroup", "lazy_group"]
+
+PACKAGE = __name__.rpartition(".")[0]
+"""Relative module names of the tables resolve against the CLI package."""
+
+
+@dataclass(frozen=True)
+class Lazy:
+    """Where a sub-command lives, and how its parent lists it.
+
+    ``target`` is ``"module:attribute"``; a module starting with ``.`` is relative to
+    :mod:`lookdev.pipeline.cli` (``".bench_blend:blend_"``). ``help`` is the one line of
+    the parent's listing (Click's ``short_help``): the command's own ``--help`` shows its
+    docstring in full.
+    """
+
+    target: str
+    help: str
+    panel: str | None = None
+
+    def load(self, name: str, markup: Any) -> Any:
+        """The Click command of this entry, built from the imported module."""
+        module, _, attribute = self.target.partition(":")
+        obj = getattr(importlib.import_module(module, PACKAGE), attribute)
+        if isinstance(obj, typer.Typer):
+            _markup(obj, markup)
+            command = typer.main.get_group(obj)
+            command.name = name
+        else:
+            info = typer.models.CommandInfo(name=name, callback=obj)
+            command = typer.main.get_command_from_info(
+                info, pretty_exceptions_short=True, rich_markup_mode=markup
+            )
+        command.short_help = self.help
+        if self.panel is not None:
+            command.rich_help_panel = self.panel
+        return command
+
+
+def _markup(app: typer.Typer, markup: Any) -> None:
+    # The parent's help style (markdown: paragraphs reflow) holds for nested groups too.
+    app.rich_markup_mode = markup
+    for group in app.registered_groups:
+        _markup(group.typer_instance, markup)
+
+
+class LazyGroup(TyperGroup):
+    """A Typer group completed from :attr:`table` (set by :func:`lazy_group`).
+
+    Until a name is resolved its entry is a placeholder carrying only the listing's line,
+    so help, typo suggestions and shell completion work without importing it.
+    """
+
+    table: Mapping[str, Lazy] = {}
+
+    def __init__(self, **attrs: Any) -> None:
+        super().__init__(**attrs)
+        for name, entry in self.table.items():
+            self.commands.setdefault(name, _Placeholder(name, entry))
+
+    def resolve_command(self, ctx: Any, args: list[str]) -> Any:
+        if args and isinstance(self.commands.get(args[0]), _Placeholder):
+            name = args[0]
+            self.commands[name] = self.table[name].load(name, self.rich_markup_mode)
+        return super().resolve_command(ctx, args)
+
+
+class _Placeholder(TyperCommand):
+    """A table entry not yet imported: its name and listing line, nothing to run."""
+
+    def __init__(self, name: str, entry: Lazy) -> None:
+        super().__init__(name=name, help=entry.help, short_help=entry.help)
+        if entry.panel is not None:
+            self.rich_help_panel = entry.panel
+
+
+def lazy_group(table: Mapping[str, Lazy]) -> type[LazyGroup]:
+    """A :class:`LazyGroup` class for ``typer.Typer(cls=...)`` that holds ``table``."""
+    return type("LazyGroup", (LazyGroup,), {"table": dict(table)})
