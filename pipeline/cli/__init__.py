@@ -109,7 +109,7 @@ def _root(
 
 
 def _register() -> None:
-    from . import bench, check, export, export_usd, plot, presets, proof
+    from . import bench, check, designer, export, export_usd, plot, presets, proof
     from . import blend as blend_cli
     from . import colour as colour_cli
 
@@ -123,6 +123,7 @@ def _register() -> None:
     app.add_typer(presets.app, name="presets")
     app.command("plot")(plot.plot)
     app.command("proof")(proof.proof)
+    app.command("designer")(designer.designer)
     app.add_typer(colour_cli.app, name="colour")
     _reflow_help(app)
 

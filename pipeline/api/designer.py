@@ -1,0 +1,104 @@
+"""``lookdev.designer(...)``: the Material Designer from Python (and from a notebook).
+
+Burley 2012 §6.1's interactive loop: a local web page whose viewport relights the
+material as every parameter and layer is edited, saving presets into the library.
+"""
+
+from __future__ import annotations
+
+import threading
+from pathlib import Path
+from typing import Any
+
+__all__ = ["DesignerHandle", "designer"]
+
+
+class DesignerHandle:
+    """A designer running on a background thread (``block=False``): its ``url``, and
+    :meth:`stop`. In a notebook the handle shows as a link to the page."""
+
+    def __init__(self, app: Any, server: Any, thread: threading.Thread):
+        self.designer = app
+        self._server = server
+        self._thread = thread
+
+    @property
+    def url(self) -> str:
+        return self.designer.url
+
+    def stop(self, timeout: float = 10.0) -> None:
+        """Stop the server and its renderer."""
+        self._server.should_exit = True
+        self._thread.join(timeout)
+        self.designer.close()
+
+    def _repr_html_(self) -> str:
+        return f'<a href="{self.url}" target="_blank">lookdev designer: {self.url}</a>'
+
+    def __repr__(self) -> str:
+        return f"DesignerHandle({self.url!r})"
+
+
+def designer(
+    presets: Any = None,
+    *,
+    library: Any = None,
+    ibl: str = "studio",
+    geometry: str | Path | None = None,
+    port: int | None = None,
+    open_browser: bool = False,
+    block: bool = True,
+    size: tuple[int, int] = (480, 270),
+) -> DesignerHandle | None:
+    """Start the Material Designer on 127.0.0.1 and print its URL (with its token).
+
+    Parameters
+    ----------
+    presets
+        A preset name or ``.toml`` file, or several: the first is opened.
+    library
+        Extra preset folders searched (and saved into) before the built-ins.
+    ibl
+        A built-in IBL name or an ``.exr``/``.hdr`` file lighting the viewport.
+    geometry
+        A mesh in the proof scene's place (as ``proof --geometry`` takes).
+    port
+        The port; default a free one.
+    open_browser
+        Open the page in the default browser.
+    block
+        True: serve until Ctrl-C. False: serve on a background thread and return a
+        :class:`DesignerHandle` (a notebook goes on running cells).
+    size
+        Viewport pixels (width, height).
+    """
+    import uvicorn
+
+    from lookdev.pipeline.designer.server import HOST, Designer
+
+    from .materials import library_for
+
+    if isinstance(presets, str | Path):
+        presets = [presets]
+    app = Designer(
+        [str(p) for p in presets or []],
+        library=library_for(library),
+        ibl=ibl,
+        geometry=None if geometry is None else str(geometry),
+        port=port,
+        size=size,
+    )
+    print(f"lookdev designer: {app.url}", flush=True)
+    if open_browser:
+        import webbrowser
+
+        webbrowser.open(app.url)
+    if block:
+        app.serve()
+        return None
+    config = uvicorn.Config(app.app, host=HOST, port=app.port, log_level="warning", ws="websockets-sansio")
+    server = uvicorn.Server(config)
+    server.install_signal_handlers = lambda: None  # not the main thread
+    thread = threading.Thread(target=server.run, name="lookdev-designer", daemon=True)
+    thread.start()
+    return DesignerHandle(app, server, thread)
