@@ -96,7 +96,9 @@ def designer(
     if block:
         app.serve()
         return None
-    config = uvicorn.Config(app.app, host=HOST, port=app.port, log_level="warning", ws="websockets-sansio")
+    config = uvicorn.Config(
+        app.app, host=HOST, port=app.port, log_level="warning", ws="websockets-sansio"
+    )
     server = uvicorn.Server(config)
     server.install_signal_handlers = lambda: None  # not the main thread
     thread = threading.Thread(target=server.run, name="lookdev-designer", daemon=True)

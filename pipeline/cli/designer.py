@@ -36,7 +36,9 @@ def designer(
     ] = None,
     port: Annotated[
         int | None,
-        typer.Option("--port", min=1024, max=65535, help="Port on 127.0.0.1 (default: a free one)."),
+        typer.Option(
+            "--port", min=1024, max=65535, help="Port on 127.0.0.1 (default: a free one)."
+        ),
     ] = None,
     open_browser: Annotated[
         bool, typer.Option("--open", help="Open the page in the default browser.")

@@ -121,7 +121,9 @@ class Renderer:
                 self.view[key] = pending[key]
                 for name, vp in views.items():
                     _set_view(vp, key, pending[key])
-                    state[name].update(fresh=True, converged=key == "exposure" and state[name]["converged"])
+                    state[name].update(
+                        fresh=True, converged=key == "exposure" and state[name]["converged"]
+                    )
 
     def _view_kwargs(self) -> dict[str, Any]:
         out = {k: self.view[k] for k in ("mode", "ibl") if k in self.view}

@@ -101,9 +101,7 @@ def save_over(session: Any) -> Path:
         )
     library = session.library
     plain = Path(os.path.abspath(path))
-    root = next(
-        (f for f in library.user_folders if plain.is_relative_to(os.path.abspath(f))), None
-    )
+    root = next((f for f in library.user_folders if plain.is_relative_to(os.path.abspath(f))), None)
     if root is None:
         if library.builtin is not None and path.resolve().is_relative_to(library.builtin.resolve()):
             root = library.builtin  # Library.save refuses it with its own message

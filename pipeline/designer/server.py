@@ -21,7 +21,7 @@ from typing import Any
 
 from starlette.applications import Starlette
 from starlette.responses import PlainTextResponse
-from starlette.routing import Mount, Route, WebSocketRoute
+from starlette.routing import Mount, WebSocketRoute
 from starlette.staticfiles import StaticFiles
 from starlette.websockets import WebSocket, WebSocketDisconnect
 
@@ -160,7 +160,9 @@ class Designer:
         if self.renderer is None:
             from .render import Renderer
 
-            self.renderer = Renderer(self._viewport, self._publish, watching=lambda: bool(self.clients))
+            self.renderer = Renderer(
+                self._viewport, self._publish, watching=lambda: bool(self.clients)
+            )
             self.renderer.post(material=self.session.hub(), ibl=self.ibl)
 
     def material_changed(self) -> None:

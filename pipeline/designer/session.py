@@ -94,7 +94,9 @@ class Session:
         """The resolved material of ``doc`` (default: the current one), hidden layers out."""
         doc = self.doc if doc is None else doc
         if hide and self.hidden and doc.get("layers"):
-            doc = dict(doc, layers=[la for i, la in enumerate(doc["layers"]) if i not in self.hidden])
+            doc = dict(
+                doc, layers=[la for i, la in enumerate(doc["layers"]) if i not in self.hidden]
+            )
             if not doc["layers"]:
                 doc["layers"] = [{"model": "disney", "mask": 0.0}]
         where = str(self.path or NEW_NAME)
@@ -185,7 +187,9 @@ class Session:
             constants = {k: list(v) if isinstance(v, tuple) else v for k, v in constants.items()}
             try:
                 canon = MODELS[model].model_validate(_plain(constants)).model_dump(mode="json")
-                values = {k: (v if isinstance(v, dict) else canon.get(k, v)) for k, v in values.items()}
+                values = {
+                    k: (v if isinstance(v, dict) else canon.get(k, v)) for k, v in values.items()
+                }
             except Exception:  # a stored document always validates; keep the raw values
                 pass
         return {
@@ -275,7 +279,9 @@ def _values(material: Material) -> dict[str, Any]:
     if material.params is None:
         return {}
     values = material.params.model_dump(mode="json")
-    values |= {k: t.model_dump(mode="json", exclude_defaults=True) for k, t in material.textures.items()}
+    values |= {
+        k: t.model_dump(mode="json", exclude_defaults=True) for k, t in material.textures.items()
+    }
     return values
 
 
