@@ -6,7 +6,6 @@ material as every parameter and layer is edited, saving presets into the library
 
 from __future__ import annotations
 
-import threading
 from pathlib import Path
 from typing import Any
 
@@ -17,20 +16,17 @@ class DesignerHandle:
     """A designer running on a background thread (``block=False``): its ``url``, and
     :meth:`stop`. In a notebook the handle shows as a link to the page."""
 
-    def __init__(self, app: Any, server: Any, thread: threading.Thread):
+    def __init__(self, app: Any, stop: Any):
         self.designer = app
-        self._server = server
-        self._thread = thread
+        self._stop = stop
 
     @property
     def url(self) -> str:
         return self.designer.url
 
-    def stop(self, timeout: float = 10.0) -> None:
+    def stop(self) -> None:
         """Stop the server and its renderer."""
-        self._server.should_exit = True
-        self._thread.join(timeout)
-        self.designer.close()
+        self._stop()
 
     def _repr_html_(self) -> str:
         return f'<a href="{self.url}" target="_blank">lookdev designer: {self.url}</a>'
@@ -72,9 +68,7 @@ def designer(
     size
         Viewport pixels (width, height).
     """
-    import uvicorn
-
-    from lookdev.pipeline.designer.server import HOST, Designer
+    from lookdev.pipeline.designer.server import Designer
 
     from .materials import library_for
 
@@ -96,11 +90,4 @@ def designer(
     if block:
         app.serve()
         return None
-    config = uvicorn.Config(
-        app.app, host=HOST, port=app.port, log_level="warning", ws="websockets-sansio"
-    )
-    server = uvicorn.Server(config)
-    server.install_signal_handlers = lambda: None  # not the main thread
-    thread = threading.Thread(target=server.run, name="lookdev-designer", daemon=True)
-    thread.start()
-    return DesignerHandle(app, server, thread)
+    return DesignerHandle(app, app.serve_in_background())

@@ -20,6 +20,7 @@ from lookdev.materials.errors import LookdevError
 
 from . import library_panel, tasks
 from .controls import mask_kinds, texture_fields
+from .session import EditRefused
 
 __all__ = ["IMAGE_SUFFIXES", "PLOT_VIEWS", "routes", "view_changes"]
 
@@ -159,11 +160,14 @@ def d_static():
 
 
 def _answering(fn):
-    """``fn`` with the library's errors as 422 and one line, never a traceback."""
+    """``fn`` with the library's errors as 422 and one line, never a traceback; an edit
+    the schema refuses is a normal answer (``{"refused": message}``), not an HTTP error."""
 
     async def wrapped(request: Request) -> Response:
         try:
             return await fn(request)
+        except EditRefused as exc:  # an answer, not a failure: the page shows it in place
+            return JSONResponse({"refused": str(exc)})
         except LookdevError as exc:
             return JSONResponse({"error": str(exc)}, status_code=422)
         except (ValueError, TypeError) as exc:

@@ -221,17 +221,40 @@ class Designer:
             self.renderer.post(**changes)
 
     # -- running ---------------------------------------------------------------------------
-    def serve(self) -> None:
-        """Run until Ctrl-C (uvicorn stops cleanly; the render thread is closed)."""
+    def _server(self):
         import uvicorn
 
         config = uvicorn.Config(
             self.app, host=HOST, port=self.port, log_level="warning", ws="websockets-sansio"
         )
+        return uvicorn.Server(config)
+
+    def serve(self) -> None:
+        """Run until Ctrl-C (uvicorn stops cleanly; the render thread is closed)."""
         try:
-            uvicorn.Server(config).run()
+            self._server().run()
         finally:
             self.close()
+
+    def serve_in_background(self, timeout: float = 30.0):
+        """Serve on a daemon thread; returns ``stop()``, which ends it and the renderer."""
+        import threading
+        import time
+
+        server = self._server()
+        server.install_signal_handlers = lambda: None  # only the main thread may
+        thread = threading.Thread(target=server.run, name="lookdev-designer", daemon=True)
+        thread.start()
+        deadline = time.monotonic() + timeout
+        while not server.started and thread.is_alive() and time.monotonic() < deadline:
+            time.sleep(0.02)
+
+        def stop() -> None:
+            server.should_exit = True
+            thread.join(timeout)
+            self.close()
+
+        return stop
 
 
 async def _send_loop(ws: WebSocket, queue: asyncio.Queue) -> None:

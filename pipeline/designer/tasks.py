@@ -29,8 +29,7 @@ def plot(d: Any, view: str) -> bytes:
 
     path = d.folder / "plots" / f"{view}-{d.session.version}.png"
     if not path.is_file():
-        material = d.session.material()
-        lookdev.plot(material, path, view=view, library=d.library)
+        lookdev.plot(d.session.hub(), path, view=view, library=d.library)
     return path.read_bytes()
 
 

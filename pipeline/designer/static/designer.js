@@ -29,6 +29,7 @@ async function api(path, body) {
   const r = await fetch(path, opts);
   const data = await r.json().catch(() => ({ error: `HTTP ${r.status}` }));
   if (!r.ok) throw new Error(data.error || `HTTP ${r.status}`);
+  if (data.refused) throw new Error(data.refused); // the schema's message, shown in place
   return data;
 }
 
