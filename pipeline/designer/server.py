@@ -230,9 +230,12 @@ class Designer:
         return uvicorn.Server(config)
 
     def serve(self) -> None:
-        """Run until Ctrl-C (uvicorn stops cleanly; the render thread is closed)."""
+        """Run until Ctrl-C: uvicorn closes the connections, the render thread closes the
+        viewports, the scratch folder goes; then return (a stop, not a failure)."""
         try:
             self._server().run()
+        except KeyboardInterrupt:  # uvicorn re-raises the SIGINT it shut down for
+            pass
         finally:
             self.close()
 

@@ -86,11 +86,12 @@ def test_a_foreign_host_is_refused(client, designer, user_library, host):
 
 def test_the_websocket_needs_the_token_and_the_origin(client, designer):
     with pytest.raises(WebSocketDisconnect):
-        with client.websocket_connect("/ws"):
+        with client.websocket_connect(f"ws://127.0.0.1:{designer.port}/ws"):
             pass
     with pytest.raises(WebSocketDisconnect):
         with client.websocket_connect(
-            f"/{designer.token}/ws", headers={"origin": "http://evil.example"}
+            f"ws://127.0.0.1:{designer.port}/{designer.token}/ws",
+            headers={"origin": "http://evil.example"},
         ):
             pass
 
