@@ -217,3 +217,50 @@ def _umask() -> int:
     mask = os.umask(0)
     os.umask(mask)
     return mask
+
+
+def _grey_png(path, value=128):
+    import numpy as np
+    from PIL import Image
+
+    ramp = np.tile(np.linspace(0, 255, 8, dtype=np.uint8), (8, 1))
+    Image.fromarray(ramp if value is None else np.full((8, 8), value, np.uint8)).save(path)
+
+
+def test_a_parameter_driven_by_a_map_can_be_swapped_and_made_constant(user_library):
+    from lookdev.pipeline.designer.guard import Roots
+
+    _grey_png(user_library / "rough.png")
+    _grey_png(user_library / "ramp.png", None)
+    s = Session(
+        Library([user_library], use_env=False), "gold", roots=Roots({"library0": user_library})
+    )
+    s.save_new("mapped")  # in the user library: texture paths are relative to it
+    ref = {"root": "library0", "path": "rough.png"}
+    _set(s, "roughness", {"texture": ref, "channel": "r", "colorspace": "Raw"})
+    assert s.doc["params"]["roughness"]["texture"] == "rough.png"
+    assert "roughness" in s.material().textures
+    shown = s.state()["targets"][0]["values"]["roughness"]
+    assert shown["texture"] == "rough.png" and shown["channel"] == "r"
+    with pytest.raises(EditRefused, match="channel"):
+        _set(s, "roughness", {"texture": ref, "channel": "q"})
+    _set(s, "roughness", {"texture": {"root": "library0", "path": "ramp.png"}, "channel": "r"})
+    assert s.hub().maps["roughness"].std() > 0.1  # the ramp varies across u
+    _set(s, "roughness", 0.4)  # replaced by a constant
+    assert s.material().textures == {} and s.material().params.roughness == 0.4
+
+
+def test_a_layer_mask_from_a_texture(user_library):
+    from lookdev.pipeline.designer.guard import Roots
+
+    _grey_png(user_library / "mask.png", None)
+    s = Session(
+        Library([user_library], use_env=False), "gold", roots=Roots({"library0": user_library})
+    )
+    s.replace({"name": "untitled", "model": "layered", "layers": [{"preset": "gold"}]})
+    mask = {"kind": "texture", "path": {"root": "library0", "path": "mask.png"}, "channel": 0}
+    s.edit({"op": "layer_add", "preset": "rust", "mask": mask})
+    path = s.save_new("masked")
+    doc = tomllib.loads(path.read_text())
+    assert doc["layers"][1]["mask"] == {"kind": "texture", "path": "mask.png"}
+    assert Library([user_library], use_env=False).load("masked").layers[1].material.name == "rust"
