@@ -110,6 +110,8 @@ class Designer:
         self.loop: asyncio.AbstractEventLoop | None = None
         self.renderer = None
         self.tasks: dict[str, dict[str, Any]] = {}
+        self.proof_settings: dict[str, Any] = {}
+        """Keyword arguments of :func:`lookdev.proof` for *Proof* (default: the main job's)."""
         self.app = self._build()
 
     @property

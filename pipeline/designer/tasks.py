@@ -19,8 +19,6 @@ __all__ = ["export_usd", "losses", "plot", "start_proof", "status"]
 
 _proofs = ThreadPoolExecutor(max_workers=1, thread_name_prefix="designer-proof")
 _lock = threading.Lock()
-PROOF_FRAMES = 4
-PROOF_LIGHT_FRAMES = 4
 
 
 def plot(d: Any, view: str) -> bytes:
@@ -71,11 +69,10 @@ def start_proof(d: Any) -> dict[str, Any]:
                 [material],
                 ibls=[d.ibl],
                 out=out,
-                frames=PROOF_FRAMES,
-                light_frames=PROOF_LIGHT_FRAMES,
                 report=True,
                 library=d.library,
                 geometry=d.geometry,
+                **d.proof_settings,
             )
         except Exception as exc:  # reported on the page, in one line
             _update(d, task_id, state="failed", error=f"{type(exc).__name__}: {exc}")
