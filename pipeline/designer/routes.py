@@ -223,6 +223,8 @@ def view_changes(message: dict[str, Any]) -> dict[str, Any]:
             out[key] = float(value) if key != "exposure" else max(-16.0, min(16.0, value))
     if message.get("mode") in MODES:
         out["mode"] = message["mode"]
+    if message.get("ab_against") in ("opened", "parent"):
+        out["ab_against"] = message["ab_against"]
     for key in ("raw", "ab"):
         if isinstance(message.get(key), bool):
             out[key] = message[key]

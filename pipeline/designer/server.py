@@ -110,6 +110,7 @@ class Designer:
         self.loop: asyncio.AbstractEventLoop | None = None
         self.renderer = None
         self.tasks: dict[str, dict[str, Any]] = {}
+        self.ab_against = "opened"
         self.proof_settings: dict[str, Any] = {}
         """Keyword arguments of :func:`lookdev.proof` for *Proof* (default: the main job's)."""
         self.app = self._build()
@@ -172,7 +173,7 @@ class Designer:
         if self.renderer is not None:
             self.renderer.post(material=self.session.hub())
             if self.renderer.view.get("ab"):
-                self.renderer.post(reference=self.session.hub(self.session.reference()))
+                self.renderer.post(reference=self._reference())
         self.broadcast({"type": "state", "version": self.session.version})
 
     def _publish(self, kind: str, data: bytes, meta: dict[str, Any]) -> None:
@@ -217,10 +218,16 @@ class Designer:
         from .routes import view_changes
 
         changes = view_changes(message)
+        if "ab_against" in changes:
+            self.ab_against = changes.pop("ab_against")
+            changes.setdefault("ab", bool(self.renderer.view.get("ab")))
         if changes.get("ab"):
-            changes["reference"] = self.session.hub(self.session.reference())
+            changes["reference"] = self._reference()
         if changes:
             self.renderer.post(**changes)
+
+    def _reference(self):
+        return self.session.hub(self.session.reference(self.ab_against))
 
     # -- running ---------------------------------------------------------------------------
     def _server(self):

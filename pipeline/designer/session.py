@@ -108,8 +108,12 @@ class Session:
 
         return resolve(preset.name, lookup)
 
-    def reference(self) -> Material:
-        """What the A/B split compares against: the preset as opened."""
+    def reference(self, against: str = "opened") -> Material:
+        """What the A/B split compares against: the preset as opened, or (``"parent"``)
+        the preset it ``extends`` (as opened when it extends nothing)."""
+        parent = self.original.get("extends")
+        if against == "parent" and parent:
+            return self.library.load(parent)
         return self.material(self.original, hide=False)
 
     def hub(self, material: Material | None = None):

@@ -394,6 +394,7 @@ function setupViewport() {
   $("mode").onchange = () => sendView({ mode: $("mode").value });
   $("raw").onchange = () => sendView({ raw: $("raw").checked });
   $("ab").onchange = () => { sendView({ ab: $("ab").checked }); paint(); };
+  $("ab-against").onchange = () => sendView({ ab_against: $("ab-against").value });
 }
 
 // -- wiring ------------------------------------------------------------------------------

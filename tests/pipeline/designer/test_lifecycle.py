@@ -91,3 +91,14 @@ def test_bad_view_messages_are_dropped():
         "exposure": 16.0,
         "ab": True,
     }
+
+
+def test_ab_split_renders_the_reference_beside(client, designer):
+    t = designer.token
+    with client.websocket_connect(f"ws://127.0.0.1:{designer.port}/{t}/ws") as ws:
+        _frame(ws)
+        ws.send_json({"ab": True, "ab_against": "parent"})
+        views = set()
+        while views != {"A", "B"}:
+            views.add(_frame(ws)["view"])
+    assert designer.ab_against == "parent" and designer.renderer.view["ab"]
