@@ -67,7 +67,7 @@ def thumbnail(library: Library, name: str, cache: Path) -> Path:
     path = cache / f"{name}-{_key(material)}.png"
     if path.is_file():
         return path
-    with _lock:  # numpy renders use every core already; one at a time
+    with _lock:  # one at a time: numpy renders use every core already
         if path.is_file():
             return path
         image = _render(lookdev.hub(material, 64))

@@ -10,6 +10,7 @@ from __future__ import annotations
 import asyncio
 import json
 import math
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 from starlette.requests import Request
@@ -27,6 +28,7 @@ __all__ = ["IMAGE_SUFFIXES", "PLOT_VIEWS", "routes", "view_changes"]
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".exr", ".tif", ".tiff", ".hdr", ".tx")
 PLOT_VIEWS = ("slice", "polar", "albedo")
 MAX_BODY = 1 << 20
+THUMBNAILS = ThreadPoolExecutor(max_workers=1, thread_name_prefix="designer-thumbnails")
 MODES = ("designer", "truth")
 SIZE_MAX = 1920
 
@@ -58,8 +60,9 @@ def routes(d: Any) -> list[Route]:
 
     async def thumbnail(request: Request) -> Response:
         name = request.path_params["name"]
-        path = await asyncio.to_thread(
-            library_panel.thumbnail, d.library, name, d.folder / "thumbnails"
+        # its own thread: seventy thumbnails queued must not starve the edits' threads
+        path = await asyncio.get_running_loop().run_in_executor(
+            THUMBNAILS, library_panel.thumbnail, d.library, name, d.folder / "thumbnails"
         )
         return FileResponse(path, media_type="image/png")
 

@@ -114,6 +114,7 @@ class Designer:
         self.proof_settings: dict[str, Any] = {}
         """Keyword arguments of :func:`lookdev.proof` for *Proof* (default: the main job's)."""
         self.app = self._build()
+        _import_heavy_modules()
 
     @property
     def url(self) -> str:
@@ -267,6 +268,18 @@ class Designer:
             self.close()
 
         return stop
+
+
+def _import_heavy_modules() -> None:
+    """Import, on this thread, what the routes' worker threads will use: extension
+    modules imported for the first time from several threads at once can deadlock on the
+    import lock (seen here: usd-core's ``pxr`` in one thread, Pillow in another)."""
+    import PIL.Image  # noqa: F401
+
+    import lookdev.pipeline.analysis.plots  # noqa: F401
+    import lookdev.pipeline.analysis.sphere  # noqa: F401
+    import lookdev.pipeline.export.usd.writer  # noqa: F401
+    import lookdev.pipeline.proof.tonemap  # noqa: F401
 
 
 async def _send_loop(ws: WebSocket, queue: asyncio.Queue) -> None:

@@ -81,12 +81,29 @@ function drawControls() {
   if (!t) return;
   $("controls-title").textContent = t.index === null ? `Parameters: ${t.label} (${t.model})`
     : `Layer ${t.index}: ${t.label} (${t.model})`;
+  box.append(metaRow());
   const descriptors = state.controls[t.model];
   if (!descriptors) {
     box.append(el("p", { textContent: "A layered preset as a layer: open it to edit its layers." }));
     return;
   }
   for (const c of descriptors) box.append(control(c, t));
+}
+
+function metaRow() {
+  const wrap = el("div", { className: "control" });
+  const desc = el("input", { value: state.doc.description || "", placeholder: "description", style: "width:100%" });
+  const tags = el("input", { value: (state.doc.tags || []).join(", "), placeholder: "tags, comma-separated",
+    style: "width:100%" });
+  const error = el("div", { className: "error" });
+  const send = async (field, value) => {
+    const message = await edit({ op: "meta", field, value });
+    if (message) error.textContent = message;
+  };
+  desc.onchange = () => send("description", desc.value);
+  tags.onchange = () => send("tags", tags.value.split(",").map((x) => x.trim()).filter(Boolean));
+  wrap.append(desc, tags, error);
+  return wrap;
 }
 
 function control(c, t) {
@@ -232,8 +249,15 @@ function drawLayers() {
       const message = await edit({ op: "layer_mask", index: i, mask: parsed });
       if (message) { error.textContent = message; mask.classList.add("invalid"); }
     };
-    li.append(eye, label, " ", up, down, del, el("span", { className: "mask", textContent: maskText(la.mask) }),
-      mask, error);
+    const presence = el("input", { type: "number", step: "any", value: la.presence ?? 1, title:
+      "presence (Pixar layers: opacity, 0..1)", style: "width:56px" });
+    presence.onchange = async () => {
+      const message = await edit({ op: "layer_presence", index: i, value: Number(presence.value) });
+      if (message) { error.textContent = message; presence.classList.add("invalid"); }
+    };
+    const pixar = (state.targets[i] || {}).model === "pixar";
+    li.append(eye, label, " ", up, down, del, ...(pixar ? [" presence ", presence] : []),
+      el("span", { className: "mask", textContent: maskText(la.mask) }), mask, error);
     list.append(li);
   }
 }
