@@ -20,16 +20,11 @@ def user_library(tmp_path: Path) -> Path:
 def designer(user_library: Path, tmp_path: Path):
     from lookdev.pipeline.designer.server import Designer
 
-    try:  # TEMPORARY until the render helper's viewport lands
-        from lookdev.pipeline.designer.viewport import Viewport
-    except ImportError:
-        from _fake_viewport import Viewport
     d = Designer(
         ["gold"],
         library=Library([user_library], use_env=False),
         folder=tmp_path / "session",
         size=(32, 18),
-        viewport_factory=Viewport,
     )
     yield d
     d.close()

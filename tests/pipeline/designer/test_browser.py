@@ -47,16 +47,11 @@ def _differ(a: list[int], b: list[int]) -> float:
 def page_on_gold(user_library: Path, tmp_path: Path):
     from lookdev.pipeline.designer.server import Designer
 
-    try:  # TEMPORARY until the render helper's viewport lands
-        from lookdev.pipeline.designer.viewport import Viewport
-    except ImportError:
-        from _fake_viewport import Viewport
     d = Designer(
         ["gold"],
         library=Library([user_library], use_env=False),
         folder=tmp_path / "s",
         size=(64, 36),
-        viewport_factory=Viewport,
     )
     stop = d.serve_in_background()
     problems: list[str] = []
