@@ -15,8 +15,9 @@ from pathlib import Path
 from typing import Any
 
 from lookdev.library.preset import check_name
+from lookdev.materials.errors import LookdevError
 
-__all__ = ["OPS", "apply", "file_refs"]
+__all__ = ["OPS", "EditRefused", "apply", "file_refs"]
 
 OPS = (
     "set",
@@ -31,10 +32,12 @@ OPS = (
 META_FIELDS = ("description", "tags")
 
 
+class EditRefused(LookdevError):
+    """An edit the schema (or the resolver) refuses: nothing was applied."""
+
+
 def apply(doc: dict[str, Any], op: dict[str, Any], session: Any) -> dict[str, Any]:
     """``doc`` with the edit ``op`` made (``doc`` is the caller's copy)."""
-    from .session import EditRefused
-
     kind = op.get("op")
     if kind not in OPS:
         raise EditRefused(f"unknown edit {kind!r}; allowed: {', '.join(OPS)}")
@@ -86,8 +89,6 @@ def apply(doc: dict[str, Any], op: dict[str, Any], session: Any) -> dict[str, An
 
 
 def _params_of(doc: dict[str, Any], target: Any) -> dict[str, Any]:
-    from .session import EditRefused
-
     if target is None:
         if doc.get("model") == "layered" or doc.get("layers"):
             raise EditRefused("a layered preset has no parameters of its own; pick a layer")
@@ -99,8 +100,6 @@ def _params_of(doc: dict[str, Any], target: Any) -> dict[str, Any]:
 
 
 def _to_layered(doc: dict[str, Any]) -> None:
-    from .session import EditRefused
-
     if doc.get("layers") or doc.get("model") == "layered":
         doc.setdefault("layers", [])
         return

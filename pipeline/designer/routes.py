@@ -11,6 +11,7 @@ import asyncio
 import json
 import math
 from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
 from typing import Any
 
 from starlette.requests import Request
@@ -23,8 +24,9 @@ from . import library_panel, tasks
 from .controls import mask_kinds, texture_fields
 from .session import EditRefused
 
-__all__ = ["IMAGE_SUFFIXES", "PLOT_VIEWS", "routes", "view_changes"]
+__all__ = ["IMAGE_SUFFIXES", "PLOT_VIEWS", "STATIC", "routes", "view_changes"]
 
+STATIC = Path(__file__).with_name("static")
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".exr", ".tif", ".tiff", ".hdr", ".tx")
 PLOT_VIEWS = ("slice", "polar", "albedo")
 MAX_BODY = 1 << 20
@@ -37,7 +39,7 @@ def routes(d: Any) -> list[Route]:
     """The routes of designer ``d`` (a :class:`~.server.Designer`)."""
 
     async def index(request: Request) -> Response:
-        return HTMLResponse((d_static() / "index.html").read_text(encoding="utf-8"))
+        return HTMLResponse((STATIC / "index.html").read_text(encoding="utf-8"))
 
     async def state(request: Request) -> Response:
         out = d.session.state()
@@ -154,12 +156,6 @@ def routes(d: Any) -> list[Route]:
         ("/api/export_usd", export_usd, ["POST"]),
     ]
     return [Route(path, _answering(fn), methods=methods) for path, fn, methods in table]
-
-
-def d_static():
-    from .server import STATIC
-
-    return STATIC
 
 
 def _answering(fn):

@@ -28,13 +28,13 @@ from starlette.websockets import WebSocket, WebSocketDisconnect
 from lookdev.library import Library
 
 from .guard import Guard, Roots, new_token
+from .routes import STATIC
 from .session import Session
 
 __all__ = ["DEFAULT_SIZE", "Designer", "GuardMiddleware", "free_port"]
 
 HOST = "127.0.0.1"
 DEFAULT_SIZE = (480, 270)
-STATIC = Path(__file__).with_name("static")
 CLIENT_QUEUE = 2
 
 

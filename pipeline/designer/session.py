@@ -30,6 +30,7 @@ from lookdev.library.preset import MODELS, build_preset, preset_document
 from lookdev.materials.errors import LookdevError
 
 from . import saving
+from .edits import EditRefused, apply
 
 __all__ = ["BLEND_RESOLUTION", "EditRefused", "Session"]
 
@@ -38,10 +39,6 @@ BLEND_RESOLUTION = 256
 BLEND_CACHE = 16
 UNDO_DEPTH = 200
 NEW_NAME = "untitled"
-
-
-class EditRefused(LookdevError):
-    """An edit the schema (or the resolver) refuses: nothing was applied."""
 
 
 class Session:
@@ -208,8 +205,6 @@ class Session:
     # -- editing ---------------------------------------------------------------------------
     def edit(self, op: dict[str, Any]) -> None:
         """Apply one edit (see :func:`.edits.apply`); refused edits raise :class:`EditRefused`."""
-        from .edits import apply
-
         with self.lock:
             candidate = apply(copy.deepcopy(self.doc), op, self)
             self._check(candidate)
