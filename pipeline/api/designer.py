@@ -69,9 +69,15 @@ def designer(
         Viewport pixels (width, height).
     """
     from lookdev.pipeline.designer.server import Designer
+    from lookdev.pipeline.proof import ibl as ibls
 
     from .materials import library_for
 
+    ibls.load(ibl, 64)  # an unknown IBL is one line now, not an error in the page later
+    if geometry is not None and not Path(geometry).is_file():
+        from lookdev.materials.errors import LookdevError
+
+        raise LookdevError("no such mesh file", where=str(geometry), field="--geometry")
     if isinstance(presets, str | Path):
         presets = [presets]
     app = Designer(
