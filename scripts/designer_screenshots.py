@@ -21,6 +21,7 @@ FLAGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networking"]
 FLAGS += ["--disable-component-update", "--disable-quic", "--disable-sync", "--no-first-run"]
 PARTS = {"viewport": "#centre", "controls": "#controls", "layers": "#layers-panel"}
 PARTS |= {"library": "#library"}
+SPP = 64
 
 
 def main(out: Path, preset: str = "rusty_iron") -> None:
@@ -37,9 +38,12 @@ def main(out: Path, preset: str = "rusty_iron") -> None:
                     "Number(document.getElementById('viewport').dataset.frames || 0) > 0",
                     timeout=300_000,
                 )
-                page.wait_for_function(
-                    "document.getElementById('frame-info').textContent.includes('converged')",
-                    timeout=300_000,
+                page.wait_for_function(  # converged, or enough samples to look at
+                    "(n) => { const t = document.getElementById('frame-info').textContent;"
+                    " const m = t.match(/(\\d+) spp/);"
+                    " return t.includes('converged') || (m && Number(m[1]) >= n); }",
+                    arg=SPP,
+                    timeout=600_000,
                 )
                 time.sleep(20)  # the plot and the thumbnails
                 page.screenshot(path=str(out / "page.png"))
