@@ -743,3 +743,7 @@ app.command("noise")(noise_)
 app.command("proof")(proof_)
 app.command("subsurface")(subsurface_)
 app.command("usd")(usd_)
+
+from .bench_designer import designer_  # noqa: E402 - the designer's bench, in its own module
+
+app.command("designer")(designer_)
