@@ -20,7 +20,7 @@ At 480×270 unless stated, on the proof scene under ``studio``:
     cache) and scenes rebuilt over 100 random edits after the first frame. Target 0.
 ``designer_vs_truth``
     per preset of the main job's set (:data:`lookdev.pipeline.api.REPRESENTATIVE`), at
-    ``compare_size``: relative MSE (Rousselle et al. 2011, as ``lookdev bench error``) of
+    ``compare_size``: relative MSE (:cite:`Rousselle2011`, as ``lookdev bench error``) of
     the converged designer image against truth (the path tracer), over the material's
     pixels and the whole frame, with the shares that explain it: truth with direct light
     only (path depth 2: what inter-reflection adds) and designer without shadow rays.

@@ -1,4 +1,4 @@
-"""Designer mode (Burley 2012 §6.1): a g-buffer of the proof scene relit per edit.
+"""Designer mode (:cite:`Burley2012` §6.1): a g-buffer of the proof scene relit per edit.
 
 The scene is the proofs' (:func:`lookdev.pipeline.proof.shaderball.scene_dict`) with a
 stand-in BSDF on the material's shapes: it is only intersected, never path traced, so

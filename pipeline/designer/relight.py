@@ -1,7 +1,7 @@
 """Designer-mode shading: the g-buffer relit by the environment with the model's own maths.
 
 Each pass shades every pixel of the g-buffer (:mod:`.gbuffer`) once per sample with two
-strategies combined by the power heuristic (Veach 1997 §9.2): a direction drawn from the
+strategies combined by the power heuristic (:cite:`Veach1997` §9.2): a direction drawn from the
 environment by Mitsuba's importance sampling of the ``envmap`` (the scene's own emitter,
 so rotating its ``to_world`` rotates the lighting and nothing else), and a direction drawn
 by the model's ``sample``. The material's pixels are shaded by the model's core functions
