@@ -1,6 +1,6 @@
 """``lookdev.designer(...)``: the Material Designer from Python (and from a notebook).
 
-Burley 2012 §6.1's interactive loop: a local web page whose viewport relights the
+The interactive loop of :cite:`Burley2012` §6.1: a local web page whose viewport relights the
 material as every parameter and layer is edited, saving presets into the library.
 """
 

@@ -1,4 +1,4 @@
-"""``lookdev designer``: the Material Designer, a local web page (Burley 2012 §6.1)."""
+"""``lookdev designer``: the Material Designer, a local web page (:cite:`Burley2012` §6.1)."""
 
 from __future__ import annotations
 

@@ -5,7 +5,7 @@ here from the schema (kind, allowed range, default, documentation, whether a tex
 drive it) and draws a slider, a colour, a switch or a choice. Values are checked on the
 server by the same model (:mod:`.session`); the range here only shapes the slider.
 
-Sliders span the plausible range (Burley 2012 §5.1: 0..1 for most parameters); the
+Sliders span the plausible range (:cite:`Burley2012` §5.1: 0..1 for most parameters); the
 number box beside accepts the schema's whole range, so ``specular`` may be pushed to its
 ceiling and ``roughness`` 1.5 is refused with the schema's message.
 

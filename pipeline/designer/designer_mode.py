@@ -1,4 +1,4 @@
-"""Designer mode (Burley 2012 §6.1): a g-buffer of the proof scene relit per edit.
+"""Designer mode (:cite:`Burley2012` §6.1): a g-buffer of the proof scene relit per edit.
 
 The scene is the proofs' (:func:`lookdev.pipeline.proof.shaderball.scene_dict`) with a
 stand-in BSDF on the material's shapes: it is only intersected, never path traced, so
@@ -119,26 +119,35 @@ class DesignerMode:
 
     @property
     def spp(self) -> int:
-        """Samples per pixel of the image: the least of the parts'."""
-        return min(p.spp for p in self.parts.values())
+        """Samples per pixel of the material's pixels (the rest of the frame refines
+        after them, see :meth:`step`); of the rest when no material is in view."""
+        material = self.parts["material"]
+        return material.spp if material.mask.any() else self.parts["other"].spp
 
     def step(self) -> np.ndarray:
-        """One pass of each part that has not converged; the image (H, W, 3) float32."""
-        layers = len(self.gbuffer.material)
-        for name, part in self.parts.items():
-            if part.converged:
-                continue
-            n = self.passes[name]
-            spp = FIRST_SPP if n == 0 else max(1, min(LATER_SPP, part.max_spp - part.spp))
-            seed = (self.seed << 24) ^ (n << 1) ^ (name == "other")
-            shaded = self.relighter.shade(self.gbuffer, name, n % layers, seed, spp)
-            if shaded is not None:
-                pixels, rgb = shaded
-                part.add(rgb, n % layers, spp, pixels)
-            else:
-                part.spp += spp  # nothing of this part at that position
-            self.passes[name] = n + 1
+        """One pass; the image (H, W, 3) float32.
+
+        A part with no samples (after an edit, the material; after an IBL turn, both) is
+        shaded first; then the material refines until it converges, then the rest.
+        """
+        empty = [name for name, part in self.parts.items() if part.spp == 0]
+        waiting = [name for name, part in self.parts.items() if not part.converged]
+        for name in empty or waiting[:1]:
+            self._pass(name)
         return self.image()
+
+    def _pass(self, name: str) -> None:
+        part, n = self.parts[name], self.passes[name]
+        layers = len(self.gbuffer.material)
+        spp = FIRST_SPP if n == 0 else max(1, min(LATER_SPP, part.max_spp - part.spp))
+        seed = (self.seed << 24) ^ (n << 1) ^ (name == "other")
+        shaded = self.relighter.shade(self.gbuffer, name, n % layers, seed, spp)
+        if shaded is not None:
+            pixels, rgb = shaded
+            part.add(rgb, n % layers, spp, pixels)
+        else:
+            part.spp += spp  # nothing of this part at that position
+        self.passes[name] = n + 1
 
     def image(self) -> np.ndarray:
         """The accumulated image (H, W, 3) float32: each part over the sub-pixel

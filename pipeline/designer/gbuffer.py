@@ -1,6 +1,6 @@
 """The designer mode's geometry buffer: what the camera sees, rendered once per pose.
 
-Burley 2012 §6.1: the Material Designer "renders out a geometry buffer (or g-buffer)
+:cite:`Burley2012` §6.1: the Material Designer "renders out a geometry buffer (or g-buffer)
 containing normals, object IDs, and material layer masks" and relights it while the
 material is edited. Here the buffer is made by Mitsuba's own ray intersection on the proof
 scene (:func:`lookdev.pipeline.proof.shaderball.scene_dict`: the ball and the cup, or a
@@ -167,6 +167,8 @@ def render(scene: Any, width: int, height: int, subpixels: int = SUBPIXELS) -> G
         view = -_np(ray.d)
         is_mat = np.isin(oid, material_ids)
         m, o = np.flatnonzero(is_mat), np.flatnonzero(~is_mat)
+        # Objects first, background last: SIMD packets then mostly share one branch.
+        o = np.concatenate([o[oid[o] != 0], o[oid[o] == 0]])
         hit = oid[o] != 0
         material.append(
             (

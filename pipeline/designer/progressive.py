@@ -28,7 +28,8 @@ class Part:
     """Accumulated passes of one set of pixels over ``layers`` sub-pixel positions.
 
     :meth:`add` takes a pass's mean of ``spp`` samples per pixel at one position;
-    passes at a position alternate between its halves.
+    passes at a position alternate between its halves. The noise is estimated again
+    once per round of positions (each estimate reads every position's halves).
     """
 
     def __init__(
@@ -43,25 +44,34 @@ class Part:
         self.reset()
 
     def reset(self) -> None:
-        shape = (self.layers, 2, self.pixels, 3)
-        self.sums = np.zeros(shape, np.float64)
+        self.sums = np.zeros((self.layers, 2, self.pixels, 3), np.float32)
         self.counts = np.zeros((self.layers, 2), np.int64)
         self.spp = 0
-        self.noise: float | None = None
         self.mask = np.zeros(self.pixels, bool)
+        self.passes = 0
+        self._noise: tuple[int, float | None] = (-self.layers, None)
 
     def add(self, rgb: np.ndarray, layer: int, spp: int, pixels: np.ndarray) -> None:
         """Add a pass of ``spp`` samples per pixel at sub-pixel position ``layer``:
-        ``rgb`` (N, 3), the mean of its samples at ``pixels`` (N flat indices)."""
+        ``rgb`` (N, 3), the mean of its samples at ``pixels`` (N distinct flat indices)."""
         half = int(self.counts[layer, 0] > self.counts[layer, 1])
-        self.sums[layer, half, pixels] += np.asarray(rgb, np.float64) * spp
+        self.sums[layer, half, pixels] += np.asarray(rgb, np.float32) * np.float32(spp)
         self.counts[layer, half] += spp
         self.mask[pixels] = True
         self.spp += spp
-        halves = self.halves()
-        if halves is not None:
-            a, b = halves
-            self.noise = estimate(a[self.mask], b[self.mask]).relative
+        self.passes += 1
+
+    @property
+    def noise(self) -> float | None:
+        """The relative noise of the mean (None until both halves have passes)."""
+        if self.passes - self._noise[0] >= self.layers:
+            halves = self.halves()
+            value = None
+            if halves is not None:
+                a, b = halves
+                value = estimate(a[self.mask], b[self.mask]).relative
+            self._noise = (self.passes, value)
+        return self._noise[1]
 
     def done(self) -> np.ndarray:
         """The sub-pixel positions that have at least one pass."""
@@ -70,11 +80,11 @@ class Part:
     def mean(self, layers: np.ndarray | None = None) -> np.ndarray:
         """(H·W, 3): each position's mean, averaged over ``layers`` (default: done ones)."""
         layers = self.done() if layers is None else layers
-        out = np.zeros((self.pixels, 3), np.float64)
+        out = np.zeros((self.pixels, 3), np.float32)
         for layer in layers:
             total = self.counts[layer].sum()
             if total:
-                out += self.sums[layer].sum(axis=0) / total
+                out += (self.sums[layer, 0] + self.sums[layer, 1]) * np.float32(1.0 / total)
         return out / max(len(layers), 1)
 
     def halves(self) -> tuple[np.ndarray, np.ndarray] | None:
@@ -90,4 +100,5 @@ class Part:
     def converged(self) -> bool:
         if self.spp >= self.max_spp:
             return True
-        return self.noise is not None and self.noise <= self.noise_target
+        noise = self.noise
+        return noise is not None and noise <= self.noise_target

@@ -1,7 +1,7 @@
 """Designer-mode shading: the g-buffer relit by the environment with the model's own maths.
 
 Each pass shades every pixel of the g-buffer (:mod:`.gbuffer`) once per sample with two
-strategies combined by the power heuristic (Veach 1997 §9.2): a direction drawn from the
+strategies combined by the power heuristic (:cite:`Veach1997` §9.2): a direction drawn from the
 environment by Mitsuba's importance sampling of the ``envmap`` (the scene's own emitter,
 so rotating its ``to_world`` rotates the lighting and nothing else), and a direction drawn
 by the model's ``sample``. The material's pixels are shaded by the model's core functions
@@ -180,20 +180,22 @@ def _material_pass(model: Any, params: Any, shadows: bool) -> Any:
         wi = frame.to_local(ds.d)
         f = mi.Vector3f(model.eval(xp, pr, wi, wo))
         p_bsdf = mi.Float(model.pdf(xp, pr, wi, wo))
-        ok = _visible(scene, it, ds.d, shadows, (ds.pdf > 0) & (wi.z > 0))
-        if shadows:
-            ok = ok | ((ds.pdf > 0) & (wi.z <= 0))  # transmission: seen straight through
-        weight = f * dr.abs(wi.z) * _power(ds.pdf, p_bsdf)
-        total = dr.select(ok, weight * mi.Vector3f(radiance), 0.0)
+        light = f * dr.abs(wi.z) * _power(ds.pdf, p_bsdf) * mi.Vector3f(radiance)
         # The model's strategy.
         u = mi.Vector3f(rng.next_float32(), rng.next_float32(), rng.next_float32())
         wi2, value, pdf2, delta = model.sample(xp, pr, wo, u)
         wi2 = mi.Vector3f(wi2)
         d2 = frame.to_world(wi2)
         mis = dr.select(mi.Bool(delta), 1.0, _power(mi.Float(pdf2), _env_pdf(emitter, it, d2)))
-        ok2 = mi.Float(pdf2) > 0
-        seen = _visible(scene, it, d2, shadows, ok2 & (wi2.z > 0)) | (ok2 & (wi2.z <= 0))
-        total += dr.select(seen, mi.Vector3f(value) * mi.Vector3f(_env(emitter, d2)) * mis, 0.0)
+        reflected = mi.Vector3f(value) * mi.Vector3f(_env(emitter, d2)) * mis
+        ok1, ok2 = ds.pdf > 0, mi.Float(pdf2) > 0
+        # Both strategies' values in one kernel before the shadow rays (a ray test splits
+        # the kernel, and anything left unevaluated would be computed again after it).
+        dr.schedule(light, reflected, ds.d, d2, wi.z, wi2.z, ok1, ok2)
+        # Transmission sees the environment straight through (no shadow ray).
+        seen1 = _visible(scene, it, ds.d, shadows, ok1 & (wi.z > 0)) | (ok1 & (wi.z <= 0))
+        seen2 = _visible(scene, it, d2, shadows, ok2 & (wi2.z > 0)) | (ok2 & (wi2.z <= 0))
+        total = dr.select(seen1, light, 0.0) + dr.select(seen2, reflected, 0.0)
         out = dr.block_sum(total, spp) / spp if spp > 1 else total
         return out
 
@@ -221,17 +223,18 @@ def _other_pass(shadows: bool) -> Any:
             it, mi.Point2f(rng.next_float32(), rng.next_float32()), diffuse
         )
         cos = dr.dot(ds.d, g["n"])
-        ok = _visible(scene, it, ds.d, shadows, diffuse & (cos > 0) & (ds.pdf > 0))
-        total = dr.select(
-            ok, albedo * INV_PI * cos * _power(ds.pdf, cos * INV_PI) * mi.Vector3f(radiance), 0.0
-        )
+        ok1 = diffuse & (cos > 0) & (ds.pdf > 0)
+        light = albedo * INV_PI * cos * _power(ds.pdf, cos * INV_PI) * mi.Vector3f(radiance)
         local = mi.warp.square_to_cosine_hemisphere(
             mi.Point2f(rng.next_float32(), rng.next_float32())
         )
         d = frame.to_world(local)
-        ok = _visible(scene, it, d, shadows, diffuse & (local.z > 0))
-        mis = _power(local.z * INV_PI, _env_pdf(emitter, it, d))
-        total += dr.select(ok, albedo * mis * mi.Vector3f(_env(emitter, d)), 0.0)
+        ok2 = diffuse & (local.z > 0)
+        reflected = albedo * _power(local.z * INV_PI, _env_pdf(emitter, it, d))
+        reflected *= mi.Vector3f(_env(emitter, d))
+        dr.schedule(light, reflected, ds.d, d, ok1, ok2)  # before the rays (see above)
+        total = dr.select(_visible(scene, it, ds.d, shadows, ok1), light, 0.0)
+        total += dr.select(_visible(scene, it, d, shadows, ok2), reflected, 0.0)
         # Mirrors (the chrome ball) see the environment along their reflected direction.
         total += mi.Vector3f(g["mirror_w"]) * mi.Vector3f(_env(emitter, g["mirror_d"]))
         total = dr.select(hit, total, mi.Vector3f(_env(emitter, -g["view"])))

@@ -1,6 +1,6 @@
 """The Material Designer's viewport: one material in the proof scene, in two modes.
 
-``designer`` (Burley 2012 §6.1) relights a g-buffer of the scene with the model's own
+``designer`` (:cite:`Burley2012` §6.1) relights a g-buffer of the scene with the model's own
 Dr.Jit evaluation and sampling against the IBL (:mod:`.designer_mode`, :mod:`.relight`):
 fast, direct lighting only. ``truth`` path traces the proofs' scene with the proofs'
 plugin, edited in place (:mod:`.truth`). Both refine progressively while nothing

@@ -221,6 +221,11 @@ def _plugin_class(variant: str) -> type:
             )
             self.lobes = lobes_of(prepared)
             """The lobes this instance traces (the model's live lobes, or ``only_lobes``)."""
+            # A constant material's prepare is the same at every hit and in every call:
+            # computed here once, not traced again by each eval/pdf/sample of each render
+            # (it was most of the model's tracing time, lookdev bench eval).
+            constant = not (self.textures or self.force_all_lobes or self.live)
+            self._constant_prepared = prepared if constant else None
             kinds = sorted(lobe_kinds(self.lobes, self.model, delta_lobes(prepared)))
             # Components: reflection and transmission with a density, then the deltas.
             groups = [
@@ -278,6 +283,8 @@ def _plugin_class(variant: str) -> type:
             return opaque_inputs(self.model, self.params, skip=self.textures)
 
         def _prepare(self, si: mi.SurfaceInteraction3f, active: mi.Bool) -> Any:
+            if self._constant_prepared is not None:
+                return self._constant_prepared
             maps = self._forced()
             for key, tex in self.textures.items():
                 if is_color_field(self.model.params_type, key):
