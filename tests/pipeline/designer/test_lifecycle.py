@@ -102,3 +102,20 @@ def test_ab_split_renders_the_reference_beside(client, designer):
         while views != {"A", "B"}:
             views.add(_frame(ws)["view"])
     assert designer.ab_against == "parent" and designer.renderer.view["ab"]
+
+
+def test_from_python_without_blocking(user_library, capsys):
+    import httpx
+
+    import lookdev
+
+    handle = lookdev.designer("gold", library=user_library, block=False, size=(32, 18))
+    try:
+        assert capsys.readouterr().out.strip() == f"lookdev designer: {handle.url}"
+        assert handle.url in handle._repr_html_()
+        assert httpx.get(handle.url + "api/state").json()["name"] == "gold"
+        assert httpx.get(handle.url.rsplit("/", 2)[0] + "/api/state").status_code == 403
+    finally:
+        handle.stop()
+    with pytest.raises(httpx.ConnectError):
+        httpx.get(handle.url + "api/state", timeout=2)
