@@ -119,3 +119,15 @@ def test_from_python_without_blocking(user_library, capsys):
         handle.stop()
     with pytest.raises(httpx.ConnectError):
         httpx.get(handle.url + "api/state", timeout=2)
+
+
+@pytest.mark.render
+def test_the_mode_switch_and_the_raw_toggle(client, designer):
+    t = designer.token
+    with client.websocket_connect(f"ws://127.0.0.1:{designer.port}/{t}/ws") as ws:
+        assert _frame(ws)["mode"] == "designer"
+        ws.send_json({"mode": "truth", "raw": True})
+        while (m := _frame(ws))["mode"] != "truth":
+            pass
+        assert not m["denoised"]  # raw: the frame before denoising, whatever the engine did
+    assert designer.renderer.view["mode"] == "truth" and designer.renderer.view["raw"]
