@@ -34,6 +34,7 @@ __all__ = [
     "export_usd",
     "hub",
     "load",
+    "measured",
     "models",
     "pdf",
     "plot",

@@ -19,7 +19,7 @@ over :data:`PARAM_SETS` (eight materials that between them switch on every lobe)
   whose pruned constant-parameter form is smaller than ``principled``'s general one;
   target ``ratio_drjit_frozen_to_mitsuba`` ≥ 1.5);
 - ``mitsuba``: the C++ ``principled`` plugin with the nearest parameters (see
-  :func:`principled_dict`; the two models differ where DESIGN.md says), same pairs.
+  :func:`principled_dict`; the two models differ where :doc:`/design` says), same pairs.
 
 Reported: evaluations per second of each, per material too (``by_material``: each form's
 rate and its ratio to ``principled`` on that material), and the throughput ratios
@@ -116,7 +116,7 @@ def mitsuba_eval(bsdf: Any, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
     return np.where(cos[:, None] > 0, f / np.maximum(cos[:, None], 1e-30), 0.0)
 
 
-# Where the two models coincide (DESIGN.md, Traps): model restricted to some lobes (None:
+# Where the two models coincide (docs/design.md, Traps): model restricted to some lobes (None:
 # all of ours), our parameters; Mitsuba gets principled_dict(params). With specular = 0
 # Mitsuba's exact Fresnel is 0 everywhere, so its total is its diffuse (+ sheen) alone.
 AGREEMENT_CASES: dict[str, tuple[tuple[str, ...] | None, DisneyParams]] = {
