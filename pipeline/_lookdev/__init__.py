@@ -28,6 +28,7 @@ __all__ = [
     "blend",
     "check",
     "colour_settings",
+    "designer",
     "evaluate",
     "export_mitsuba",
     "export_usd",

@@ -18,6 +18,7 @@ CLI prints.
 :func:`proof`            turntable proofs, materials × IBLs, resumable; the manifest
 :func:`plot`             BRDF-explorer views of materials, side by side
 :func:`check`            the stability sweep of every reflectance model
+:func:`designer`         the Material Designer: a local web page, a live viewport
 :data:`models`           the reflectance models by name
 :func:`colour_settings`  a ``with`` block: OCIO config, working space, display/view/look
 =======================  ==========================================================
@@ -47,6 +48,7 @@ need them, never by ``import lookdev``.
 from lookdev.library.display import register_swatch
 from lookdev.materials.colour import use as colour_settings
 
+from .designer import DesignerHandle, designer
 from .materials import (
     EVALUATE_RESOLUTION,
     LookdevError,
@@ -90,8 +92,10 @@ __all__ = [
     "UsdExport",
     "bake",
     "blend",
+    "DesignerHandle",
     "check",
     "colour_settings",
+    "designer",
     "evaluate",
     "export_mitsuba",
     "export_usd",

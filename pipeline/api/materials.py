@@ -174,6 +174,7 @@ def blend(
     prune: bool = True,
     progress: Callable[[int, int], None] | None = None,
     library: Any = None,
+    images: dict | None = None,
 ) -> BlendedMaterial:
     """Blend a material's layers into constants (where uniform) and maps (where not).
 
@@ -194,6 +195,9 @@ def blend(
         Called as ``progress(rows_done, rows_total)`` after each tile.
     library
         See :func:`load`.
+    images
+        A dict kept across calls: decoded textures and mask sources are reused from it,
+        so re-blending after an edit decodes nothing again (the designer keeps one).
 
     Returns
     -------
@@ -215,7 +219,9 @@ def blend(
     from lookdev.pipeline.blend.surface_maps import attach
 
     material = _material(material, library)
-    result = blend_material(material, resolution, progress=progress, prune=prune, layering=layering)
+    result = blend_material(
+        material, resolution, progress=progress, prune=prune, layering=layering, images=images
+    )
     return attach(result, material)
 
 

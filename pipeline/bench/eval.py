@@ -8,13 +8,21 @@ over :data:`PARAM_SETS` (eight materials that between them switch on every lobe)
   float64, channel-first arrays prepared beforehand (the layout change of the public
   wrappers is not evaluation);
 - ``drjit``: the same Python model traced by Dr.Jit (LLVM), forced with ``dr.eval`` and
-  waited for; the first call (tracing + kernel compilation, or a hit in Dr.Jit's on-disk
-  kernel cache after an earlier run) is reported on its own and excluded from the
-  throughput;
+  waited for, as the plugin evaluates a constant material: its ``prepare`` once, ``eval``
+  traced in every call; the first call (tracing + kernel compilation, or a hit in Dr.Jit's
+  on-disk kernel cache after an earlier run) is reported on its own and excluded from the
+  throughput. Beside it, in the same rounds: ``drjit_prepare_each_call`` (``prepare``
+  traced again in every call, as the plugin did before it kept a constant material's
+  prepare: most of the tracing time, which at 125 000 evaluations a material is about half
+  of a call) and ``drjit_frozen`` (the call recorded once by ``dr.freeze`` and replayed,
+  as the proofs' turntable and the designer's passes run the model: the kernel alone,
+  whose pruned constant-parameter form is smaller than ``principled``'s general one;
+  target ``ratio_drjit_frozen_to_mitsuba`` ≥ 1.5);
 - ``mitsuba``: the C++ ``principled`` plugin with the nearest parameters (see
   :func:`principled_dict`; the two models differ where :doc:`/design` says), same pairs.
 
-Reported: evaluations per second of each and the throughput ratios
+Reported: evaluations per second of each, per material too (``by_material``: each form's
+rate and its ratio to ``principled`` on that material), and the throughput ratios
 ``ratio_drjit_to_mitsuba`` (target ≥ 0.5) and ``ratio_numpy_to_mitsuba`` (target ≥ 0.1,
 with the faster numpy dtype, named in ``numpy_dtype``). What pruning buys is measured
 too: numpy float32 with every lobe kept at weight zero (``ratio_pruned_to_every_lobe``,
@@ -202,62 +210,91 @@ def _numpy_runner(wi: np.ndarray, wo: np.ndarray, dtype: Any, prune: bool = True
     return run
 
 
-def _drjit_runner(wi: np.ndarray, wo: np.ndarray):
+def _drjit_runner(wi: np.ndarray, wo: np.ndarray, mode: str = "prepared"):
+    """Per-material callables of the Python model traced by Dr.Jit.
+
+    ``mode``: ``"prepared"`` as the plugin evaluates a constant material (``prepare`` run
+    once, ``eval`` traced per call); ``"prepare_each_call"`` with ``prepare`` traced
+    again in every call (the plugin before it kept a constant material's prepare);
+    ``"frozen"``: the call recorded once by ``dr.freeze`` and replayed, as the proofs'
+    turntable and the designer's passes run it.
+    """
     import drjit as dr
     import mitsuba as mi
 
     from lookdev.materials.arrays import DrJitOps
 
     xp = DrJitOps.for_mitsuba()
+    model = disney.MODEL
     parts = [(_vectors(mi, wi[s]), _vectors(mi, wo[s])) for s in _split(len(wi))]
     dr.eval(parts)
+    runners = []
+    for params, (a, b) in zip(PARAM_SETS.values(), parts, strict=True):
+        prepared = model.prepare(xp, params)
 
-    def run() -> list[Any]:
-        model = disney.MODEL
-        out = [
-            model.eval(xp, model.prepare(xp, p), a, b)
-            for p, (a, b) in zip(PARAM_SETS.values(), parts, strict=True)
-        ]
-        dr.eval(out)
-        dr.sync_thread()
-        return out
+        def call(a: Any, b: Any, params: Any = params, prepared: Any = prepared) -> Any:
+            pr = model.prepare(xp, params) if mode == "prepare_each_call" else prepared
+            return model.eval(xp, pr, a, b)
 
-    return run
+        fn = dr.freeze(call) if mode == "frozen" else call
+
+        def run(fn: Any = fn, a: Any = a, b: Any = b) -> Any:
+            out = fn(a, b)
+            dr.eval(out)
+            dr.sync_thread()
+            return out
+
+        runners.append(run)
+    return runners
 
 
 def _mitsuba_runner(wi: np.ndarray, wo: np.ndarray):
     import drjit as dr
     import mitsuba as mi
 
-    bsdfs = [mi.load_dict(principled_dict(p)) for p in PARAM_SETS.values()]
     ctx = mi.BSDFContext()
-    parts = []
-    for s in _split(len(wi)):
+    runners = []
+    for p, s in zip(PARAM_SETS.values(), _split(len(wi)), strict=True):
+        bsdf = mi.load_dict(principled_dict(p))
         si = dr.zeros(mi.SurfaceInteraction3f, s.stop - s.start)
         si.wi = _vectors(mi, wo[s])
-        parts.append((si, _vectors(mi, wi[s])))
-    dr.eval(parts)
+        w = _vectors(mi, wi[s])
+        dr.eval(si, w)
 
-    def run() -> list[Any]:
-        out = [b.eval(ctx, si, w) for b, (si, w) in zip(bsdfs, parts, strict=True)]
-        dr.eval(out)
-        dr.sync_thread()
-        return out
+        def run(bsdf: Any = bsdf, si: Any = si, w: Any = w) -> Any:
+            out = bsdf.eval(ctx, si, w)
+            dr.eval(out)
+            dr.sync_thread()
+            return out
 
-    return run
+        runners.append(run)
+    return runners
+
+
+def _all(runners: list[Any]) -> Any:
+    return lambda: [r() for r in runners]
 
 
 def _timed(fn: Any) -> float:
-    t0 = time.perf_counter()
+    """CPU seconds of the process (every thread) for ``fn()``: on a shared machine, wall
+    time measures the other users' load as much as the code."""
+    t0 = time.process_time()
     fn()
-    return time.perf_counter() - t0
+    return time.process_time() - t0
+
+
+DRJIT_MODES = ("prepared", "prepare_each_call", "frozen")
+TARGET_FROZEN = 1.5
 
 
 def run(n: int = 1_000_000, *, repeat: int = 5, progress: Any = None) -> dict[str, Any]:
     """Every figure of the benchmark (see the module docstring).
 
-    The backends are timed in interleaved rounds (each once per round, best of
-    ``repeat`` rounds kept), so a change in machine load between them skews no ratio.
+    The backends are timed in CPU seconds in interleaved rounds (each once per round,
+    best of ``repeat`` rounds kept), so a change in machine load between them skews no
+    ratio;
+    the Dr.Jit forms and Mitsuba are timed material by material, so every material's
+    ratio is measured too (the totals are the sums of the materials' best times).
     """
     from lookdev.pipeline.variant import use_mitsuba
 
@@ -267,17 +304,36 @@ def run(n: int = 1_000_000, *, repeat: int = 5, progress: Any = None) -> dict[st
         "numpy_float32": _numpy_runner(wi, wo, np.float32),
         "numpy_float64": _numpy_runner(wi, wo, np.float64),
         "numpy_every_lobe": _numpy_runner(wi, wo, np.float32, prune=False),
-        "drjit": _drjit_runner(wi, wo),
-        "mitsuba": _mitsuba_runner(wi, wo),
     }
+    split = {f"drjit_{m}": _drjit_runner(wi, wo, m) for m in DRJIT_MODES}
+    split["mitsuba"] = _mitsuba_runner(wi, wo)
     first = {name: _timed(fn) for name, fn in runners.items()}
+    first |= {name: _timed(_all(fns)) for name, fns in split.items()}
+    for fns in split.values():  # a second call: a frozen function records its replay
+        _all(fns)()
     best = dict.fromkeys(runners, math.inf)
+    per = {name: [math.inf] * len(PARAM_SETS) for name in split}
     for round_ in range(repeat):
         if progress is not None:
             progress(round_)
         for name, fn in runners.items():
             best[name] = min(best[name], _timed(fn))
+        for k in range(len(PARAM_SETS)):
+            for name, fns in split.items():
+                per[name][k] = min(per[name][k], _timed(fns[k]))
+    for name, times in per.items():
+        best[name] = sum(times)
     rate = {k: n / v for k, v in best.items()}
+    sizes = [s.stop - s.start for s in _split(n)]
+    by_material = {
+        material: {name: sizes[k] / per[name][k] for name in split}
+        | {
+            f"ratio_{name}_to_mitsuba": per["mitsuba"][k] / per[name][k]
+            for name in split
+            if name != "mitsuba"
+        }
+        for k, material in enumerate(PARAM_SETS)
+    }
     numpy_dtype = max(("float32", "float64"), key=lambda d: rate[f"numpy_{d}"])
     return {
         "n": n,
@@ -285,17 +341,25 @@ def run(n: int = 1_000_000, *, repeat: int = 5, progress: Any = None) -> dict[st
         "variant": variant,
         "evals_per_s_numpy_float32": rate["numpy_float32"],
         "evals_per_s_numpy_float64": rate["numpy_float64"],
-        "evals_per_s_drjit": rate["drjit"],
+        "evals_per_s_drjit": rate["drjit_prepared"],
+        "evals_per_s_drjit_prepare_each_call": rate["drjit_prepare_each_call"],
+        "evals_per_s_drjit_frozen": rate["drjit_frozen"],
         "evals_per_s_mitsuba": rate["mitsuba"],
-        "drjit_first_call_s": first["drjit"],
+        "drjit_first_call_s": first["drjit_prepared"],
+        "drjit_frozen_first_call_s": first["drjit_frozen"],
         "mitsuba_first_call_s": first["mitsuba"],
         "numpy_dtype": numpy_dtype,
-        "ratio_drjit_to_mitsuba": rate["drjit"] / rate["mitsuba"],
+        "ratio_drjit_to_mitsuba": rate["drjit_prepared"] / rate["mitsuba"],
+        "ratio_drjit_prepare_each_call_to_mitsuba": rate["drjit_prepare_each_call"]
+        / rate["mitsuba"],
+        "ratio_drjit_frozen_to_mitsuba": rate["drjit_frozen"] / rate["mitsuba"],
         "ratio_numpy_to_mitsuba": rate[f"numpy_{numpy_dtype}"] / rate["mitsuba"],
         "evals_per_s_numpy_every_lobe": rate["numpy_every_lobe"],
         "ratio_pruned_to_every_lobe": rate["numpy_float32"] / rate["numpy_every_lobe"],
         "every_lobe_max_abs_diff": _max_diff(runners["numpy_float32"], runners["numpy_every_lobe"]),
+        "by_material": by_material,
         "target_drjit": 0.5,
+        "target_drjit_frozen": TARGET_FROZEN,
         "target_numpy": 0.1,
     }
 

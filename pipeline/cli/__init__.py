@@ -29,6 +29,7 @@ COMMANDS = {
     "import": Lazy(".export_usd:import_app", "Read materials written by other tools back."),
     "validate": Lazy(".export_usd:validate_app", "Check exported files as their readers will."),
     "proof": Lazy(".proof:proof", "Render turntable proofs: every preset under every IBL."),
+    "designer": Lazy(".designer:designer", "Develop a look interactively in a local web page."),
     "check": Lazy(".check:check", "Sweep every model over its stiff and extreme cases."),
     "colour": Lazy(".colour:app", "List the OCIO config's colour spaces, views and looks."),
     "bench": Lazy(".bench:app", "Measure performance targets against baselines run alongside."),

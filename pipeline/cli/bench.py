@@ -26,6 +26,9 @@ COMMANDS = {
     "depth": Lazy(
         ".bench_depth:depth_", "The proof scene at each material's path depth vs a deep reference."
     ),
+    "designer": Lazy(
+        ".bench_designer:designer_", "The designer's viewport: edit, rotation and convergence."
+    ),
     "error": Lazy(
         ".bench_error:error_", "Error against run time of every approximation lookdev makes."
     ),

@@ -1,4 +1,4 @@
-"""The Python API (``import lookdev``): its contract, and the README's example running."""
+"""The Python API (``import lookdev``): its contract, and the guide's example running."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ import lookdev
 from lookdev.materials.bsdf import Model
 from lookdev.materials.pixar import LAYERED_MODEL
 
-README = Path(__file__).resolve().parents[2] / "README.md"
+GUIDE = Path(__file__).resolve().parents[2] / "docs" / "guide" / "python.md"
 RNG = np.random.default_rng(7)
 
 
@@ -244,20 +244,18 @@ def test_check_returns_the_findings():
         lookdev.check(["no_such_model"])
 
 
-# -- proofs and the README -------------------------------------------------------------------
-def _readme_example() -> str:
-    text = README.read_text(encoding="utf-8")
-    section = text.split("## Python API", 1)[1].split("\n## ", 1)[0]
-    blocks = re.findall(r"```python\n(.*?)```", section, flags=re.S)
-    assert len(blocks) == 1
+# -- proofs and the guide's example ----------------------------------------------------------
+def _guide_example() -> str:
+    """The first example of the Python API guide page."""
+    blocks = re.findall(r"```python\n(.*?)```", GUIDE.read_text(encoding="utf-8"), flags=re.S)
     return blocks[0]
 
 
 @pytest.mark.slow
 @pytest.mark.render
-def test_the_readme_example_runs(tmp_path, monkeypatch, capsys):
+def test_the_guide_example_runs(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
-    exec(compile(_readme_example(), "README.md", "exec"), {"__name__": "readme"})
+    exec(compile(_guide_example(), "python.md", "exec"), {"__name__": "readme"})
     assert (tmp_path / "looks.usda").is_file()
     manifest = json.loads((tmp_path / "proofs" / "manifest.json").read_text())
     assert [(p["material"], p["ibl"], p["frames"]) for p in manifest["proofs"]] == [

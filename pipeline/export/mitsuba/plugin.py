@@ -64,7 +64,10 @@ values, so a lobe whose weight is a constant zero is pruned while the kernel is 
 textures are evaluated at ``si`` and handed to ``prepare`` as ``maps``. With the boolean
 property ``force_all_lobes`` every numeric parameter is handed over as an opaque Dr.Jit
 value instead: no weight is then a *known* zero and every lobe is traced (the benchmark
-baseline).
+baseline). With ``live`` (the Material Designer's truth mode) those opaque values are the
+traversed parameters themselves, defaults included: ``mi.traverse`` edits of any of them
+change memory the kernel reads, never the kernel; only a switch (``thin``, a model name)
+needs a new BSDF.
 """
 
 from __future__ import annotations
@@ -83,6 +86,10 @@ from lookdev.materials.registry import is_color_field
 
 PLUGIN_PREFIX = "lookdev_"
 FORCE_ALL_LOBES = "force_all_lobes"
+LIVE = "live"
+"""Boolean property: every continuous parameter is a traversed, opaque Dr.Jit value read
+by the kernel from memory, so an edit through ``mi.traverse`` needs no new kernel (the
+designer's truth mode); every lobe a value can switch on is traced."""
 ONLY_LOBES = "only_lobes"
 """Comma-separated lobe names: the plugin evaluates and samples only these (Model.restrict)."""
 WEIGHT_SCALE = "weight_scale"
@@ -165,6 +172,7 @@ def _plugin_class(variant: str) -> type:
             self.xp = DrJitOps.for_mitsuba()
             fields = model.params_type.model_fields
             self.force_all_lobes = False
+            self.live = False
             self.only_lobes: tuple[str, ...] | None = None
             self.weight_scale = 1.0
             self.constants: dict[str, Any] = {}
@@ -173,6 +181,8 @@ def _plugin_class(variant: str) -> type:
                 value = props[key]
                 if key == FORCE_ALL_LOBES:
                     self.force_all_lobes = bool(value)
+                elif key == LIVE:
+                    self.live = bool(value)
                 elif key == ONLY_LOBES:
                     self.only_lobes = tuple(n.strip() for n in str(value).split(",") if n.strip())
                 elif key == WEIGHT_SCALE:
@@ -194,6 +204,9 @@ def _plugin_class(variant: str) -> type:
                 for k, v in self.constants.items()
                 if isinstance(v, float | tuple)
             }
+            if self.live:
+                params = self.model.params_type.parse(self.constants, where=plugin_name(model))
+                self.traversed = opaque_inputs(self.model, params, skip=self.textures)
             self._configure()
 
         # -- parameters ----------------------------------------------------------------
@@ -208,6 +221,11 @@ def _plugin_class(variant: str) -> type:
             )
             self.lobes = lobes_of(prepared)
             """The lobes this instance traces (the model's live lobes, or ``only_lobes``)."""
+            # A constant material's prepare is the same at every hit and in every call:
+            # computed here once, not traced again by each eval/pdf/sample of each render
+            # (it was most of the model's tracing time, lookdev bench eval).
+            constant = not (self.textures or self.force_all_lobes or self.live)
+            self._constant_prepared = prepared if constant else None
             kinds = sorted(lobe_kinds(self.lobes, self.model, delta_lobes(prepared)))
             # Components: reflection and transmission with a density, then the deltas.
             groups = [
@@ -256,27 +274,17 @@ def _plugin_class(variant: str) -> type:
             return dr.opaque(mi.Float, 0.5)
 
         def _forced(self) -> dict[str, Any]:
-            """Every numeric parameter as an opaque Dr.Jit value, when all lobes must be traced.
-
-            ``known_zero`` cannot see through an opaque value, so no lobe weight derived
-            from one (``spec_trans``, or ``1 − metallic`` of a metal) is pruned.
-            """
+            """Every numeric parameter as an opaque Dr.Jit value, when all lobes must be
+            traced (:func:`opaque_inputs`); in ``live`` mode the traversed values."""
+            if self.live:
+                return dict(self.traversed)
             if not self.force_all_lobes:
                 return {}
-            from lookdev.materials.textures import texturable
-
-            weights = texturable(self.model.params_type)  # not choices such as specular_gamma
-            forced = {}
-            for key, value in self.params.model_dump().items():
-                if key in self.textures or isinstance(value, bool) or key not in weights:
-                    continue
-                if isinstance(value, float):
-                    forced[key] = dr.opaque(mi.Float, value)
-                elif isinstance(value, tuple):
-                    forced[key] = self.xp.Array3(*(dr.opaque(mi.Float, c) for c in value))
-            return forced
+            return opaque_inputs(self.model, self.params, skip=self.textures)
 
         def _prepare(self, si: mi.SurfaceInteraction3f, active: mi.Bool) -> Any:
+            if self._constant_prepared is not None:
+                return self._constant_prepared
             maps = self._forced()
             for key, tex in self.textures.items():
                 if is_color_field(self.model.params_type, key):
@@ -301,6 +309,12 @@ def _plugin_class(variant: str) -> type:
 
         def parameters_changed(self, keys: list[str]) -> None:
             changed = [k for k in keys if k in self.traversed]
+            if self.live:
+                # In memory, not literals: the kernel reads them (no new kernel), and the
+                # lobes and flags depend on switches only.
+                for key in changed:
+                    dr.make_opaque(self.traversed[key])
+                return
             for key in changed:
                 self.constants[key] = _from_drjit(self.traversed[key], self.constants[key])
             if changed:
@@ -451,6 +465,33 @@ def _plugin_class(variant: str) -> type:
             return f"ModelBSDF[model={self.model.name!r}, lobes={self.m_flags!r}]"
 
     return ModelBSDF
+
+
+def opaque_inputs(model: Model, params: Any, skip: Iterable[str] = ()) -> dict[str, Any]:
+    """Every continuous parameter of ``params`` (the schema's texturable fields that hold
+    a value, defaults included) as an opaque Dr.Jit value, for ``model.prepare``'s maps.
+
+    ``known_zero`` cannot see through an opaque value, so no lobe weight derived from one
+    (``spec_trans``, or ``1 − metallic`` of a metal) is pruned, and a kernel traced with
+    these inputs reads them from memory: new values need no new kernel. Fields in ``skip``
+    (textures) are left out.
+    """
+    import drjit as dr
+    import mitsuba as mi
+
+    from lookdev.materials.textures import texturable
+
+    weights = texturable(model.params_type)  # not choices such as specular_gamma
+    skip = set(skip)
+    out: dict[str, Any] = {}
+    for key, value in params.model_dump().items():
+        if key in skip or isinstance(value, bool) or key not in weights:
+            continue
+        if isinstance(value, int | float):
+            out[key] = dr.opaque(mi.Float, float(value))
+        elif isinstance(value, tuple):
+            out[key] = mi.Vector3f(*(dr.opaque(mi.Float, float(c)) for c in value))
+    return out
 
 
 def _union(flags: list[Any], flag: Any) -> int:

@@ -33,7 +33,7 @@ from lookdev.pipeline.exr import colour_space_of
 from .depth import max_depth_for
 from .medium import integrator, interior_dict
 from .normals import with_normals
-from .plugin import FORCE_ALL_LOBES, ONLY_LOBES, MitsubaExportError, register_model
+from .plugin import FORCE_ALL_LOBES, LIVE, ONLY_LOBES, MitsubaExportError, register_model
 
 BLEND_ONLY = frozenset({"layering"})
 """Constants a blend records for the record, which no BSDF takes."""
@@ -142,6 +142,7 @@ def bsdf_dict(
     *,
     force_all_lobes: bool = False,
     allow_principled: bool = True,
+    live: bool = False,
 ) -> dict[str, Any]:
     """The Mitsuba BSDF dict of a blended material (or of a model's parameters).
 
@@ -149,16 +150,21 @@ def bsdf_dict(
     (for XML export), in-memory tensors otherwise. The plugin traces exactly the hub's
     live lobes (:attr:`BlendedMaterial.live_lobes`); ``force_all_lobes`` keeps lobes with
     zero weight traced (the pruning benchmark's baseline) and never takes the
-    ``principled`` fast path.
+    ``principled`` fast path; ``live`` too, with every continuous parameter a traversed
+    value the kernel reads from memory (the plugin's ``live`` property: the designer's
+    truth mode edits them in place).
     """
     hub = as_hub(material)
     register_plugins()
     model = hub.bsdf_model
     one_frame = hub.specular_normal_map is None
-    fast = principled_equivalent(hub) if allow_principled and one_frame else None
-    out = _plugin_dict(hub, texture_dir) if force_all_lobes or fast is None else fast
-    lobes = model.lobe_names if force_all_lobes else hub.live_lobes
-    if force_all_lobes:
+    every = force_all_lobes or live
+    fast = principled_equivalent(hub) if allow_principled and one_frame and not every else None
+    out = _plugin_dict(hub, texture_dir) if fast is None else fast
+    lobes = model.lobe_names if every else hub.live_lobes
+    if live:
+        out[LIVE] = True
+    elif force_all_lobes:
         out[FORCE_ALL_LOBES] = True
     elif hub.maps and fast is None:
         # A texture's lobes cannot be pruned while the kernel is traced: say which live.
