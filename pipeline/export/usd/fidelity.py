@@ -38,8 +38,10 @@ __all__ = [
     "ANGLES",
     "PREVIEW_SUFFIX",
     "Fidelity",
+    "Measured",
     "PreviewHub",
     "fidelity",
+    "measure",
     "preview_hub",
     "preview_params",
 ]
@@ -129,27 +131,49 @@ HIGHLIGHT_CONE_DEG = 10.0
 """The highlight is the light reflected within this angle of the mirror direction."""
 
 
-def _measure(model, params, maps: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]:
-    """E(θ) per angle and channel by the model's own sampler (fixed seed), and the part
-    of it reflected within :data:`HIGHLIGHT_CONE_DEG` of the mirror direction (the
-    highlight's energy: finite for mirrors too, unlike a peak value)."""
+@dataclass(frozen=True)
+class Measured:
+    """Directional albedo split by where the light leaves, and the highlight's energy,
+    each (angles, RGB)."""
+
+    reflected: np.ndarray
+    transmitted: np.ndarray
+    highlight: np.ndarray
+
+    @property
+    def albedo(self) -> np.ndarray:
+        return self.reflected + self.transmitted
+
+
+def measure(model, params, maps: dict[str, Any], samples: int = SAMPLES) -> Measured:
+    """E(θ) per angle and channel by the model's own sampler (fixed seed), split into the
+    light leaving above and below the surface, and the part reflected within
+    :data:`HIGHLIGHT_CONE_DEG` of the mirror direction (the highlight's energy: finite
+    for mirrors too, unlike a peak value)."""
     from lookdev.materials.bsdf import draw
 
     rng = np.random.default_rng(7)
-    maps = {k: np.broadcast_to(v, (SAMPLES, *np.shape(v))) for k, v in maps.items()}
+    maps = {k: np.broadcast_to(v, (samples, *np.shape(v))) for k, v in maps.items()}
     cone = math.cos(math.radians(HIGHLIGHT_CONE_DEG))
-    albedo, highlight = [], []
+    up, down, highlight = [], [], []
     for deg in ANGLES:
         t = math.radians(deg)
         wo = np.array([math.sin(t), 0.0, math.cos(t)])
         mirror = np.array([-wo[0], 0.0, wo[2]])
-        u = rng.random((SAMPLES, 3))
-        wi, weight, _ = draw(model, params, np.broadcast_to(wo, (SAMPLES, 3)), u, **maps)
+        u = rng.random((samples, 3))
+        wi, weight, _ = draw(model, params, np.broadcast_to(wo, (samples, 3)), u, **maps)
         weight = np.where(np.isfinite(weight), weight, 0.0)
+        above = (wi[:, 2] >= 0.0)[:, None]
         near = (wi @ mirror) >= cone
-        albedo.append(weight.mean(axis=0))
+        up.append((weight * above).mean(axis=0))
+        down.append((weight * ~above).mean(axis=0))
         highlight.append((weight * near[:, None]).mean(axis=0))
-    return np.asarray(albedo), np.asarray(highlight)
+    return Measured(np.asarray(up), np.asarray(down), np.asarray(highlight))
+
+
+def _measure(model, params, maps: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]:
+    m = measure(model, params, maps)
+    return m.albedo, m.highlight
 
 
 def fidelity(hub: Any, source: Source, preview_opacity: str = "keep") -> Fidelity:
