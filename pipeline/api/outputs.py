@@ -90,6 +90,7 @@ def export_usd(
     report: bool = False,
     collect: bool = False,
     preview_geometry: bool = False,
+    mtlx_surface: str = "openpbr",
 ) -> UsdExport:
     """Write materials as UsdShade materials under ``/Materials`` of ``path``.
 
@@ -138,6 +139,10 @@ def export_usd(
         referenced where they are, relative to ``path`` where possible.
     preview_geometry
         Add a sphere per material, bound to it, in a grid under ``/Materials/Geometry``.
+    mtlx_surface
+        The ``mtlx`` surface of Disney materials: ``"openpbr"`` (default, OpenPBR
+        Surface through :mod:`lookdev.pipeline.export.usd.openpbr_map`) or ``"disney"``
+        (``ND_disney_principled``).
 
     Returns
     -------
@@ -184,6 +189,7 @@ def export_usd(
         report=report,
         collect=collect,
         preview_geometry=preview_geometry,
+        mtlx_surface=mtlx_surface,
     )
     return UsdExport(
         result.files[0],

@@ -33,6 +33,7 @@ def export_materials(
     report: bool = False,
     collect: bool = False,
     preview_geometry: bool = False,
+    mtlx_surface: str = "openpbr",
 ):
     """Write blended materials (:class:`~lookdev.pipeline.blend.BlendedMaterial`) as
     UsdShade materials to ``out``.
@@ -89,6 +90,7 @@ def export_materials(
             meters_per_unit=meters_per_unit,
             collect=collect,
             preview_geometry=preview_geometry,
+            mtlx_surface=mtlx_surface,
         )
         result.fidelity = measured
         return result

@@ -287,8 +287,12 @@ def test_specular_gamma_round_trips_through_custom_data(tmp_path):
     assert found.params == {"metallic": 1.0, "roughness": 0.4, "specular_gamma": 3.0}
     assert all("specular_gamma=3" in line and "GGX roughness" in line for line in found.loss)
     stage = Usd.Stage.Open(str(out))
-    for node in ("preview_surface", "mtlx_surface", "ri_surface"):
-        written = stage.GetPrimAtPath(f"/Materials/m/{node}").GetAttribute("inputs:roughness")
+    for node, name in (
+        ("preview_surface", "roughness"),
+        ("mtlx_surface", "specular_roughness"),  # OpenPBR Surface
+        ("ri_surface", "roughness"),
+    ):
+        written = stage.GetPrimAtPath(f"/Materials/m/{node}").GetAttribute(f"inputs:{name}")
         assert written.Get() == pytest.approx(0.35677, abs=1e-4)  # lookdev.materials.highlight
 
 
