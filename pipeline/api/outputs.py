@@ -54,10 +54,18 @@ class UsdExport:
     fidelity: dict[str, Any] = field(default_factory=dict)
     """material → its universal context measured against it (``report=True``):
     :class:`lookdev.pipeline.export.usd.fidelity.Fidelity`."""
+    contexts_fidelity: dict[str, Any] = field(default_factory=dict)
+    """material → every context measured against it, one ``Fidelity`` each (``report``)."""
 
     def to_json(self) -> dict[str, Any]:
-        """The summary ``lookdev export usd --json`` prints."""
+        """The summary ``lookdev export usd --json`` prints (with ``report``: ``fidelity``,
+        the universal context per material, and ``context_fidelity``, a row per material
+        × context)."""
         extra = {"fidelity": [f.to_json() for f in self.fidelity.values()]} if self.fidelity else {}
+        if self.contexts_fidelity:
+            extra["context_fidelity"] = [
+                f.to_json() for rows in self.contexts_fidelity.values() for f in rows
+            ]
         return extra | {
             "output": str(self.output),
             "files": [str(p) for p in self.files],
@@ -199,6 +207,7 @@ def export_usd(
         result.images,
         result.losses,
         result.fidelity,
+        result.contexts_fidelity,
     )
 
 

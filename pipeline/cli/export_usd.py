@@ -106,8 +106,9 @@ def export_usd(
         bool,
         typer.Option(
             "--report",
-            help="Measure each material's UsdPreviewSurface against the material: "
-            "directional albedo over view angles (RMS, worst) and the highlight ratio.",
+            help="Measure every context of each material against the material (universal, "
+            "mtlx as OpenPBR and as ND_disney_principled, ri where its model is known): "
+            "directional albedo 0-85° (RMS, worst) and the highlight's energy and width.",
         ),
     ] = False,
     collect: Annotated[
@@ -217,14 +218,17 @@ def export_usd(
         console.print(losses)
     else:
         console.print("every render context expresses every material fully")
-    if result.fidelity:
-        rows = sorted(result.fidelity.values(), key=lambda f: -f.rms)
+    if result.contexts_fidelity:
+        rows = [f for by in result.contexts_fidelity.values() for f in by]
+        rows.sort(key=lambda f: (f.material, f.context))
         fid = table(
-            "UsdPreviewSurface vs the material (albedo over 0-85°, highlight at 30°)",
-            ["material", "albedo RMS", "worst", "highlight preview/source"],
+            "Each context vs the material (albedo over 0-85°, highlight at 30°)",
+            ["material", "context", "albedo RMS", "worst", "highlight energy", "width"],
             [f.row() for f in rows],
         )
         console.print(fid)
+        for note in sorted({n for f in rows for n in f.notes}):
+            console.print(f"note: {note}", highlight=False)
 
 
 @contextmanager

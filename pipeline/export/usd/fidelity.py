@@ -40,11 +40,21 @@ __all__ = [
     "Fidelity",
     "Measured",
     "PreviewHub",
+    "compared",
+    "context_fidelity",
     "fidelity",
+    "source_measured",
     "measure",
     "preview_hub",
     "preview_params",
 ]
+
+SHORT = {
+    "ND_open_pbr_surface_surfaceshader": "OpenPBR",
+    "ND_disney_principled": "disney_principled",
+    "ND_UsdPreviewSurface_surfaceshader": "UsdPreviewSurface",
+}
+"""Surface ids as the report table names them."""
 
 ANGLES = (0.0, 30.0, 45.0, 60.0, 75.0, 85.0)
 """View angles (degrees from the normal) at which albedo is compared."""
@@ -54,7 +64,8 @@ CHANNELS = "RGB"
 
 @dataclass(frozen=True)
 class Fidelity:
-    """One material's universal-context fidelity (see the module doc)."""
+    """One material's fidelity in one context (see the module doc). ``albedo_preview``
+    is the context's albedo (the name is the universal context's, kept for scripts)."""
 
     material: str
     albedo_source: list[list[float]]  # per angle, RGB
@@ -62,11 +73,26 @@ class Fidelity:
     rms: float  # over angles and channels
     worst: float  # largest |difference|
     worst_at: str  # "60° G"
-    highlight_ratio: float  # preview / source luminance of f·cos at the mirror direction
+    highlight_ratio: float  # context / source luminance of f·cos near the mirror direction
+    context: str = "universal"
+    surface: str = "UsdPreviewSurface"
+    highlight_width_source: float = 0.0  # degrees: the source's spread near the mirror
+    highlight_width: float = 0.0  # degrees: the context's
+    loss: str = ""  # what the network could not express (its surface's note)
+    notes: tuple[str, ...] = ()  # renderer behaviours that change the look
+    unavailable: str = ""  # why there is no figure (the context's model is not known)
 
     def to_json(self) -> dict[str, Any]:
+        if self.unavailable:  # no figures: null, not NaN (which JSON does not have)
+            blank = {k: None for k in ("albedo_preview", "rms", "worst", "highlight_ratio")}
+            return {**self._json(), **blank, "highlight_width_deg": None}
+        return self._json()
+
+    def _json(self) -> dict[str, Any]:
         return {
             "material": self.material,
+            "context": self.context,
+            "surface": self.surface,
             "angles_deg": list(ANGLES),
             "albedo_source": self.albedo_source,
             "albedo_preview": self.albedo_preview,
@@ -74,14 +100,24 @@ class Fidelity:
             "worst": self.worst,
             "worst_at": self.worst_at,
             "highlight_ratio": self.highlight_ratio,
+            "highlight_width_source_deg": self.highlight_width_source,
+            "highlight_width_deg": self.highlight_width,
+            "loss": self.loss,
+            "notes": list(self.notes),
+            "unavailable": self.unavailable,
         }
 
     def row(self) -> list[str]:
+        where = f"{self.context} {SHORT.get(self.surface, self.surface)}"
+        if self.unavailable:
+            return [self.material, where, "not available", "", "", ""]
         return [
             self.material,
+            where,
             f"{self.rms:.3f}",
             f"{self.worst:+.3f} at {self.worst_at}",
             f"{self.highlight_ratio:.2f}",
+            f"{self.highlight_width_source:.1f}° → {self.highlight_width:.1f}°",
         ]
 
 
@@ -129,6 +165,9 @@ def _clip(c: Any) -> tuple[float, float, float]:
 
 HIGHLIGHT_CONE_DEG = 10.0
 """The highlight is the light reflected within this angle of the mirror direction."""
+WIDTH_CONE_DEG = 30.0
+"""The highlight's width: the RMS angle from the mirror direction of the light (luminance)
+reflected within this angle of it (the diffuse within it included, for both sides)."""
 
 
 @dataclass(frozen=True)
@@ -139,6 +178,7 @@ class Measured:
     reflected: np.ndarray
     transmitted: np.ndarray
     highlight: np.ndarray
+    width: np.ndarray  # per angle: RMS angle (degrees) from the mirror within WIDTH_CONE_DEG
 
     @property
     def albedo(self) -> np.ndarray:
@@ -155,7 +195,8 @@ def measure(model, params, maps: dict[str, Any], samples: int = SAMPLES) -> Meas
     rng = np.random.default_rng(7)
     maps = {k: np.broadcast_to(v, (samples, *np.shape(v))) for k, v in maps.items()}
     cone = math.cos(math.radians(HIGHLIGHT_CONE_DEG))
-    up, down, highlight = [], [], []
+    up, down, highlight, width = [], [], [], []
+    wide = math.cos(math.radians(WIDTH_CONE_DEG))
     for deg in ANGLES:
         t = math.radians(deg)
         wo = np.array([math.sin(t), 0.0, math.cos(t)])
@@ -168,34 +209,87 @@ def measure(model, params, maps: dict[str, Any], samples: int = SAMPLES) -> Meas
         up.append((weight * above).mean(axis=0))
         down.append((weight * ~above).mean(axis=0))
         highlight.append((weight * near[:, None]).mean(axis=0))
-    return Measured(np.asarray(up), np.asarray(down), np.asarray(highlight))
+        cos_m = np.clip(wi @ mirror, -1.0, 1.0)
+        lum = np.where(cos_m >= wide, luminance(weight), 0.0)
+        theta = np.degrees(np.arccos(cos_m))
+        total = lum.sum()
+        width.append(math.sqrt(float((lum * theta**2).sum() / total)) if total > 0 else 0.0)
+    return Measured(np.asarray(up), np.asarray(down), np.asarray(highlight), np.asarray(width))
 
 
-def _measure(model, params, maps: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]:
-    m = measure(model, params, maps)
-    return m.albedo, m.highlight
+def _ratio(a: float, b: float) -> float:
+    return a / b if b > 0.0 else math.inf if a > 0.0 else 1.0
+
+
+def compared(name: str, src: Measured, got: Measured, **about: Any) -> Fidelity:
+    """The :class:`Fidelity` of ``got`` (a context's model) against ``src`` (the
+    material's own): albedo RMS and worst over angles × channels, the highlight's energy
+    and width at the 30° view as ratios."""
+    a_src, a_got = src.albedo, got.albedo
+    diff = a_got - a_src
+    k = np.unravel_index(np.argmax(np.abs(diff)), diff.shape)
+    at = ANGLES.index(30.0)
+    return Fidelity(
+        name,
+        a_src.round(5).tolist(),
+        a_got.round(5).tolist(),
+        float(np.sqrt(np.mean(diff * diff))),
+        float(diff[k]),
+        f"{ANGLES[k[0]]:g}° {CHANNELS[k[1]]}",
+        _ratio(float(luminance(got.highlight[at])), float(luminance(src.highlight[at]))),
+        highlight_width_source=round(float(src.width[at]), 3),
+        highlight_width=round(float(got.width[at]), 3),
+        **about,
+    )
+
+
+def source_measured(hub: Any) -> Measured:
+    """The material's own model measured (at its centre texel when it varies)."""
+    params, maps = _source_params(hub)
+    return measure(hub.bsdf_model, params, maps)
 
 
 def fidelity(hub: Any, source: Source, preview_opacity: str = "keep") -> Fidelity:
     """Measure the universal context of ``source`` (made from ``hub``) against ``hub``."""
-    model = hub.bsdf_model
-    params, maps = _source_params(hub)
     preview = preview_params(source, preview_opacity)
-    a_src, hl_src = _measure(model, params, maps)
-    a_pre, hl_pre = _measure(PREVIEW, preview, {})
-    diff = a_pre - a_src
-    k = np.unravel_index(np.argmax(np.abs(diff)), diff.shape)
-    at = ANGLES.index(30.0)
-    h_src, h_pre = float(luminance(hl_src[at])), float(luminance(hl_pre[at]))
-    return Fidelity(
-        source.name,
-        a_src.round(5).tolist(),
-        a_pre.round(5).tolist(),
-        float(np.sqrt(np.mean(diff * diff))),
-        float(diff[k]),
-        f"{ANGLES[k[0]]:g}° {CHANNELS[k[1]]}",
-        h_pre / h_src if h_src > 0.0 else math.inf if h_pre > 0.0 else 1.0,
-    )
+    return compared(source.name, source_measured(hub), measure(PREVIEW, preview, {}))
+
+
+def context_fidelity(
+    hub: Any, source: Source, preview_opacity: str = "keep", meters_per_unit: float = 1.0
+) -> list[Fidelity]:
+    """Every context of ``source`` (both ``mtlx`` surfaces of a Disney material) measured
+    against ``hub`` (:mod:`.context_views`); a context whose model is not available gets
+    its reason instead of figures."""
+    from .context_views import views
+
+    src = source_measured(hub)
+    out = []
+    for view in views(source, preview_opacity, meters_per_unit):
+        about = {
+            "context": view.context,
+            "surface": view.surface,
+            "loss": view.loss,
+            "notes": tuple(view.notes),
+        }
+        if view.model is None:
+            nan = [[math.nan] * 3 for _ in ANGLES]
+            out.append(
+                Fidelity(
+                    source.name,
+                    src.albedo.round(5).tolist(),
+                    nan,
+                    math.nan,
+                    math.nan,
+                    "",
+                    math.nan,
+                    unavailable=view.unavailable,
+                    **about,
+                )  # fmt: skip
+            )
+            continue
+        out.append(compared(source.name, src, measure(view.model, view.params, {}), **about))
+    return out
 
 
 def _source_params(hub: Any) -> tuple[Any, dict[str, Any]]:

@@ -316,6 +316,8 @@ class ExportResult:
     losses: dict[str, dict[str, str]] = field(default_factory=dict)
     fidelity: dict[str, Any] = field(default_factory=dict)
     """material → :class:`.fidelity.Fidelity` when the export was asked to measure."""
+    contexts_fidelity: dict[str, Any] = field(default_factory=dict)
+    """material → a :class:`.fidelity.Fidelity` per context (:func:`.fidelity.context_fidelity`)."""
 
 
 def losses_of(specs: list[MaterialSpec]) -> dict[str, dict[str, str]]:

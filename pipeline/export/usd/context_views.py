@@ -1,0 +1,166 @@
+"""What each render context's renderer evaluates: its network read back into a model.
+
+A context is measured by reading the network the writer builds, the way a renderer
+reads it: the written values, the surface's own defaults where an input is not written,
+a map's centre texel where an input is connected, and the model of that surface:
+
+- ``UsdPreviewSurface`` (universal; the ``mtlx`` surface of a layered Pixar blend):
+  :mod:`lookdev.materials.preview_surface`;
+- ``ND_open_pbr_surface_surfaceshader``: :mod:`lookdev.materials.openpbr`;
+- ``ND_disney_principled`` and ``PxrDisneyBsdf``: Burley's model
+  (:mod:`lookdev.materials.disney`) with the parameters their name tables carry back:
+  what is measured is what the names and the surfaces' defaults lose, not each
+  renderer's own implementation of Burley's lobes, which is not available here;
+- ``PxrSurface``: not available to evaluate (RenderMan's own lobes); no figure.
+
+Renderer behaviours that change the look are named with the view (:data:`NOTES`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from lookdev.materials.params import DisneyParams
+from lookdev.materials.registry import MODELS
+
+from .names import table_for
+from .network import Connection, Network, Source, plain_value
+
+__all__ = ["ContextView", "NOTES", "views"]
+
+NOTES = {
+    "mtlx_layered": "RenderMan's MaterialX path does not layer (\"we don't support material "
+    'layering via MaterialX"): the live mix chains of this network render unlayered there',
+    "storm": "Storm renders this context; it ignores material bindings of purpose `full` "
+    "only, and lookdev binds all-purpose",
+}
+"""Known renderer behaviours, named where they apply."""
+
+
+@dataclass
+class ContextView:
+    """One context as its renderer sees it: the model and parameters, or why not."""
+
+    context: str
+    surface: str
+    model: Any = None
+    params: Any = None
+    loss: str = ""
+    unavailable: str = ""
+    notes: list[str] = field(default_factory=list)
+
+
+def _centre(source: Source, param: str) -> Any:
+    from .fidelity import _centre as centre
+
+    return centre(source, param)
+
+
+def _surface_values(net: Network, source: Source, table) -> dict[str, Any]:
+    """Input → value of the network's surface: constants as written, connected inputs
+    as their slot converts the parameter's centre texel."""
+    surface = net.nodes[0]
+    slots = {s.input: s for s in table}
+    out = {}
+    for name, (_, value) in surface.inputs.items():
+        value = plain_value(value)
+        if isinstance(value, Connection):
+            slot = slots.get(name)
+            if slot is None:
+                continue
+            value = slot.to_target(_centre(source, slot.param))
+        out[name] = value
+    return out
+
+
+def _openpbr(net: Network, source: Source) -> Any:
+    from .openpbr_import import params_from_values
+    from .openpbr_map import DIRECT, openpbr_values
+
+    if source.model == "disney":
+        table = DIRECT
+        values = _surface_values(net, source, table)
+        centre = {
+            k: _centre(source, k) if k in source.maps else v for k, v in source.live_values.items()
+        }
+        derived = openpbr_values(centre, source.lobes)
+        for name, (_, value) in net.nodes[0].inputs.items():
+            if isinstance(plain_value(value), Connection) and name not in values:
+                values[name] = derived[name]  # a mix chain of a derived input: its centre
+    else:
+        values = _surface_values(net, source, table_for("mtlx", source.model))
+    values.pop("geometry_normal", None)
+    params, _ = params_from_values(values, source.name)
+    return params
+
+
+def _disney(net: Network, source: Source, context: str) -> DisneyParams:
+    """Burley's parameters as a Disney name table carries them back (unwritten inputs:
+    lookdev's defaults, which MaterialX's and lookdev's Disney defaults share)."""
+    table = table_for(context, "disney")
+    values = _surface_values(net, source, table)
+    out: dict[str, Any] = {}
+    for slot in table:
+        if slot.input in values and slot.param not in out:
+            v = slot.from_target(values[slot.input])
+            number = isinstance(v, int | float) and not isinstance(v, bool)
+            out[slot.param] = float(v) if number else v
+    if "scatter_distance" in out:
+        out.pop("scatter_distance")  # the radius is in scene units: keep the source's
+    keep = {"sheen_model", "sheen_roughness", "scatter_distance", "scatter_distance_scale"}
+    out.update({k: source.live_values[k] for k in keep if k in source.live_values})
+    if "ior" in out and "specular" in out:
+        out.pop("ior")
+    fields = DisneyParams.model_fields
+    return DisneyParams.model_construct(**{k: v for k, v in out.items() if k in fields})
+
+
+def views(
+    source: Source, preview_opacity: str = "keep", meters_per_unit: float = 1.0
+) -> list[ContextView]:
+    """Every context of ``source`` (both ``mtlx`` surfaces of a Disney material) as the
+    renderer sees it."""
+    from lookdev.materials.openpbr import MODEL as OPENPBR
+    from lookdev.materials.preview_surface import MODEL as PREVIEW
+
+    from . import mtlx, preview, ri
+    from .fidelity import preview_params
+
+    out = [
+        ContextView(
+            "universal",
+            "UsdPreviewSurface",
+            PREVIEW,
+            preview_params(source, preview_opacity),
+            _loss(preview.build(source, preview_opacity)),
+            notes=[NOTES["storm"]],
+        )
+    ]
+    surfaces = ("openpbr", "disney") if source.model == "disney" else ("openpbr",)
+    for surface in surfaces:
+        net = mtlx.build(source, meters_per_unit, surface)
+        node_id = net.nodes[0].id
+        view = ContextView("mtlx", node_id, loss=_loss(net))
+        if any(n.id.startswith("ND_mix_") for n in net.nodes):
+            view.notes.append(NOTES["mtlx_layered"])
+        if node_id == "ND_open_pbr_surface_surfaceshader":
+            view.model, view.params = OPENPBR, _openpbr(net, source)
+        elif node_id == "ND_disney_principled":
+            view.model, view.params = MODELS["disney"], _disney(net, source, "mtlx")
+        elif node_id == "ND_UsdPreviewSurface_surfaceshader":
+            view.model, view.params = PREVIEW, preview_params(source, preview_opacity)
+        out.append(view)
+    net = ri.build(source, meters_per_unit)
+    node_id = net.nodes[0].id
+    view = ContextView("ri", node_id, loss=_loss(net))
+    if node_id == "PxrDisneyBsdf":
+        view.model, view.params = MODELS["disney"], _disney(net, source, "ri")
+    else:
+        view.unavailable = f"{node_id}'s BSDF (RenderMan's own lobes) is not available to evaluate"
+    out.append(view)
+    return out
+
+
+def _loss(net: Network) -> str:
+    return "; ".join(n.custom["loss"] for n in net.nodes if n.custom.get("loss"))
