@@ -146,7 +146,8 @@ def export_usd(
         the Material's doc string and kept in the surface's customData (under "losses"
         with --json). Glass keeps opacity 1 in UsdPreviewSurface unless
         --preview-opacity transmission. Only what a material needs is written: inputs at
-        the target's default and lobes without weight are left out. Layered presets are blended and their
+        the target's default and lobes without weight are left out. Layered presets are
+        blended and their
         varying parameters baked to EXR maps beside the file (UsdPreviewSurface has no mix
         node). With several presets, /Materials/Look carries a variant set that switches between
         them. A parameter read from one texture file references that file (its colour space
