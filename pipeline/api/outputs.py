@@ -469,7 +469,10 @@ def proof(
         ``"universal"``: also proof, beside each material, its USD universal context as
         ``NAME-universal``: the UsdPreviewSurface values rendered by that surface's own
         BRDF (:func:`lookdev.pipeline.export.usd.fidelity.preview_hub`), what a DCC
-        preview shows.
+        preview shows. ``"mtlx"``: its ``mtlx`` context as ``NAME-mtlx``, the OpenPBR
+        Surface values rendered by the OpenPBR model
+        (:func:`lookdev.pipeline.export.usd.context_views.mtlx_hub`), what an OpenPBR
+        renderer shows.
     geometry
         A mesh (PLY, OBJ, or USD geometry) rendered in the cup's place beside the ball,
         with its own UVs (:mod:`lookdev.pipeline.proof.geometry`).
@@ -531,14 +534,18 @@ def proof(
     ibl_names = list(dict.fromkeys(ibls or ibl_module.builtin_names()))
     environments = [ibl_module.load(name, ibl_width) for name in ibl_names]
     loaded = [hub(m, batch.MAP_RESOLUTION, lib) for m in chosen]
-    if context not in (None, "source", "universal"):
+    if context not in (None, "source", "universal", "mtlx"):
         raise batch.ProofError(
-            f"unknown context {context!r}; allowed: universal", field="--context"
+            f"unknown context {context!r}; allowed: universal, mtlx", field="--context"
         )
     if context == "universal":
         from lookdev.pipeline.export.usd.fidelity import preview_hub
 
         loaded = [h for m in loaded for h in (m, preview_hub(m))]
+    if context == "mtlx":
+        from lookdev.pipeline.export.usd.context_views import mtlx_hub
+
+        loaded = [h for m in loaded for h in (m, mtlx_hub(m))]
     doc = batch.proof(
         loaded,
         environments,

@@ -21,13 +21,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from lookdev.materials.errors import LookdevError
 from lookdev.materials.params import DisneyParams
 from lookdev.materials.registry import MODELS
 
 from .names import table_for
 from .network import Connection, Network, Source, plain_value
 
-__all__ = ["ContextView", "NOTES", "views"]
+__all__ = ["MTLX_SUFFIX", "NOTES", "ContextView", "mtlx_hub", "views"]
 
 NOTES = {
     "mtlx_layered": "RenderMan's MaterialX path does not layer (\"we don't support material "
@@ -164,3 +165,49 @@ def views(
 
 def _loss(net: Network) -> str:
     return "; ".join(n.custom["loss"] for n in net.nodes if n.custom.get("loss"))
+
+
+MTLX_SUFFIX = "-mtlx"
+"""Name suffix of a material's ``mtlx``-context proof (``lookdev proof --context mtlx``)."""
+
+_MAPPED_OPENPBR = {"base_color": "base_color", "metallic": "base_metalness"}
+"""Disney maps an OpenPBR proof keeps per texel (the rest at their centre value)."""
+
+
+def mtlx_hub(hub: Any) -> Any:
+    """What an OpenPBR renderer shows of ``hub``: its ``mtlx`` context as OpenPBR Surface
+    (:mod:`.mtlx_openpbr`, or Smits' table for Pixar presets) rendered by the OpenPBR
+    model (:mod:`lookdev.materials.openpbr`), named ``NAME-mtlx``; base colour and
+    metalness maps kept per texel, roughness too where no anisotropy changes it."""
+    import tempfile
+    from pathlib import Path
+
+    import numpy as np
+
+    from lookdev.pipeline.blend.result import BlendedMaterial
+
+    from .sources import source_for
+
+    with tempfile.TemporaryDirectory(prefix="lookdev-mtlx-") as tmp:
+        source = source_for(hub, Path(tmp) / "tex", scratch=Path(tmp), bake=True)
+        view = next(v for v in views(source) if v.context == "mtlx")
+    if view.model is None or view.model.name != "openpbr":
+        raise LookdevError(f"{hub.name}: its mtlx context is {view.surface}, not OpenPBR")
+    constants = view.params.model_dump()
+    maps: dict[str, np.ndarray] = {}
+    mapped = dict(_MAPPED_OPENPBR)
+    if source.live_values.get("anisotropic", 0.0) == 0.0:
+        mapped["roughness"] = "specular_roughness"
+    if source.model == "disney":
+        for param, field_name in mapped.items():
+            if param in hub.maps:
+                maps[field_name] = np.asarray(hub.maps[param], np.float32)
+                constants.pop(field_name, None)
+    out = BlendedMaterial(f"{hub.name}{MTLX_SUFFIX}", "openpbr", hub.resolution, constants)
+    out.maps = maps
+    if hub.normal_map is not None:
+        out.normal_map = hub.normal_map
+    out.description = f"{hub.name} as an OpenPBR renderer shows its mtlx context"
+    if not maps:
+        out.__dict__["params"] = view.params
+    return out

@@ -66,3 +66,27 @@ def test_live_layering_names_renderman(report):
 def test_named_losses_ride_with_the_row(report):
     row = _rows(report, "velvet")[("mtlx", "ND_open_pbr_surface_surfaceshader")]
     assert "sheen → fuzz" in row["loss"]
+
+
+def test_mtlx_proof_hub_is_the_openpbr_model_of_the_mtlx_context():
+    from lookdev.library import Library, load_material
+    from lookdev.pipeline import api
+    from lookdev.pipeline.export.usd.context_views import mtlx_hub
+
+    lib = Library(use_env=False)
+    gold = mtlx_hub(api.hub(load_material("gold", lib), 8))
+    assert gold.name == "gold-mtlx" and gold.bsdf_model.name == "openpbr"
+    assert gold.params.base_metalness == 1.0
+    rusty = mtlx_hub(api.hub(load_material("rusty_iron", lib), 8))
+    assert "base_color" in rusty.maps  # the texture is kept per texel
+    pixar = mtlx_hub(api.hub(load_material("pixar_gold", lib), 8))
+    assert pixar.bsdf_model.name == "openpbr"
+
+
+def test_proof_context_rejects_unknown_in_one_line(tmp_path):
+    from typer.testing import CliRunner
+
+    from lookdev.pipeline.cli import app
+
+    result = CliRunner().invoke(app, ["proof", "gold", "-o", str(tmp_path), "--context", "ri"])
+    assert result.exit_code == 2 and "Traceback" not in result.output
