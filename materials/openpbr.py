@@ -19,7 +19,8 @@ with M, T, S, C, F the metalness, transmission, subsurface, coat and fuzz weight
 - ``metal``: the same GGX lobe with the F82-tint Fresnel (:func:`.openpbr_params.f82_tint`)
   times ``specular_weight``;
 - ``transmission``: Walter's rough dielectric BTDF at the same IOR, tinted by
-  ``transmission_color``, its own Fresnel factor left out as the specification allows;
+  ``transmission_color``, its own Fresnel factor left out as the specification allows
+  (on a thin wall without the radiance factor 1/η², the slab's two faces cancelling);
 - ``diffuse``: the energy-preserving Oren–Nayar (EON) of ``base_weight · base_color``;
 - ``subsurface``: the slab's reflectance limit, a Lambertian of ``subsurface_color``;
 - ``coat``: GGX reflection with the dielectric Fresnel of ``coat_ior``;
@@ -161,6 +162,7 @@ def prepare(xp: Any, params: OpenPBRParams, **maps: Any) -> dict[str, Any]:
         "fuzz_color": xp.color(p.fuzz_color),
         "fuzz_r": p.fuzz_roughness,
         "opacity": p.geometry_opacity,
+        "thin": p.geometry_thin_walled,
         "eta": eta,
         # under a denser coat η′ < 1: the reflection is read with 1/η′ (same F0, no
         # total internal reflection, which the light refracted into the coat never meets)
@@ -223,6 +225,9 @@ def eval(xp: Any, p: dict[str, Any], wi: Any, wo: Any) -> Any:
         h_t = xp.normalize(wi_t * p["eta"] + wo)
         keep = 1.0 - fresnel.dielectric(xp, xp.abs(xp.dot(wo, h_t)), p["eta"])
         lobe = btdf / xp.maximum(keep, 1e-6)  # the specification omits this Fresnel factor
+        if p["thin"]:
+            # a thin wall's second interface undoes the first's radiance compression
+            lobe = lobe * (p["eta"] * p["eta"])
         transmitted = (1.0 - m) * t * (1.0 - e_spec) * p["trans_color"] * lobe
     if "metal" in lobes:
         f = f82_tint(xp, p["base"], p["spec_color"], oh) * p["spec_weight"]

@@ -111,7 +111,8 @@ NOT_MODELLED: dict[str, str] = {
     "transmission_dispersion_scale": "no dispersion (one IOR for all wavelengths)",
     "subsurface_radius": "subsurface is its reflectance limit, a Lambertian of "
     "subsurface_color (no transport distance)",
-    "geometry_thin_walled": "thin walls are evaluated as the solid's surface",
+    "geometry_thin_walled": "thin walls refract as the solid's surface (no slab offset); "
+    "their subsurface is not transmitted",
     "emission_luminance": "emission is not part of the BSDF",
     "geometry_opacity": "the uncovered part is a pass-through, not scattered",
 }

@@ -35,6 +35,9 @@ NOTES = {
     'layering via MaterialX"): the live mix chains of this network render unlayered there',
     "storm": "Storm renders this context; it ignores material bindings of purpose `full` "
     "only, and lookdev binds all-purpose",
+    "medium": "the source sends light into a scattering interior (its volume colours it "
+    "there): its surface albedo counts that light as it enters, where OpenPBR's reduction "
+    "and the other surfaces reflect a colour at the surface; the figures compare the two",
 }
 """Known renderer behaviours, named where they apply."""
 
@@ -160,6 +163,9 @@ def views(
     else:
         view.unavailable = f"{node_id}'s BSDF (RenderMan's own lobes) is not available to evaluate"
     out.append(view)
+    if source.lobes.get("scatter"):
+        for view in out:
+            view.notes.append(NOTES["medium"])
     return out
 
 

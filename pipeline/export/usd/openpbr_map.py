@@ -277,7 +277,7 @@ LOSSES: tuple[Loss, ...] = (
     ),
     Loss(
         "diff_trans",
-        _on("diff_trans"),
+        lambda v, lobes: bool(lobes.get("diff_trans")) and bool(v["thin"]),
         "diff_trans → geometry_thin_walled + subsurface_weight: the split between "
         "transmitted and reflected diffuse is OpenPBR's, not Burley's",
     ),
