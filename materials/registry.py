@@ -51,8 +51,9 @@ MODELS: dict[str, Model] = {
 """Every model by name; each renders in Mitsuba as the plugin ``lookdev_<name>``. A new
 model adds itself here (tests add toy models the same way)."""
 
-PRESET_MODELS: tuple[str, ...] = ("disney", "pixar")
-"""Models a preset file may name (besides ``layered``, a stack of them)."""
+PRESET_MODELS: tuple[str, ...] = ("disney", "pixar", "openpbr")
+"""Models a preset file may name (besides ``layered``, a stack of them); ``openpbr``
+holds an imported OpenPBR material as itself."""
 
 LAYERED: Mapping[str, str] = types.MappingProxyType({"pixar": "pixar_layered"})
 """Preset model → the model that takes its composited layer stack where blending does not

@@ -30,6 +30,11 @@ class PreviewOpacity(StrEnum):
     transmission = "transmission"
 
 
+class ImportOpenPBR(StrEnum):
+    disney = "disney"
+    itself = "itself"
+
+
 class MtlxSurface(StrEnum):
     openpbr = "openpbr"
     disney = "disney"
@@ -139,42 +144,42 @@ def export_usd(
 ) -> None:
     """Write presets as UsdShade materials that DCCs and their renderers read.
 
-        Each preset becomes /Materials/NAME with up to three render contexts: **universal**
-        (UsdPreviewSurface, read everywhere), **mtlx** (MaterialX OpenPBR Surface, or
-        ND_disney_principled with --mtlx-surface disney) and **ri** (RenderMan
-        PxrDisneyBsdf). What a context cannot express is printed as a table, written as
-        the Material's doc string and kept in the surface's customData (under "losses"
-        with --json). Glass keeps opacity 1 in UsdPreviewSurface unless
-        --preview-opacity transmission. Only what a material needs is written: inputs at
-        the target's default and lobes without weight are left out. Layered presets are
-        blended and their
-        varying parameters baked to EXR maps beside the file (UsdPreviewSurface has no mix
-        node). With several presets, /Materials/Look carries a variant set that switches between
-        them. A parameter read from one texture file references that file (its colour space
-        named: sourceColorSpace, colorSpace, colorspace, linearize), or a copy with --collect;
-        a preset's height map becomes displacement in scene units (metersPerUnit = 1).
+    Each preset becomes /Materials/NAME with up to three render contexts: **universal**
+    (UsdPreviewSurface, read everywhere), **mtlx** (MaterialX OpenPBR Surface, or
+    ND_disney_principled with --mtlx-surface disney) and **ri** (RenderMan
+    PxrDisneyBsdf). What a context cannot express is printed as a table, written as
+    the Material's doc string and kept in the surface's customData (under "losses"
+    with --json). Glass keeps opacity 1 in UsdPreviewSurface unless
+    --preview-opacity transmission. Only what a material needs is written: inputs at
+    the target's default and lobes without weight are left out. Layered presets are
+    blended and their
+    varying parameters baked to EXR maps beside the file (UsdPreviewSurface has no mix
+    node). With several presets, /Materials/Look carries a variant set that switches between
+    them. A parameter read from one texture file references that file (its colour space
+    named: sourceColorSpace, colorSpace, colorspace, linearize), or a copy with --collect;
+    a preset's height map becomes displacement in scene units (metersPerUnit = 1).
 
-        Clearcoat in UsdPreviewSurface: clearcoat = 0.25 x lookdev's clearcoat (Burley weights
-        his GTR1 coat 0.25, the spec's coat is unweighted: the scale keeps the coat's reflected
-        energy) and clearcoatRoughness = sqrt(mix(0.1, 0.001, clearcoat_gloss)) (Burley's coat
-        alpha, squared back by the spec); import divides and inverts the same way. The
-        subsurface radius is scatter_distance (metres) / --meters-per-unit, 1 mm where only
-        Burley 2012's distance-less subsurface is live.
+    Clearcoat in UsdPreviewSurface: clearcoat = 0.25 x lookdev's clearcoat (Burley weights
+    his GTR1 coat 0.25, the spec's coat is unweighted: the scale keeps the coat's reflected
+    energy) and clearcoatRoughness = sqrt(mix(0.1, 0.001, clearcoat_gloss)) (Burley's coat
+    alpha, squared back by the spec); import divides and inverts the same way. The
+    subsurface radius is scatter_distance (metres) / --meters-per-unit, 1 mm where only
+    Burley 2012's distance-less subsurface is live.
 
-        Examples:
+    Examples:
 
-          lookdev export usd gold -o gold.usda
+      lookdev export usd gold -o gold.usda
 
-          lookdev export usd gold copper glass_clear -o metals.usda --context universal
+      lookdev export usd gold copper glass_clear -o metals.usda --context universal
 
-          lookdev export usd --all -o library.usda --split materials/ --mtlx library.mtlx
+      lookdev export usd --all -o library.usda --split materials/ --mtlx library.mtlx
 
-          lookdev export usd rusty_iron -o rust.usdz --package
+      lookdev export usd rusty_iron -o rust.usdz --package
 
-          lookdev --working-space acescg export usd gold -o gold.usda --mtlx gold.mtlx
+      lookdev --working-space acescg export usd gold -o gold.usda --mtlx gold.mtlx
 
-        Values and maps are in the working space (global --working-space), named on each
-        Material (ColorSpaceAPI colorSpace:name) and in the MaterialX document (colorspace).
+    Values and maps are in the working space (global --working-space), named on each
+    Material (ColorSpaceAPI colorSpace:name) and in the MaterialX document (colorspace).
     """
     from lookdev.pipeline import api
 
@@ -278,6 +283,15 @@ def import_usd(
             "(default: refuse; --force replaces a preset in -o instead).",
         ),
     ] = False,
+    openpbr: Annotated[
+        ImportOpenPBR,
+        typer.Option(
+            "--openpbr",
+            help="OpenPBR Surface materials from other tools: 'disney' (translated to "
+            "Burley's parameters, losses named) or 'itself' (an openpbr preset holding "
+            "its inputs as they are, proofed by lookdev's OpenPBR model).",
+        ),
+    ] = ImportOpenPBR.disney,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
     """Read materials from a USD file back into presets.
@@ -308,6 +322,11 @@ def import_usd(
 
     skipped: list[str] = []
     found = read(file.expanduser(), skipped)
+    if openpbr is ImportOpenPBR.itself:
+        from lookdev.pipeline.export.usd.openpbr_import import import_as_openpbr
+
+        itself = import_as_openpbr(file.expanduser())
+        found = [itself.get(m.name, m) for m in found]
     names = import_names(found, _taken_names(output, rename), rename=rename)
     written = write_presets(found, output, force=force, names=names)
     if as_json:
