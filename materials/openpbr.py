@@ -28,7 +28,7 @@ with M, T, S, C, F the metalness, transmission, subsurface, coat and fuzz weight
 
 Where the specification leaves the implementation free, this model chooses, and each
 choice is a difference from other OpenPBR implementations, measured in
-``docs/measurements/openpbr.md``: the GGX lobes carry Turquin's multiple-scattering
+``docs/measurements/contexts.md``: the GGX lobes carry Turquin's multiple-scattering
 factor (:mod:`.energy`), and E[f] of a dielectric GGX lobe is the compensated lobe's
 albedo with Schlick's Fresnel from the exact F0, F0 (E − B) + B
 (:func:`.openpbr_params.schlick_split`); the fuzz is Conty and Kulla's sheen

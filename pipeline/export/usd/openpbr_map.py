@@ -246,9 +246,16 @@ LOSSES: tuple[Loss, ...] = (
     ),
     Loss(
         "metallic",
-        lambda v, lobes: v["metallic"] > 0.0 and v["specular_tint"] > 0.0,
+        lambda v, lobes: 0.0 < v["metallic"] < 1.0 and v["specular_tint"] > 0.0,
         "metallic → base_metalness: specular_color (the dielectric's tint) also tints "
         "the F82 edge of the metal",
+    ),
+    Loss(
+        "multiple_scattering",
+        lambda v, lobes: not v.get("energy_compensation") and v["roughness"] > 0.0,
+        "OpenPBR's microfacet lobes keep the light that scatters between microfacets "
+        "(energy-preserving); Burley's single-scattering lobes lose it (energy_compensation "
+        "off): rough metals and glossy dielectrics are brighter in OpenPBR",
     ),
     Loss(
         "anisotropic",

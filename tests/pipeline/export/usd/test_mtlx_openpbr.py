@@ -148,3 +148,13 @@ def test_each_named_loss_applies_where_its_term_is_live():
     assert {"clearcoat", "sheen", "anisotropic"} <= got
     v, lobes = _values(metallic=1.0)
     assert "diffuse" not in {loss.name for loss in losses_of(v, lobes)}
+
+
+def test_term_losses_measure_every_case():
+    from lookdev.pipeline.analysis.openpbr_losses import CASES, term_losses
+
+    rows = {r["case"]: r for r in term_losses(samples=2048)}
+    assert set(rows) == set(CASES)
+    assert rows["spec_trans"]["rms"] < 0.02  # glass carries over
+    assert rows["metallic, roughness 0.1"]["rms"] < 0.02  # F82 with a white tint is Schlick
+    assert rows["subsurface (2012)"]["rms"] > rows["diffuse+specular (base)"]["rms"]
