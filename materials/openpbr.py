@@ -269,11 +269,12 @@ def pdf(xp: Any, p: dict[str, Any], wi: Any, wo: Any) -> Any:
         out = out + p["p_spec"] * visible_ggx_pdf(xp, wo, h, p["ax"], p["ay"]) * jac
     if p["p_coat"] > 0.0:
         out = out + p["p_coat"] * visible_ggx_pdf(xp, wo, h, p["cax"], p["cay"]) * jac
-    out = xp.select(up, out, 0.0 * out)
+    nothing = 0.0 * wi[2]  # not 0·out: masked lanes may hold NaN (a view below)
+    out = xp.select(up, out, nothing)
     if p["p_trans"] > 0.0:
         wi_t = xp.select(down, wi, -wi)
         pt = p["p_trans"] * dielectric_btdf(xp, wi_t, wo, p["eta"], p["ax"], p["ay"], True)
-        out = out + xp.select(down, pt, 0.0 * pt)
+        out = out + xp.select(down, pt, nothing)
     return out
 
 
@@ -298,8 +299,11 @@ def sample(xp: Any, p: dict[str, Any], wo: Any, u: Any) -> Any:
     density = pdf(xp, p, wi, wo)
     f = eval(xp, p, wi, wo)
     ok = (density > 0.0) & (wo[2] > 0.0)
-    weight = xp.select(ok, f * xp.abs(wi[2]) / xp.maximum(density, 1e-30), 0.0 * f)
-    return wi, weight, xp.select(ok, density, 0.0 * density), False
+    nothing = 0.0 * u0
+    weight = xp.select(
+        ok, f * xp.abs(wi[2]) / xp.maximum(density, 1e-30), nothing + 0.0 * p["base"]
+    )
+    return wi, weight, xp.select(ok, density, nothing), False
 
 
 MODEL = Model(
