@@ -21,14 +21,18 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from lookdev.materials.errors import LookdevError
 from lookdev.materials.params import DisneyParams
+from lookdev.materials.preview_surface import PreviewParams
 from lookdev.materials.registry import MODELS
 
 from .names import table_for
 from .network import Connection, Network, Source, plain_value
+from .preview import build, preview_defaults
 
-__all__ = ["MTLX_SUFFIX", "NOTES", "ContextView", "mtlx_hub", "views"]
+__all__ = ["MTLX_SUFFIX", "NOTES", "ContextView", "mtlx_hub", "preview_params", "views"]
 
 NOTES = {
     "mtlx_layered": "RenderMan's MaterialX path does not layer (\"we don't support material "
@@ -55,10 +59,46 @@ class ContextView:
     notes: list[str] = field(default_factory=list)
 
 
-def _centre(source: Source, param: str) -> Any:
-    from .fidelity import _centre as centre
+def preview_params(source: Source, preview_opacity: str = "keep") -> PreviewParams:
+    """The UsdPreviewSurface a DCC reads for ``source``: the universal network's values,
+    the surface's defaults where an input is not written, a map's centre texel (else its
+    mean) where an input is connected."""
+    net = build(source, preview_opacity)
+    surface = net.nodes[0]
+    values = dict(preview_defaults())
+    slots = {s.input: s for s in table_for("universal", source.model, preview_opacity)}
+    for name, (_, value) in surface.inputs.items():
+        value = plain_value(value)  # an interface input: the value it holds
+        if isinstance(value, Connection):
+            slot = slots.get(name)
+            if slot is None:
+                continue
+            value = slot.to_target(_centre(source, slot.param))
+        values[name] = value
+    return PreviewParams(
+        diffuse_color=_clip(values["diffuseColor"]),
+        use_specular_workflow=bool(values.get("useSpecularWorkflow", 0)),
+        specular_color=_clip(values["specularColor"]),
+        metallic=min(max(float(values["metallic"]), 0.0), 1.0),
+        roughness=min(max(float(values["roughness"]), 0.0), 1.0),
+        clearcoat=float(values["clearcoat"]),
+        clearcoat_roughness=min(max(float(values["clearcoatRoughness"]), 0.0), 1.0),
+        ior=float(values["ior"]),
+    )
 
-    return centre(source, param)
+
+def _centre(source: Source, param: str) -> Any:
+    image = source.maps.get(param)
+    if image is None or image.pixels is None:
+        return source.live_values[param]
+    px = np.asarray(image.pixels, np.float64)
+    v = px[px.shape[0] // 2, px.shape[1] // 2]
+    return tuple(float(x) for x in v) if np.ndim(v) else float(v)
+
+
+def _clip(c: Any) -> tuple[float, float, float]:
+    c = np.broadcast_to(np.asarray(c, np.float64), (3,))
+    return tuple(float(x) for x in np.clip(c, 0.0, 1.0))
 
 
 def _surface_values(net: Network, source: Source, table) -> dict[str, Any]:
@@ -129,7 +169,6 @@ def views(
     from lookdev.materials.preview_surface import MODEL as PREVIEW
 
     from . import mtlx, preview, ri
-    from .fidelity import preview_params
 
     out = [
         ContextView(
@@ -187,8 +226,6 @@ def mtlx_hub(hub: Any) -> Any:
     metalness maps kept per texel, roughness too where no anisotropy changes it."""
     import tempfile
     from pathlib import Path
-
-    import numpy as np
 
     from lookdev.pipeline.blend.result import BlendedMaterial
 

@@ -30,9 +30,10 @@ from lookdev.materials.preview_surface import MODEL as PREVIEW
 from lookdev.materials.preview_surface import PreviewParams
 from lookdev.pipeline.blend.result import BlendedMaterial
 
+from .context_views import preview_params, views
 from .names import table_for
 from .network import Connection, Source, plain_value
-from .preview import build, preview_defaults
+from .preview import build
 
 __all__ = [
     "ANGLES",
@@ -119,48 +120,6 @@ class Fidelity:
             f"{self.highlight_ratio:.2f}",
             f"{self.highlight_width_source:.1f}° → {self.highlight_width:.1f}°",
         ]
-
-
-def preview_params(source: Source, preview_opacity: str = "keep") -> PreviewParams:
-    """The UsdPreviewSurface a DCC reads for ``source``: the universal network's values,
-    the surface's defaults where an input is not written, a map's centre texel (else its
-    mean) where an input is connected."""
-    net = build(source, preview_opacity)
-    surface = net.nodes[0]
-    values = dict(preview_defaults())
-    slots = {s.input: s for s in table_for("universal", source.model, preview_opacity)}
-    for name, (_, value) in surface.inputs.items():
-        value = plain_value(value)  # an interface input: the value it holds
-        if isinstance(value, Connection):
-            slot = slots.get(name)
-            if slot is None:
-                continue
-            value = slot.to_target(_centre(source, slot.param))
-        values[name] = value
-    return PreviewParams(
-        diffuse_color=_clip(values["diffuseColor"]),
-        use_specular_workflow=bool(values.get("useSpecularWorkflow", 0)),
-        specular_color=_clip(values["specularColor"]),
-        metallic=min(max(float(values["metallic"]), 0.0), 1.0),
-        roughness=min(max(float(values["roughness"]), 0.0), 1.0),
-        clearcoat=float(values["clearcoat"]),
-        clearcoat_roughness=min(max(float(values["clearcoatRoughness"]), 0.0), 1.0),
-        ior=float(values["ior"]),
-    )
-
-
-def _centre(source: Source, param: str) -> Any:
-    image = source.maps.get(param)
-    if image is None or image.pixels is None:
-        return source.live_values[param]
-    px = np.asarray(image.pixels, np.float64)
-    v = px[px.shape[0] // 2, px.shape[1] // 2]
-    return tuple(float(x) for x in v) if np.ndim(v) else float(v)
-
-
-def _clip(c: Any) -> tuple[float, float, float]:
-    c = np.broadcast_to(np.asarray(c, np.float64), (3,))
-    return tuple(float(x) for x in np.clip(c, 0.0, 1.0))
 
 
 HIGHLIGHT_CONE_DEG = 10.0
@@ -261,8 +220,6 @@ def context_fidelity(
     """Every context of ``source`` (both ``mtlx`` surfaces of a Disney material) measured
     against ``hub`` (:mod:`.context_views`); a context whose model is not available gets
     its reason instead of figures."""
-    from .context_views import views
-
     src = source_measured(hub)
     out = []
     for view in views(source, preview_opacity, meters_per_unit):
