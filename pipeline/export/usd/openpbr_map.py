@@ -181,7 +181,8 @@ MAPPED: frozenset[str] = frozenset(
     (
         "base_color metallic roughness anisotropic specular specular_tint ior sheen "
         "sheen_tint sheen_model sheen_roughness clearcoat clearcoat_gloss spec_trans "
-        "diff_trans thin subsurface scatter_distance scatter_distance_scale flatness"
+        "diff_trans thin subsurface scatter_distance scatter_distance_scale flatness "
+        "energy_compensation"
     ).split()
 )
 """The Disney parameters the mapping reads (``flatness`` and the 2012 ``subsurface``
