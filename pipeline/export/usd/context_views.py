@@ -64,17 +64,8 @@ def preview_params(source: Source, preview_opacity: str = "keep") -> PreviewPara
     the surface's defaults where an input is not written, a map's centre texel (else its
     mean) where an input is connected."""
     net = build(source, preview_opacity)
-    surface = net.nodes[0]
-    values = dict(preview_defaults())
-    slots = {s.input: s for s in table_for("universal", source.model, preview_opacity)}
-    for name, (_, value) in surface.inputs.items():
-        value = plain_value(value)  # an interface input: the value it holds
-        if isinstance(value, Connection):
-            slot = slots.get(name)
-            if slot is None:
-                continue
-            value = slot.to_target(_centre(source, slot.param))
-        values[name] = value
+    table = table_for("universal", source.model, preview_opacity)
+    values = {**preview_defaults(), **_surface_values(net, source, table)}
     return PreviewParams(
         diffuse_color=_clip(values["diffuseColor"]),
         use_specular_workflow=bool(values.get("useSpecularWorkflow", 0)),
@@ -108,7 +99,7 @@ def _surface_values(net: Network, source: Source, table) -> dict[str, Any]:
     slots = {s.input: s for s in table}
     out = {}
     for name, (_, value) in surface.inputs.items():
-        value = plain_value(value)
+        value = plain_value(value)  # an interface input: the value it holds
         if isinstance(value, Connection):
             slot = slots.get(name)
             if slot is None:
