@@ -1,4 +1,4 @@
-"""Preset files and libraries: load, resolve, validate, save (issue 4).
+"""Preset files and libraries: load, resolve, validate, save.
 
 >>> from lookdev.library import Library
 >>> Library(use_env=False).load("gold").params.metallic

@@ -1,4 +1,4 @@
-"""The one write path: every file lookdev writes goes through here (DESIGN.md, Files on
+"""The one write path: every file lookdev writes goes through here (:doc:`/design`, Files on
 shared storage).
 
 The rules, written once:

@@ -35,7 +35,7 @@ from .preset import (
 )
 
 ENV_PATH = "LOOKDEV_LIBRARY_PATH"
-BUILTIN_OTHER_DATA = ("ibl",)
+BUILTIN_OTHER_DATA = ("ibl", "measured")
 """Sub-folders of the built-in ``presets/`` that hold other data, not material presets."""
 
 
@@ -402,7 +402,7 @@ def links_on_the_way(path: Path, root: Path | None = None) -> list[tuple[Path, P
 def refuse_links_out(path: Path, root: Path) -> None:
     """Refuse a write or delete at ``path`` through a symlink that leads out of ``root``.
 
-    The rule (DESIGN.md, Files on shared storage): a library never writes or deletes
+    The rule (:doc:`/design`, Files on shared storage): a library never writes or deletes
     through a link out of its root; reads may. A link to a file *inside* the root is
     edited in place: the write goes through to its target and the link stays a link;
     ``presets rm`` removes the link itself. The root folder may itself be a link.

@@ -1,6 +1,6 @@
 """One preset file: its schema, strict parsing into one-line errors, and TOML output.
 
-A preset file is small TOML (issue 4)::
+A preset file is small TOML::
 
     name = "brushed_steel"
     model = "disney"                      # or "pixar", or "layered"

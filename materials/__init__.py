@@ -1,0 +1,1 @@
+"""What a material is and how it reflects light: models, lobes, the array shim (no I/O)."""

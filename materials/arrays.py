@@ -1,4 +1,4 @@
-"""The array shim: one model implementation, two array backends (DESIGN.md).
+"""The array shim: one model implementation, two array backends (:doc:`/design`).
 
 Every reflectance model in :mod:`lookdev.materials` is written once against the small
 namespace defined here, passed as ``xp`` to the model's core functions:

@@ -10,7 +10,7 @@ as a :class:`Model`:
     (constants, discrete switches such as ``thin``); ``maps`` override single fields with
     per-element values (texture lookups in Mitsuba, per-texel arrays in analysis). A lobe
     whose weight is ``xp.known_zero`` is recorded as absent here, and the other core
-    functions then skip it entirely (DESIGN.md: nothing is computed that is not needed).
+    functions then skip it entirely (:doc:`/design`: nothing is computed that is not needed).
 ``eval(xp, prepared, wi, wo) -> colour``
     f(wi, wo) *without* the cosine; ``wi`` towards the light, ``wo`` towards the viewer,
     both pointing away from the surface in the local frame (normal +z).

@@ -1,6 +1,6 @@
 """Colour management: the one OpenColorIO config, the working space, and every conversion.
 
-lookdev is scene-linear in a *named* working space (DESIGN.md, Colour). Every conversion
+lookdev is scene-linear in a *named* working space (:doc:`/design`, Colour). Every conversion
 between colour spaces is an OpenColorIO processor built from one config, so no transfer
 curve or primaries matrix is written by hand anywhere in the program:
 

@@ -20,7 +20,9 @@ w_g = (1 − metallic)·spec_trans:
                 and the glass's reflection (see :func:`_fresnel_terms`); the expert
                 ``specular_gamma`` ≠ 2 makes D the isotropic GTR of App. B eq. 1, sampled
                 by eqs. 2–3 (Chichi 2018's ``d_gamma``)
+
 ``clearcoat``   0.25 · clearcoat · D_GTR1 · F(0.04) · G(α = 0.25) / (4 cos θl cos θv)
+
 ``spec_trans``  w_g · T · Walter et al. 2007 rough dielectric BTDF (solid), or the
                 mirrored-reflection thin sheet with Burley 2015's roughness scale (thin)
 

@@ -11,7 +11,7 @@ with one roughness, so they are sampled as one strategy, as Mitsuba's ``dielectr
   A solid rough surface takes F at the sampled microfacet (wo·h), so each micro-normal
   reflects or refracts as its own Fresnel says; a thin sheet, whose two lobes have
   different roughnesses, and a smooth surface take it at the macro normal (cos θo). A
-  fixed choice costs 2.3–2.9× the per-pixel noise on glass (issue 16).
+  fixed choice costs 2.3–2.9× the per-pixel noise on glass (:doc:`/measurements/glass`).
 * **Smooth lobes are deltas.** Where a lobe's α (roughness², stretched by
   ``anisotropic``) is below :data:`~.microfacet.ALPHA_MIN` — the value roughness 0 used
   to be clamped to — the lobe is a Dirac delta (:func:`~.microfacet.is_delta`): the

@@ -1,4 +1,4 @@
-"""The one exception family of lookdev (DESIGN.md, Errors).
+"""The one exception family of lookdev (:doc:`/design`, Errors).
 
 Every error a user can cause derives from :class:`LookdevError`. Its ``str`` is a
 single line naming where the problem is (a file, a layer), the field, and what is

@@ -98,7 +98,7 @@ def ior_to_specular(ior: Any) -> Any:
 
 
 def schlick_weight(xp: Any, cos: Any) -> Any:
-    """(1 − cos θ)⁵ (Schlick 1994), 0 where rounding makes cos θ exceed 1.
+    """(1 − cos θ)⁵ :cite:p:`Schlick1994`, 0 where rounding makes cos θ exceed 1.
 
     >>> import numpy as np
     >>> from .arrays import NumpyOps
@@ -111,7 +111,7 @@ def schlick_weight(xp: Any, cos: Any) -> Any:
 
 
 def schlick(xp: Any, f0: Any, cos: Any) -> Any:
-    """F = F0 + (1 − F0)(1 − cos θd)⁵ (Burley 2012 §5.5; Schlick 1994 eq. 24).
+    """F = F0 + (1 − F0)(1 − cos θd)⁵ (:cite:t:`Burley2012` §5.5; :cite:t:`Schlick1994` eq. 24).
 
     ``f0`` may be a scalar or a colour; the result has its shape broadcast with ``cos``.
     Linear in F0, so mixing two F0s mixes the two Fresnel curves the same way.

@@ -3,18 +3,18 @@
 Written once over the array shim (:mod:`.arrays`); directions are channel-first vectors in
 the shading frame (normal +z, tangent +x). References:
 
-* Burley 2012, Appendix B: the Generalized-Trowbridge-Reitz distribution (eqs. 1–9) and
+* :cite:t:`Burley2012`, Appendix B: the Generalized-Trowbridge-Reitz distribution (eqs. 1–9) and
   its anisotropic γ = 2 form (eqs. 10–15); the 2014 addendum's α_x, α_y.
-* Heitz 2014, "Understanding the Masking-Shadowing Function …", eq. 86 (anisotropic
+* :cite:t:`Heitz2014`, eq. 86 (anisotropic
   GGX Λ), as the 2014 addendum adopts it.
-* Heitz 2018, "Sampling the GGX Distribution of Visible Normals" (JCGT 7(4)), listing 1.
+* :cite:t:`Heitz2018`, listing 1.
 
 **Minimum α, and below it a delta.** ``ALPHA_MIN`` = 10⁻³, the value of the Disney BRDF
 Explorer (and Schutte's and Mitsuba's ``principled``), is the smallest α a *glossy* GGX
 lobe takes: at it the peak D(n) = 1/(π α²) ≈ 3·10⁵ is still finite in float32, and
 ``sample``, ``pdf`` and ``eval`` all see the same α. Roughness used to be clamped up to it,
 so every roughness below √10⁻³ ≈ 0.0316 already rendered alike, as a lobe 0.06° wide that
-a renderer had to treat as glossy (sample lights at every vertex for nothing, issue 16).
+a renderer had to treat as glossy (sample lights at every vertex for nothing).
 The rule now (:func:`is_delta`): a GGX lobe whose larger α (roughness²/aspect, computed
 from the float32 roughness and anisotropy every consumer stores) is below ``ALPHA_MIN``
 is the α → 0 limit itself, a Dirac delta (mirror reflection, Snell refraction), sampled

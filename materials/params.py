@@ -76,7 +76,7 @@ SheenLambda = Literal["fit", "exact"]
 """Conty-Kulla's Smith Λ: Table 1's fit (r ≥ 0.08) or the integrated one (r ≥ 0.01),
 :mod:`lookdev.materials.sheen`."""
 SHEEN_MAX = 10.0
-"""Ceiling of Disney ``sheen`` (DESIGN.md, Ranges: every parameter has a ceiling)."""
+"""Ceiling of Disney ``sheen`` (:doc:`/design`, Ranges: every parameter has a ceiling)."""
 SPECULAR_GAMMA_MAX = 10.0
 """Ceiling of Disney ``specular_gamma``. At γ = 10 the GTR lobe is already ≈ 2.3 times narrower
 than GGX at the same roughness, and every float32 value of the lobe is finite up to it

@@ -234,7 +234,7 @@ def ends(xp: Any, w: dict[str, Any]) -> dict[str, tuple[Any, Any]]:
 
     Only the diffuse weights depend on the view, through FrnlBlend[…, V·n], which is
     affine in s = (1 − V·n)⁵: dN = Mix[(1 − clear)(1 − nRefl) FrnlBlend[1 − nRefl,
-    1 − gRefl, V·n], 1, rough] (the seed's ``1 rough`` lost its comma, DESIGN.md), dG
+    1 − gRefl, V·n], 1, rough] (the seed's ``1 rough`` lost its comma, :doc:`/design`), dG
     likewise with (1 − gRefl); diffN/diffG take (1 − back), diffTN/diffTG take back.
     So each is affine in s too and its two ends give it exactly at every view
     (:func:`at_view`). The highlight weights have one value: ``(w, None)``.

@@ -4,7 +4,7 @@ Smits writes every lobe as π × BRDF ("a traditional diffuse BRDF is a constant
 his energy plots divide by π). Here every function is the BRDF itself, so a white
 traditional diffuse is 1/π and the hemispherical integrals are the plain ones.
 
-Transcription traps in the seed (DESIGN.md): ``(1 - cos)5`` is (1 − cos)⁵; ``FrnBlend``
+Transcription traps in the seed (:doc:`/design`): ``(1 - cos)5`` is (1 − cos)⁵; ``FrnBlend``
 and ``FrnlBlend`` are one function; ``PSpecular``'s trailing ``4`` divides.
 
 >>> from lookdev.materials.arrays import NumpyOps

@@ -75,7 +75,7 @@ def at_view(xp: Any, pairs: dict[str, tuple[Any, Any]], cos_view: Any) -> dict[s
 
 
 def kept_lobes(xp: Any, pairs: dict[str, tuple[Any, Any]]) -> tuple[str, ...]:
-    """Lobes whose weights are not known to be zero (DESIGN.md: nothing unneeded)."""
+    """Lobes whose weights are not known to be zero (:doc:`/design`: nothing unneeded)."""
     kept = []
     for lobe in LOBES:
         values = [v for end in "NG" for v in pairs[PREFIX[lobe] + end] if v is not None]
@@ -92,7 +92,7 @@ def delta_lobes(cones: dict[str, Any], falloffs: dict[str, Any]) -> tuple[str, .
     cone used to be floored at 0.5° (the blend still floors it, for its energy-weighted
     means, :mod:`lookdev.pipeline.blend.pixar_composite`, hence "at most" here, so a lone
     layer stays its preset), and every narrower cone rendered alike as a glossy
-    lobe the renderer sampled lights for at every vertex (issue 16, as the Disney glass).
+    lobe the renderer sampled lights for at every vertex (as the Disney glass did).
     Below the floor the lobe is now its p → ∞ limit, a mirror (or, for a transmitted
     lobe, the view refracted by the IOR), whose weight is FrnBlend[N, G, cos θo]: the
     lobe's albedo in that limit. A cone or falloff that varies per element stays glossy

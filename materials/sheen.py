@@ -1,4 +1,4 @@
-"""Conty Estevez & Kulla 2017, "Production Friendly Microfacet Sheen BRDF".
+"""The Conty–Kulla microfacet sheen :cite:p:`Conty2017`.
 
 A microfacet lobe for cloth, written once over the array shim (:mod:`.arrays`):
 
@@ -20,7 +20,7 @@ with and without softening, at 64 μ × 32 r nodes. The size was chosen by measu
 bilinear read against direct quadrature at off-node points
 (``sheen_fit.albedo_table_error``); worst absolute error over μ ∈ [0, 1], r ∈ [R_MIN, 1]:
 16×16: 7.9e-3, 32×32: 4.1e-3, 64×16: 3.3e-3, **64×32: 1.5e-3**, 64×64: 1.6e-3,
-128×32: 6.8e-4. 1.5e-3 is the most the layering can gain (tests/test_sheen.py).
+128×32: 6.8e-4. 1.5e-3 is the most the layering can gain (tests/materials/test_sheen.py).
 
 Roughness: the paper's r lies in (0, 1] and, with the fitted Λ (``sheen_lambda = "fit"``),
 r is clamped to :data:`R_MIN` = 0.08.
@@ -30,14 +30,14 @@ sheen_fit``), the fit is under half the true Λ below r ≈ 0.03 and the lobe th
 more than it receives (albedo 1.04 at r = 0.01, cos θ = 0.01; without the softening
 already 1.10 at r = 0.05). From r = 0.08 up the albedo stays below 0.96 either way.
 Over r ∈ [0.08, 1], cos θ ∈ [0.01, 1] the fit's worst relative error is 0.21 (at r = 0.08,
-cos θ = 0.97, counting Λ ≥ 0.01 only); the r = 1 row is within 6% (tests/test_sheen.py
+cos θ = 0.97, counting Λ ≥ 0.01 only); the r = 1 row is within 6% (tests/materials/test_sheen.py
 prints the figures, ``sheen_fit.lambda_fit_error`` computes them).
 
 ``sheen_lambda = "exact"`` replaces the fit by the integrated Λ, read from a table
 (:mod:`.sheen_exact`, see :func:`lambda_exact`: 64 θ × 24 log r, worst relative error
 1.6e-3), and lowers the floor to :data:`R_MIN_EXACT` = 0.01; its own albedo tables
 (64 μ × 24 r on the same r nodes, worst error 1.25e-3, at most 7e-5 low) keep the
-layering consistent. Measured over r ∈ [0.01, 1] (tests/test_sheen.py): the lobe's albedo
+layering consistent. Measured over r ∈ [0.01, 1] (tests/materials/test_sheen.py): the lobe's albedo
 stays ≤ 0.99992, ≤ 1.0001 over a white base. The default stays ``"fit"``: the paper's
 model, which MaterialX's ``sheen_bsdf`` (``mode = "conty_kulla"``) implements, so a DCC
 shows what the proofs show (the two modes' albedos differ by up to 0.07 at r = 0.3).

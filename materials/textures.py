@@ -1,6 +1,6 @@
 """A parameter driven by an image: what a preset writes in place of a constant (no I/O).
 
-Any parameter of any model may be a texture as well as a constant (DESIGN.md, Textures)::
+Any parameter of any model may be a texture as well as a constant (:doc:`/design`, Textures)::
 
     roughness = { texture = "asset_Roughness.<UDIM>.png", channel = "r" }
     base_color = { texture = "asset_BaseColor.<UDIM>.png", colorspace = "sRGB - Texture" }

@@ -1,0 +1,1 @@
+"""Blending, textures, exporters, proofs, analysis, benchmarks and the command line."""

@@ -1,4 +1,4 @@
-"""Choosing the Mitsuba variant (DESIGN.md, Proofing).
+"""Choosing the Mitsuba variant (:doc:`/design`, Proofing).
 
 ``cuda_ad_rgb`` where a GPU is present, else ``llvm_ad_rgb`` where a libLLVM that works
 with Dr.Jit is found (libLLVM 14-16 crash in the JIT, so only 17 and newer are tried),

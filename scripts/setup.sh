@@ -18,7 +18,7 @@ if ! ldconfig -p 2>/dev/null | grep -q 'libLLVM.so.19'; then
   fi
 fi
 
-# Headless Chromium opens the proof review page in tests/test_report.py.
+# Headless Chromium opens the proof review page in tests/pipeline/analysis/test_review.py.
 if ! command -v chromium >/dev/null 2>&1 && command -v apt-get >/dev/null 2>&1; then
   SUDO=""
   [ "$(id -u)" -ne 0 ] && command -v sudo >/dev/null 2>&1 && SUDO="sudo"
@@ -42,4 +42,17 @@ if [ ! -f "$stamp" ] || [ pyproject.toml -nt "$stamp" ]; then
     exit 1
   fi
   touch "$stamp"
+fi
+
+# The documentation site's tools (the `docs` extra: Sphinx, MyST, numpydoc, bibtex), which
+# scripts/test.sh uses to build docs/ with warnings as errors.
+docs_stamp=.venv/.lookdev-docs-installed
+if [ ! -f "$docs_stamp" ] || [ pyproject.toml -nt "$docs_stamp" ]; then
+  echo "setup: installing the documentation tools into .venv (log: .venv/pip-docs.log)"
+  if ! .venv/bin/python -m pip install -q -e '.[docs]' >.venv/pip-docs.log 2>&1; then
+    tail -n 30 .venv/pip-docs.log >&2
+    echo "setup: error: pip install of the docs extra failed (full log: .venv/pip-docs.log)" >&2
+    exit 1
+  fi
+  touch "$docs_stamp"
 fi

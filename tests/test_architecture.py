@@ -1,4 +1,4 @@
-"""Import directions of the source tree (DESIGN.md, Layout and Data flow), read from the
+"""Import directions of the source tree (docs/design.md, Layout and Data flow), read from the
 source with ``ast``, nothing imported: ``pipeline → library → materials``; nothing outside
 ``pipeline/cli`` imports the CLI; benchmarks are imported only by the CLI and by each
 other; and no two modules import each other, directly or round a longer loop.
@@ -148,7 +148,7 @@ def test_only_the_cli_and_the_benchmarks_import_the_benchmarks(graph):
 
 
 CONSUMERS = ("lookdev.pipeline.export", "lookdev.pipeline.proof", "lookdev.pipeline.analysis")
-"""Modules that take the blended material (DESIGN.md: one hub): exporters, proofs, plots,
+"""Modules that take the blended material (docs/design.md: one hub): exporters, proofs, plots,
 the report and the stability sweep."""
 PRESET_WRITERS = ("lookdev.pipeline.export.usd.presets",)
 """`lookdev import usd` writes what it read as preset files: the one consumer that needs

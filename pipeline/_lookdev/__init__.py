@@ -33,6 +33,7 @@ __all__ = [
     "export_usd",
     "hub",
     "load",
+    "measured",
     "models",
     "pdf",
     "plot",

@@ -18,6 +18,7 @@ centre texel in the other views.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -251,6 +252,52 @@ def draw_polar(
     ax.legend(fontsize="x-small", loc="upper left", bbox_to_anchor=(-0.12, 1.12))
 
 
+# -- overlays: several materials on one axes (a measurement beside its fit) --------------
+OVERLAY_STYLES = ("-", "--", ":", "-.")
+
+
+def draw_albedo_overlay(ax: Any, hubs: Sequence[BlendedMaterial]) -> None:
+    """Each material's albedo per channel on one axes, a line style per material."""
+    for hub, style in zip(hubs, itertools.cycle(OVERLAY_STYLES), strict=False):
+        mc = albedo_curves(hub)[0]
+        for c, colour in enumerate(CHANNEL_COLOURS):
+            label = hub.name if c == 0 else None
+            ax.plot(np.degrees(mc.theta), mc.albedo[:, c], style, color=colour, lw=1.4, label=label)
+    ax.axhline(1.0, color="0.4", ls=":", lw=1)
+    ax.set_xlim(0, 90)
+    ax.set_ylim(0, 1.05)
+    ax.set_xlabel("incidence angle θ (°)")
+    ax.set_ylabel(f"directional albedo R, G, B (MC, {ALBEDO_SAMPLES} spp)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize="small", loc="best")
+
+
+def draw_polar_overlay(
+    ax: Any, hubs: Sequence[BlendedMaterial], incidence_deg: Sequence[float] = (0, 30, 60)
+) -> None:
+    """Each material's polar curves on one log radius, a colour per incidence angle and a
+    line style per material."""
+    curves = [polar_curves(h.bsdf_model, h.centre_params, incidence_deg) for h in hubs]
+    top = math.log10(max(max(float(lum.max()) for _, lum in curves), 1e-12))
+    floor = top - POLAR_DECADES
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for hub, (theta_o, lum), style in zip(
+        hubs, curves, itertools.cycle(OVERLAY_STYLES), strict=False
+    ):
+        for k, (ti, row) in enumerate(zip(incidence_deg, lum, strict=True)):
+            r = np.log10(np.maximum(row, 10.0**floor)) - floor
+            ax.plot(theta_o, r, style, color=colours[k], lw=1.3, label=f"{hub.name}, θi = {ti:g}°")
+    ax.set_theta_zero_location("N")
+    ax.set_theta_direction(-1)
+    ax.set_thetamin(-90)
+    ax.set_thetamax(90)
+    ax.set_rmax(POLAR_DECADES * 1.02)
+    ticks = np.arange(1, POLAR_DECADES + 1)
+    ax.set_rticks(ticks)
+    ax.set_yticklabels([f"{10.0 ** (floor + t):.1g}" for t in ticks], fontsize="x-small")
+    ax.legend(fontsize="xx-small", loc="upper left", bbox_to_anchor=(-0.25, 1.15))
+
+
 # -- sphere --------------------------------------------------------------------------
 def draw_sphere(ax: Any, image: np.ndarray, exposure: float, title: str) -> None:
     ax.imshow(tonemap.view(image, exposure))
@@ -303,10 +350,18 @@ def figure(
     environment: np.ndarray | None = None,
     ibl_name: str = "IBL",
     resolution: int = 128,
+    overlay: bool = False,
 ):
-    """A matplotlib figure of one view for several materials side by side."""
+    """A matplotlib figure of one view for several materials side by side, or (albedo and
+    polar with ``overlay``) drawn over each other on one axes."""
     if view not in VIEWS:
         raise ValueError(f"view must be one of {', '.join(VIEWS)}")
+    if overlay and view in ("albedo", "polar"):
+        fig = plt.figure(figsize=(6.4, 4.6), layout="constrained")
+        ax = fig.add_subplot(1, 1, 1, projection="polar" if view == "polar" else None)
+        (draw_polar_overlay if view == "polar" else draw_albedo_overlay)(ax, hubs)
+        fig.suptitle(f"{view}: " + " vs ".join(h.name for h in hubs), fontsize="medium")
+        return fig
     cols = len(hubs)
     rows = 2 if view == "sphere" and environment is not None else 1
     polar = view == "polar"

@@ -31,7 +31,7 @@ __all__ = ["ASSETS", "FRAME_FIELDS", "copy_assets", "data_script", "page_data"]
 ASSETS = ("review.js", "review.css")
 """The page's static files, shipped beside this module."""
 FRAME_FIELDS = ("spp", "noise", "noise_target", "time_s", "stop", "firefly_share", "clamp")
-"""Per-frame numbers the page shows (issue 16's manifest fields)."""
+"""Per-frame numbers the page shows (the proof manifest's fields)."""
 _OLD_NAMES = {"noise": "noise_relative", "time_s": "seconds"}
 
 

@@ -45,7 +45,7 @@ def sphere_normals(resolution: int) -> tuple[np.ndarray, np.ndarray]:
 def shading_frames(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Tangent and bitangent for unit normals (..., 3), branch-free.
 
-    Duff et al. 2017, "Building an Orthonormal Basis, Revisited", Listing 3.
+    :cite:t:`Duff2017`, Listing 3.
     """
     sign = np.where(n[..., 2] >= 0, 1.0, -1.0)
     a = -1.0 / (sign + n[..., 2])

@@ -14,7 +14,7 @@ The largest albedo met is reported per azimuth too.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -254,15 +254,21 @@ def _sweep_medium(report: ModelReport, label: str, params: Any, dtype: Any) -> N
 
 
 def check_model(
-    name: str, model: Model, progress: Callable[[str], None] = lambda label: None
+    name: str,
+    model: Model,
+    progress: Callable[[str], None] = lambda label: None,
+    measured: Sequence[Any] = (),
 ) -> ModelReport:
-    """The full sweep of one model."""
+    """The full sweep of one model (``measured``: the tables a measured model sweeps)."""
     report = ModelReport(name, allowance(name))
     for dtype in DTYPES:
         report.by_dtype[np.dtype(dtype).name] = dict.fromkeys(KINDS, 0)
         report.cases_by_dtype[np.dtype(dtype).name] = 0
-    cases = [(label, params, False) for label, params in parameter_cases(model.params_type)]
-    for label, params, with_maps in [*cases, (MAPS_LABEL, model.params_type(), True)]:
+    cases = [
+        (label, params, False) for label, params in parameter_cases(model.params_type, measured)
+    ]
+    # the maps run starts from the first case: the defaults (a measured model has none)
+    for label, params, with_maps in [*cases, (MAPS_LABEL, cases[0][1], True)]:
         progress(label)
         for dtype in DTYPES:
             try:
@@ -284,16 +290,19 @@ def check_model(
 
 
 def run(
-    names: list[str] | None = None, progress: Callable[[str, str], None] = lambda m, c: None
+    names: list[str] | None = None,
+    progress: Callable[[str, str], None] = lambda m, c: None,
+    measured: Sequence[Any] = (),
 ) -> dict[str, ModelReport]:
-    """Reports for every model of the registry (or those named)."""
+    """Reports for every model of the registry (or those named); ``measured``: the
+    tables (:class:`~lookdev.materials.measured.MeasuredTable`) the measured model sweeps."""
     reports = {}
     for name, model in models_named(names).items():
-        reports[name] = check_model(name, model, lambda label, n=name: progress(n, label))
+        reports[name] = check_model(name, model, lambda label, n=name: progress(n, label), measured)
     return reports
 
 
-def case_count(names: list[str] | None = None) -> int:
+def case_count(names: list[str] | None = None, measured: Sequence[Any] = ()) -> int:
     """How many parameter sets :func:`run` will sweep (for a progress bar)."""
     models = models_named(names).values()
-    return sum(len(parameter_cases(m.params_type)) + 1 for m in models)
+    return sum(len(parameter_cases(m.params_type, measured)) + 1 for m in models)

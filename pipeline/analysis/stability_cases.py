@@ -1,6 +1,6 @@
 """What ``lookdev check`` sweeps: the models, their stiff and extreme inputs, allowances.
 
-The cases of DESIGN.md, "Numerics that need care", for every model:
+The cases of :doc:`/design`, "Numerics that need care", for every model:
 
 * **parameters** — every field at each end of its range, one at a time from the defaults
   (roughness 0 and 1, black and white colours, each switch and each sheen model …), plus
@@ -21,7 +21,7 @@ Allowances: the Conty-Kulla lobe and Smits' model conserve energy by constructio
 0.002: its albedo table's measured interpolation error; pixar 0). The Disney BRDF adds
 energy by design (Burley 2012 fits measured looks, not energy conservation: the
 retro-reflective diffuse, the sheen and the clearcoat are added on top), so its allowance is
-a measured bound, documented here, not a tuning knob: 0.79. tests/test_disney.py measures
+a measured bound, documented here, not a tuning knob: 0.79. tests/materials/test_disney.py measures
 each lobe's gain up to θo = 89° (rough white plastic 1.567, sheen +0.09, clearcoat +0.05).
 With all of them at once and ``specular`` 1 the albedo keeps rising towards grazing: 1.721
 at 89°, 1.758 at 89.9°, 1.762 ± 0.001 at 89.99° and 89.9999° along the tangent (φo = 0).
@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import itertools
 import typing
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -62,13 +63,13 @@ ALLOWANCE = {
 }
 UNBOUNDED_HIGH = 10.0
 """The "pushed" value of a field with no upper bound. Every field a preset accepts has a
-ceiling (DESIGN.md, Ranges), so the sweep tests each at its ceiling; only the composited
+ceiling (:doc:`/design`, Ranges), so the sweep tests each at its ceiling; only the composited
 Pixar lobe weights (model inputs a blend produces, never written in a preset) use this."""
 
 SHEEN_ROUGHNESS = (0.01, 0.05, 0.08, 1.0)
 """Conty-Kulla roughness swept in both Λ modes (``sheen_lambda``)."""
 
-# Named stiff combinations (DESIGN.md), applied where every named field exists.
+# Named stiff combinations (docs/design.md), applied where every named field exists.
 COMBINATIONS: tuple[dict[str, Any], ...] = (
     {"roughness": 0.0, "metallic": 1.0},  # delta metal (α clamp)
     {"roughness": 0.0, "anisotropic": 1.0},
@@ -212,8 +213,32 @@ def plausible(params: Any) -> bool:
     return True
 
 
-def parameter_cases(params_type: type) -> list[tuple[str, Any]]:
-    """(label, params): defaults, each field at each extreme, and the named combinations."""
+def measured_cases(measured: Sequence[Any] = ()) -> list[tuple[str, Any]]:
+    """The measured model's cases: each measurement given (as read, negative noise
+    included: ``lookdev check`` gives the shipped ones) at scale 1 and the first at the
+    scale's ceiling, and two synthetic tables on the periodic MERL grid: all zero, and a
+    white Lambertian 0.999/π (the furnace's edge)."""
+    from lookdev.materials.measured import MeasuredParams, MeasuredTable
+
+    lambert = np.full((5, 5, 7, 3), 0.999 / np.pi, dtype=np.float32)
+    tables = list(measured)
+    tables += [MeasuredTable.constant(0.0), MeasuredTable("merl", lambert, source="white")]
+    cases = [(t.source, MeasuredParams(table=t)) for t in tables]
+    ceiling = MeasuredParams.model_fields["scale"].metadata[-1].le
+    cases += [
+        (f"{t.source}, scale={ceiling:g}", MeasuredParams(table=t, scale=ceiling))
+        for t in tables[:1]
+    ]
+    return cases
+
+
+def parameter_cases(params_type: type, measured: Sequence[Any] = ()) -> list[tuple[str, Any]]:
+    """(label, params): defaults, each field at each extreme, and the named combinations;
+    for the measured model, :func:`measured_cases` of the tables ``measured``."""
+    from lookdev.materials.measured import MeasuredParams
+
+    if params_type is MeasuredParams:
+        return measured_cases(measured)
     cases = [("defaults", params_type())]
     fields = params_type.model_fields
     for name, info in fields.items():

@@ -30,6 +30,7 @@ __all__ = [
     "hub",
     "library_for",
     "load",
+    "measured",
     "models",
     "pdf",
     "sample",
@@ -123,10 +124,32 @@ def load(name_or_path: PathLike, library: Any = None) -> Material:
 
 
 def _material(material: Any, library: Any = None) -> Any:
-    """``material`` itself unless it names a preset, which is then loaded."""
+    """``material`` itself unless it names a preset, which is then loaded, or a measured
+    BRDF file (``.mbsdf``, MERL ``.binary``), which becomes a blended material of the
+    ``measured`` model."""
     if isinstance(material, str | os.PathLike):
+        from lookdev.library.measured import MEASURED_SUFFIXES
+
+        if Path(material).suffix.lower() in MEASURED_SUFFIXES:
+            return measured(material)
         return load(material, library)
     return material
+
+
+def measured(path: PathLike) -> BlendedMaterial:
+    """A measured BRDF file as a material (the ``measured`` model over its table): a path,
+    or the file name of a shipped measurement (``"carpaint_red.mbsdf"``).
+
+    >>> import lookdev
+    >>> lookdev.measured("carpaint_red.mbsdf").params.table.shape
+    (45, 45, 90)
+    """
+    from lookdev.library.measured import read_measured, resolve_measured
+    from lookdev.materials.measured import MeasuredParams
+    from lookdev.pipeline.blend import BlendedMaterial
+
+    table = read_measured(resolve_measured(path))
+    return BlendedMaterial.of_params(MeasuredParams(table=table), name=Path(path).name)
 
 
 def _materials(materials: Any, library: Any) -> list[Any]:

@@ -613,6 +613,7 @@ def plot(
     library: Any = None,
     vary: tuple[str, Sequence[float]] | None = None,
     uv: tuple[float, float] | None = None,
+    overlay: bool = False,
 ) -> Plot:
     """Draw materials side by side as one BRDF-explorer view (Burley §3.2) to an image.
 
@@ -623,7 +624,8 @@ def plot(
     channel), ``polar`` (f in the plane of incidence) or ``sphere`` (a lit sphere, also
     under ``ibl`` when given). ``path`` ends in ``.png``, ``.pdf`` or ``.svg``.
     ``vary`` = (parameter, values) draws each material once per value
-    (``("specular_gamma", [1, 1.5, 2, 3])``).
+    (``("specular_gamma", [1, 1.5, 2, 3])``). ``overlay``: the albedo and polar views draw
+    every material on one axes (a measurement over its fit).
     """
     from lookdev.pipeline.analysis import plots
 
@@ -659,6 +661,7 @@ def plot(
         environment=environment,
         ibl_name=ibl or "",
         resolution=resolution,
+        overlay=overlay,
     )
     plots.save_figure(fig, output)
     return Plot(output, view, [h.name for h in hubs])
@@ -694,7 +697,7 @@ def check(
 ) -> Stability:
     """Sweep every reflectance model (or those named) over its stiff and extreme cases.
 
-    Parameters at both ends of their ranges and DESIGN.md's combinations, directions at
+    Parameters at both ends of their ranges and the named stiff combinations, directions at
     and beyond grazing, ``wi = −wo``, uniforms at 0, ½ and 1 − 2⁻²⁴, in float32 and
     float64; white-furnace albedos against each model's energy allowance.
     ``progress(done, total, model, case)`` is called after each parameter set.
@@ -708,10 +711,12 @@ def check(
     """
     import time
 
+    from lookdev.library.measured import builtin_measured, read_measured
     from lookdev.pipeline.analysis import stability
 
     names = list(models) if models else None
-    total = stability.case_count(names) if progress is not None else 0
+    measured = [read_measured(p) for p in builtin_measured()]  # the shipped measurements
+    total = stability.case_count(names, measured) if progress is not None else 0
     done = 0
 
     def advance(name: str, label: str) -> None:
@@ -721,5 +726,5 @@ def check(
             progress(done, total, name, label)
 
     started = time.perf_counter()
-    reports = stability.run(names, advance)
+    reports = stability.run(names, advance, measured)
     return Stability(reports, time.perf_counter() - started)

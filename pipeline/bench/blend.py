@@ -19,7 +19,7 @@ different per layer, so all parameter maps vary. Measured in one run:
   masks at twice the resolution driving a single map (where decoded masks, not maps,
   would dominate), streamed and, as the baseline, ``_decoded`` whole; and for
   :func:`udim_material`, a 2 × 2 UDIM set of N × N 8-bit roughness tiles on the base of a
-  two-layer stack (``-r 4096``: the 4-tile 4K set of issue 14), the map (2N)²;
+  two-layer stack (``-r 4096``: a 4-tile 4K UDIM set), the map (2N)²;
 - ``targets_met``: each bounded figure against :data:`TARGETS` (the table's target column);
 - pruning: the same blend with ``prune=False`` on the built-in ``rusty_car_paint`` (maps
   that need not vary) and on this stack with a full-coverage layer and a zero layer added
@@ -56,7 +56,7 @@ TARGETS = {
     "peak_rss_to_output_large_masks": 2.0,
     "peak_rss_to_output_udim": 2.0,
 }
-"""Issue 5's bounds: time ≤ 4× the copy, peak memory < 2× the output."""
+"""The bounds: time ≤ 4× the copy, peak memory < 2× the output."""
 
 
 def verdict(name: str, value: Any) -> str:

@@ -270,7 +270,8 @@ def summarise(
     >>> raw += [{"spp": 8, "rel_mse": 0.25, "seconds": 2.0}]
     >>> den = [{"spp": 4, "rel_mse": 0.01, "seconds": 2.0}]
     >>> s = summarise(raw, den, 4096)
-    >>> s["K"], s["points"][0]["raw_rel_mse_same_time"], s["points"][0]["raw_spp_to_match"]
+    >>> point = s["points"][0]
+    >>> round(s["K"], 12), round(point["raw_rel_mse_same_time"], 12), point["raw_spp_to_match"]
     (2.0, 0.25, 200.0)
     """
     spp = np.array([p["spp"] for p in raw], dtype=float)

@@ -12,7 +12,7 @@ over :data:`PARAM_SETS` (eight materials that between them switch on every lobe)
   kernel cache after an earlier run) is reported on its own and excluded from the
   throughput;
 - ``mitsuba``: the C++ ``principled`` plugin with the nearest parameters (see
-  :func:`principled_dict`; the two models differ where DESIGN.md says), same pairs.
+  :func:`principled_dict`; the two models differ where :doc:`/design` says), same pairs.
 
 Reported: evaluations per second of each and the throughput ratios
 ``ratio_drjit_to_mitsuba`` (target ≥ 0.5) and ``ratio_numpy_to_mitsuba`` (target ≥ 0.1,
@@ -108,7 +108,7 @@ def mitsuba_eval(bsdf: Any, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
     return np.where(cos[:, None] > 0, f / np.maximum(cos[:, None], 1e-30), 0.0)
 
 
-# Where the two models coincide (DESIGN.md, Traps): model restricted to some lobes (None:
+# Where the two models coincide (docs/design.md, Traps): model restricted to some lobes (None:
 # all of ours), our parameters; Mitsuba gets principled_dict(params). With specular = 0
 # Mitsuba's exact Fresnel is 0 everywhere, so its total is its diffuse (+ sheen) alone.
 AGREEMENT_CASES: dict[str, tuple[tuple[str, ...] | None, DisneyParams]] = {

@@ -29,7 +29,7 @@ not counted:
 Monte Carlo error falls as 1/spp while time grows as spp, so relMSE × seconds is the
 cost at equal noise, and
 
-    ratio = (relMSE × s)_ours / (relMSE × s)_built-in     (target ≤ 1.5, issue 16).
+    ratio = (relMSE × s)_ours / (relMSE × s)_built-in     (target ≤ 1.5).
 
 ``reference_difference`` is the relative difference of the two renderers' mean luminance
 over every sample rendered (frames and reference pooled), with its standard error
@@ -72,7 +72,7 @@ DEFAULT_PRESETS = (
 )
 """Every built-in glass preset (``presets/glass``)."""
 TARGET = 1.5
-"""The cost ratio ours / built-in at equal noise that issue 16 asks for, per preset."""
+"""The cost ratio ours / built-in at equal noise (target ≤ 1.5), per preset."""
 
 
 RELMSE_EPS = 1e-2

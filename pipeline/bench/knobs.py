@@ -1,4 +1,4 @@
-"""What each knob of the main job costs (issue 16): ``lookdev bench mainjob``.
+"""What each knob of the main job costs: ``lookdev bench mainjob``.
 
 For every preset of the main job under one IBL, a proof job is replayed as
 :func:`lookdev.pipeline.proof.batch.run_job` runs it — the Turntable built (the scene

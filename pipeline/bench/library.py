@@ -1,6 +1,6 @@
 """``lookdev bench library``: listing a big preset library against reading its bytes.
 
-Target (issue 4): ``lookdev presets list`` over a library of 10,000 presets answers within
+Target: ``lookdev presets list`` over a library of 10,000 presets answers within
 2x the time it takes merely to read those files' bytes. Both are timed in this process
 over the same freshly generated library, best of a few runs each, page cache warm:
 

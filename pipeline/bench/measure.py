@@ -172,8 +172,9 @@ def bench_lambda(
     reference_nodes: int = 2048,
 ) -> list[Row]:
     """The Λ fit, and the projected-area integral at a ladder of Gauss-Legendre nodes,
-    against that integral converged (:func:`lookdev.pipeline.analysis.sheen_fit.
-    lambda_integrated`, Heitz 2014: 1 + Λ(ω) = ∫ ⟨ω·m⟩ D(m) dm / cos θ)."""
+    against that integral converged
+    (:func:`~lookdev.pipeline.analysis.sheen_fit.lambda_integrated`, Heitz 2014: 1 + Λ(ω) =
+    ∫ ⟨ω·m⟩ D(m) dm / cos θ)."""
     from lookdev.pipeline.analysis.sheen_fit import lambda_integrated
 
     rows = []
@@ -289,7 +290,7 @@ def _drjit_lambdas(batch: np.ndarray) -> dict[str, dict[str, Callable[..., Any]]
 
 # -- float32 against float64 -----------------------------------------------------------
 def direction_pairs(n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """Random (wi, wo) pairs over both hemispheres, plus the edge cases DESIGN.md lists:
+    """Random (wi, wo) pairs over both hemispheres, plus the edge cases :doc:`/design` lists:
     normal incidence, grazing (cos θ = 1e-4), retro-reflection and wi = −wo."""
     rng = np.random.default_rng(seed)
     v = rng.normal(size=(2, n, 3))

@@ -1,4 +1,4 @@
-"""``lookdev bench noise``: what rendering to a noise target costs (issue 16).
+"""``lookdev bench noise``: what rendering to a noise target costs.
 
 Three measurements, each a ratio within one run (the machine may be shared):
 

@@ -1,4 +1,4 @@
-"""What the main job's defaults buy (issue 16): ``lookdev bench error --item mainjob``.
+"""What the main job's defaults buy: ``lookdev bench error --item mainjob``.
 (What each knob costs: :mod:`.knobs`, ``lookdev bench mainjob``.)
 
 **Error of the defaults** (:func:`error`). For a sampled subset of the main job (a glossy
@@ -6,7 +6,7 @@ plastic, a metal, glass and skin, one IBL each, the turntable's first pose), a c
 reference is rendered as two independent halves (their difference is its own noise,
 stated), and the frame as each default renders it is compared with it:
 
-* *old* — the job before issue 16: 192×96, a fixed 32 spp, Gaussian pixel filter, raw;
+* *old* — the job's old defaults: 192×96, a fixed 32 spp, Gaussian pixel filter, raw;
   its reference is rendered at 192×96 with the same filter, so the error is noise alone;
 * *new* — :mod:`lookdev.pipeline.proof.settings`' defaults: 480×240, box filter, the noise
   target and its cap, and the denoised frame when denoising is on; reference at 480×240.
@@ -14,7 +14,7 @@ stated), and the frame as each default renders it is compared with it:
 Error is relative MSE (:func:`.measure.relative_mse`, Rousselle et al. 2011) over the
 frame's RGB, the mean over ``seeds`` renders; the reference's own relMSE (``floor``, from
 its halves: Var of their mean = E[(A − B)²]/4) is part of every measured value and is
-listed beside it. The *estimate check* of issue 16 compares each raw frame's own noise
+listed beside it. The *estimate check* compares each raw frame's own noise
 estimate (:func:`lookdev.pipeline.proof.passes.estimate`, relative RMS on luminance) with
 the error measured the same way against the reference, the reference's noise taken out in
 quadrature: within a factor of 2 passes. The estimate describes the raw frame, never the
@@ -53,7 +53,7 @@ CASES: tuple[tuple[str, str], ...] = (
 )
 """The sampled subset of the main job whose error is measured: (preset, IBL)."""
 ESTIMATE_FACTOR = 2.0
-"""Issue 16: a frame's noise estimate within this factor of its measured error."""
+"""The target: a frame's noise estimate within this factor of its measured error."""
 
 
 def blended(preset: str) -> Any:

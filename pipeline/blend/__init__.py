@@ -1,4 +1,4 @@
-"""Blending engine: masks, Disney parameter blending, Pixar lobe compositing (issue 5).
+"""Blending engine: masks, Disney parameter blending, Pixar lobe compositing.
 
 >>> from lookdev.library import Library
 >>> blended = blend(Library(use_env=False).load("gold"), 64)

@@ -1,7 +1,7 @@
 """``blend()``: a layered material in, a :class:`BlendedMaterial` out.
 
 The result holds each parameter as a constant where it is uniform and as a map where it
-varies, and nothing is computed that the result does not need (DESIGN.md):
+varies, and nothing is computed that the result does not need (:doc:`/design`):
 
 - a layer whose mask is zero everywhere is dropped;
 - a layer under a full-coverage layer (mask 1 everywhere, presence 1) is dropped;

@@ -1,4 +1,4 @@
-"""The blended material: the one hub every consumer takes (DESIGN.md, Data flow).
+"""The blended material: the one hub every consumer takes (:doc:`/design`, Data flow).
 
 The library resolves a preset; :func:`lookdev.pipeline.blend.blend` runs once per material
 and resolution and returns a :class:`BlendedMaterial`; the USD exporter, the Mitsuba scene

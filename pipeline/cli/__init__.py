@@ -2,7 +2,7 @@
 
 Commands are verbs; each group lives in its own module beside this one and is added in
 :func:`_register`. Bad input anywhere ends in one line on stderr and exit code 2
-(DESIGN.md, Errors): commands raise :class:`~lookdev.materials.errors.LookdevError` and
+(:doc:`/design`, Errors): commands raise :class:`~lookdev.materials.errors.LookdevError` and
 :func:`main` turns it into that line.
 """
 
@@ -109,7 +109,7 @@ def _root(
 
 
 def _register() -> None:
-    from . import bench, check, export, export_usd, plot, presets, proof
+    from . import bench, check, export, export_usd, fit, plot, presets, proof
     from . import blend as blend_cli
     from . import colour as colour_cli
 
@@ -122,6 +122,7 @@ def _register() -> None:
     app.add_typer(export_usd.validate_app, name="validate")
     app.add_typer(presets.app, name="presets")
     app.command("plot")(plot.plot)
+    app.command("fit")(fit.fit)
     app.command("proof")(proof.proof)
     app.add_typer(colour_cli.app, name="colour")
     _reflow_help(app)
@@ -145,7 +146,7 @@ INTERRUPTED = "interrupted: run the same command again to resume"
 def main(argv: list[str] | None = None) -> None:
     """Entry point of the ``lookdev`` script; ``argv`` defaults to ``sys.argv[1:]``.
 
-    The one place errors become what a user sees (DESIGN.md, Errors): a
+    The one place errors become what a user sees (:doc:`/design`, Errors): a
     :class:`LookdevError`, Click's own usage errors (bad option values, unknown commands
     and options, missing arguments) and an ``OSError`` end in one line on stderr and exit
     2; exit 1 stays "checked and found problems"; Ctrl-C ends in one line and exit 130.

@@ -292,7 +292,7 @@ def error_(
     if report.mainjob:
         console.print(
             table(
-                "mainjob: old (before issue 16) and new default frames against converged "
+                "mainjob: old (192×96, 32 spp) and new default frames against converged "
                 "references; noise estimate vs measured: relative RMS of the raw frame",
                 quality.TABLE_COLUMNS,
                 quality.table_rows(report.mainjob),

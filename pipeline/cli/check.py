@@ -30,7 +30,7 @@ def check(
     """Sweep every model over its stiff and extreme cases, in float32 and float64.
 
     Models: disney, sheen, pixar (one not built yet is skipped).
-    Parameters: each at both ends of its range, and DESIGN.md's combinations.
+    Parameters: each at both ends of its range, and the named stiff combinations.
     Directions: normal, cos θ = 0.5, 1e-4, 1e-7, 0, below, wi = −wo, mirror.
     Uniforms: 0, ½ and 1 − 2⁻²⁴ in every sampling dimension, and random.
 

@@ -82,11 +82,20 @@ def plot(
             "--uv", help="Plot a texture-driven material as it is at this UV (default: centre)."
         ),
     ] = None,
+    overlay: Annotated[
+        bool,
+        typer.Option(
+            "--overlay",
+            help="albedo, polar: every material on one axes (a measurement and its fit).",
+        ),
+    ] = False,
     as_json: Annotated[
         bool, typer.Option("--json", help="Print one JSON object for scripts.")
     ] = False,
 ) -> None:
     """Draw PRESET… as one BRDF-explorer view and write it to an image.
+
+    A PRESET may be a measured BRDF file (.mbsdf, MERL .binary).
 
     Examples:
 
@@ -97,6 +106,8 @@ def plot(
       lookdev plot gold --vary specular_gamma=1,1.5,2,3 -o gamma.png --exposure -3
 
       lookdev plot gold --view albedo --vary energy_compensation=off,on -o ms.png
+
+      lookdev plot carpaint_red.mbsdf red_fit.toml --view polar --overlay -o fit.png
       lookdev --view Un-tone-mapped plot gold -o gold.png    # another OCIO view (global)
     """
     from lookdev.pipeline import api
@@ -112,6 +123,7 @@ def plot(
             library=library,
             vary=_vary(vary),
             uv=uv,
+            overlay=overlay,
         )
     if as_json:
         print_json(result.to_json())

@@ -77,7 +77,7 @@ __all__ = [
 
 MANIFEST = "manifest.json"
 TICK_S = 0.5
-FORMAT_VERSION = 2  # 2: per-frame sampling fields, ``images`` and ``files`` (issue 16)
+FORMAT_VERSION = 2  # 2: per-frame sampling fields, ``images`` and ``files``
 MAP_RESOLUTION = 512
 """Texels a side of a layered material's maps in a proof (the blend the proof renders)."""
 
@@ -235,7 +235,7 @@ def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
 
 
 def frame_entry(r: Any, images: dict[str, Path], settings: Settings) -> dict[str, Any]:
-    """A frame's manifest entry (the fields issue 16 agreed, per frame).
+    """A frame's manifest entry (its fields, per frame).
 
     ``images``: the role of each written file (``raw`` EXR, view-transformed ``png``) →
     its name in the proof's folder; ``files``: the same roles with size and SHA-256,

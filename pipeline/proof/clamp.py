@@ -1,7 +1,7 @@
 """``--clamp``: a path tracer whose camera samples are limited to a radiance, for previews.
 
 Clamping hides fireflies by biasing the image darker where light is concentrated (sun
-caustics, small hot highlights), so proofs render unclamped unless asked (issue 16: the
+caustics, small hot highlights), so proofs render unclamped unless asked (the
 manifest reports each frame's ``firefly_share`` instead). Mitsuba 3's ``path``
 integrator has no clamp, so this wraps it: a sample's radiance L is scaled by
 ``min(1, clamp / max(L))``, which keeps its hue. It is registered as a Mitsuba plugin and

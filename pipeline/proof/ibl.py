@@ -8,7 +8,7 @@ is used the same way.
 
 Every IBL of a batch is brought to one resolution and its exposure is folded into the
 pixels (:func:`load`): in Mitsuba 3.9 a new envmap resolution or ``scale`` compiles a new
-kernel, while new pixel values of the same size do not (DESIGN.md, Proofing).
+kernel, while new pixel values of the same size do not (:doc:`/design`, Proofing).
 
 Colour: the proof renders in the working space. Built-ins are generated in linear Rec.709
 (:data:`IBL_SPACE`); a file is in the space its header names (``colorSpace``,
@@ -179,8 +179,8 @@ def directions(width: int) -> tuple[np.ndarray, np.ndarray]:
     """Unit directions (H, W, 3) where Mitsuba's envmap shows each pixel; solid angles (H, W).
 
     Mitsuba 3.9's envmap puts column i at u = (i + ½)/W but row j at v = j/(H − 1): the
-    first row is the zenith itself and the last the nadir (measured in tests/test_ibl.py).
-    Solid angles are the trapezoid rule's weights on that grid.
+    first row is the zenith itself and the last the nadir (measured in
+    tests/pipeline/proof/test_ibl.py). Solid angles are the trapezoid rule's weights on that grid.
 
     >>> d, omega = directions(64)
     >>> bool(abs(omega.sum() - 4 * math.pi) < 0.05), d[0, 0].round(6).tolist()

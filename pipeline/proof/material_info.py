@@ -29,7 +29,10 @@ def _plain(value: Any) -> Any:
         return [round(float(c), 6) for c in np.asarray(value, dtype=np.float64).ravel()]
     if isinstance(value, np.generic):
         value = value.item()
-    return round(value, 6) if isinstance(value, float) else value
+    if isinstance(value, float):
+        return round(value, 6)
+    # a parameter that is not a number or a switch (a measured table) shows as its repr
+    return value if isinstance(value, int | str | bool | None) else repr(value)
 
 
 def describe(hub: Any) -> dict[str, Any]:

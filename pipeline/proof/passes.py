@@ -55,7 +55,7 @@ four passes of 4 spp took 1.19× the CPU time of one pass of 16: ``lookdev bench
 so passes are not smaller than the main job's cap: its frames render in one pass."""
 
 FIREFLY_FRACTION = 0.001
-"""The hottest 0.1 % of a frame's pixels are its fireflies (issue 16)."""
+"""The hottest 0.1 % of a frame's pixels are its fireflies."""
 
 
 @dataclass(frozen=True)

@@ -1,5 +1,5 @@
 """The calibrated look-dev rig beside the material: a chrome ball, an 18 % grey ball and a
-ColorChecker chart (DESIGN.md, Proofing).
+ColorChecker chart (:doc:`/design`, Proofing).
 
 A look-dev lead reads a proof against references that do not change from material to
 material: the chrome ball shows where the light comes from and how sharp it is, the grey

@@ -57,7 +57,7 @@ DEFAULT_DENOISE = True
 """Also write every frame denoised (:mod:`.denoise`, the raw kept), unless
 ``--no-denoise``: at the main job's sample counts the denoised frame's relMSE against a
 converged reference was 19–650× lower than a raw frame's at about the same time, and
-6.6–30× lower than the job's before issue 16 (192×96, 32 spp), where raw frames at
+6.6–30× lower than the old job's (192×96, 32 spp), where raw frames at
 480×240 stay above it at any affordable cap (README)."""
 DEFAULT_RESOLUTION = (480, 240)
 """Frame width and height of a proof: big enough to judge a texture."""

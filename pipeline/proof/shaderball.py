@@ -177,7 +177,7 @@ def camera(
 
     The pixel filter is a box by default: each sample lands in one pixel, so pixel noise
     stays independent, which a denoiser relies on (a Gaussian spreads each sample over
-    its neighbours, and OIDN then gains almost nothing: issue 16), and it costs less.
+    its neighbours, and OIDN then gains almost nothing), and it costs less.
     """
     import mitsuba as mi
 

@@ -3,7 +3,7 @@
 Burley 2012 §6.1: "all turntables include both element and lighting rotations". The scene
 is loaded once; every frame only updates scene parameters through ``mi.traverse`` (the
 ``to_world`` of the ball's and the cup's instances and of the envmap),
-so Mitsuba reuses the kernels it compiled for the first frame (DESIGN.md, Proofing).
+so Mitsuba reuses the kernels it compiled for the first frame (:doc:`/design`, Proofing).
 Renders are also frozen (``dr.freeze``): after the first frames are recorded, a frame
 replays the recorded kernel launches instead of tracing the integrator and our Python
 BSDF plugins again, which is most of a small frame's fixed cost.

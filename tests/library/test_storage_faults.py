@@ -1,4 +1,4 @@
-"""Fault injection for files on shared storage (issue 13, DESIGN.md "Files on shared storage").
+"""Fault injection for files on shared storage (issue 13, docs/design.md "Files on shared storage").
 
 Each case asserts what a user sees (one ``lookdev: error:`` line, exit code 2; warnings are
 ``lookdev: warning:`` lines), that no file outside the library changed (a tree snapshot

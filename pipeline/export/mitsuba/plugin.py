@@ -2,9 +2,9 @@
 
 The class adapts the model's four core functions, run on the Dr.Jit backend of the array
 shim (:meth:`DrJitOps.for_mitsuba`), to Mitsuba's BSDF interface, so a proof shows the very
-maths the numpy plots and tests describe (DESIGN.md, One implementation of each model).
+maths the numpy plots and tests describe (:doc:`/design`, One implementation of each model).
 
-Conventions at the boundary, and only here (DESIGN.md, Conventions):
+Conventions at the boundary, and only here (:doc:`/design`, Conventions):
 
 * Mitsuba's ``si.wi`` is the viewer side and its ``wo`` the light side; our core
   ``eval(xp, prepared, wi=light, wo=viewer)`` is the other way round, so the names swap.

@@ -1,4 +1,4 @@
-"""Materials as Mitsuba BSDF dictionaries and minimal scenes (issue 7).
+"""Materials as Mitsuba BSDF dictionaries and minimal scenes.
 
 :func:`bsdf_dict` turns a blended material (the hub, or a model's parameters) into the dictionary
 ``mi.load_dict`` takes: our own plugin (:mod:`.plugin`) for the material's model, with
@@ -110,11 +110,11 @@ def principled_equivalent(hub: BlendedMaterial) -> dict[str, Any] | None:
     Where: untextured metals (``metallic`` = 1 exactly, no clearcoat). There Burley's
     diffuse, sheen and transmission weights carry a factor (1 − metallic) = 0 and the
     specular is Schlick's Fresnel on the base colour with the anisotropic GGX and Smith G
-    of the 2014 addendum, which ``principled`` implements the same way (DESIGN.md, Traps);
-    tests/test_mitsuba_scene.py measures the two equal to float32 precision over roughness
-    0.04..1 and anisotropic 0..1. Tinted and dielectric speculars, clearcoat (Mitsuba leaves
-    out its 1/(4 cos θl cos θv)) and transmission differ on purpose and keep our plugin,
-    and so does a smooth metal (roughness below √10⁻³): a delta mirror in our model
+    of the 2014 addendum, which ``principled`` implements the same way (:doc:`/design`, Traps);
+    tests/pipeline/export/mitsuba/test_mitsuba_scene.py measures the two equal to float32 precision
+    over roughness 0.04..1 and anisotropic 0..1. Tinted and dielectric speculars, clearcoat
+    (Mitsuba leaves out its 1/(4 cos θl cos θv)) and transmission differ on purpose and keep our
+    plugin, and so does a smooth metal (roughness below √10⁻³): a delta mirror in our model
     (:func:`lookdev.materials.microfacet.is_delta`), a glossy α = 10⁻³ lobe in principled.
     """
     c = hub.constants
@@ -216,6 +216,10 @@ def _plugin_dict(hub: BlendedMaterial, texture_dir: str | Path | None) -> dict[s
 
 
 def _constant(value: Any) -> Any:
+    from lookdev.materials.measured import MeasuredTable
+
+    if isinstance(value, MeasuredTable):  # properties hold strings: the table by its key
+        return value.key()
     if isinstance(value, tuple):
         return {"type": "rgb", "value": [float(c) for c in value]}
     if isinstance(value, bool | str):

@@ -1,6 +1,6 @@
 """Which lobes of a material carry weight, and its parameters with the dead ones reset.
 
-"A lobe whose weight is zero everywhere is not … exported" (DESIGN.md). Which of a
+"A lobe whose weight is zero everywhere is not … exported" (:doc:`/design`). Which of a
 model's lobes live is the model's own rule (:func:`lookdev.materials.registry.live_lobes`);
 this module adds the exporter's finer groups of inputs (the dielectric part of the
 specular, Conty-Kulla sheen, the 2012 subsurface, flatness on thin sheets, the scatter

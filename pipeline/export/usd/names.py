@@ -2,7 +2,7 @@
 
 Each :class:`Slot` says which of our parameters feeds which input of the target's
 surface, with what USD value type, and how a value converts there and back. A table is
-the only place a target's spelling of a parameter appears (DESIGN.md, Names).
+the only place a target's spelling of a parameter appears (:doc:`/design`, Names).
 
 Choice of MaterialX surface per model:
 

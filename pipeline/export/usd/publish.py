@@ -1,4 +1,4 @@
-"""What makes an exported file an asset a pipeline can publish (issue 15, assets).
+"""What makes an exported file an asset a pipeline can publish.
 
 - Maps the exporter writes are half-float, tiled, mip-mapped EXRs made by OpenImageIO's
   ``make_texture`` (what renderers page from), with a fixed ``DateTime`` so the same

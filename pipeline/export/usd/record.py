@@ -1,5 +1,5 @@
 """The preset an export came from, carried in the Material's ``customData`` so that
-``lookdev import usd`` gives it back exactly (issue 15: every lookdev export round-trips).
+``lookdev import usd`` gives it back exactly (every lookdev export round-trips).
 
 The networks say what each renderer can express; this record says what the preset *was*:
 its model, description, tags, citation and the parameters it gave (a plain preset, after

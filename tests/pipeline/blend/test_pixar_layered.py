@@ -417,8 +417,8 @@ def test_mitsuba_chi2_of_the_layered_plugin(mi, view):
 @pytest.mark.slow
 def test_mitsuba_chi2_zoomed_on_the_composited_mirror_peak(mi):
     """The glaze's 1° reflection cone, composited over clay, on a chart around its mirror
-    direction (as tests/test_mitsuba_models.py zooms on narrow peaks). 10⁶ samples: at
-    2·10⁵ this seed gave p = 0.0015 (the plain glaze 0.058), at 10⁶ p = 0.56; an error
+    direction (as tests/pipeline/export/mitsuba/test_mitsuba_models.py zooms on narrow peaks). 10⁶
+    samples: at 2·10⁵ this seed gave p = 0.0015 (the plain glaze 0.058), at 10⁶ p = 0.56; an error
     in the composite's sampler would show more clearly with more samples, not less."""
     from _mitsuba_chi2 import chi2
 

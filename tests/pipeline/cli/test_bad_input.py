@@ -3,7 +3,7 @@ NaN/inf everywhere, every CLI argument error, the wrong messages, ``presets show
 ``import usd``, batch pre-validation and manifest merge, and a hypothesis test driving the
 CLI's argument parsing.
 
-Run: ``.venv/bin/python -m pytest tests/test_bad_input.py -q``
+Run: ``.venv/bin/python -m pytest tests/pipeline/cli/test_bad_input.py -q``
 """
 
 from __future__ import annotations

@@ -141,7 +141,7 @@ def test_every_kind_of_plugin_renders_frozen(tmp_path):
 
 
 def test_every_ibl_of_a_batch_enters_the_scene_the_same_way(mitsuba):
-    """Why a batch brings IBLs to one size and folds exposure into pixels (DESIGN.md):
+    """Why a batch brings IBLs to one size and folds exposure into pixels (docs/design.md):
     Mitsuba compiles a new kernel for an envmap of another resolution or ``scale``. So
     every IBL, built-in or a file, at any exposure, arrives as an array of one shape and
     dtype, and two proof scenes differ in the environment's pixels and nothing else.
