@@ -27,6 +27,7 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from lookdev.materials.layers import CombineMask, ConstantMask, Mask, TextureMask, map_textures
+from lookdev.materials.openpbr_params import OpenPBRParams
 from lookdev.materials.params import DisneyParams
 from lookdev.materials.pixar import PixarParams
 from lookdev.materials.textures import UDIM_TOKEN, TextureInput, is_texture_input
@@ -45,10 +46,12 @@ class Material(BaseModel):
     model_config = ConfigDict(frozen=True)
 
     name: str
-    model: Literal["disney", "pixar", "layered"]
+    model: Literal["disney", "pixar", "openpbr", "layered"]
     description: str = ""
     tags: list[str] = Field(default_factory=list)
-    params: DisneyParams | PixarParams | None = Field(None, description="None when layered.")
+    params: DisneyParams | PixarParams | OpenPBRParams | None = Field(
+        None, description="None when layered."
+    )
     textures: dict[str, TextureInput] = Field(
         default_factory=dict,
         description="Parameters driven by textures (paths absolute), checked at load; "

@@ -56,7 +56,7 @@ class PresetFile(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, title="lookdev preset")
 
     name: str = Field(description="Preset name; must equal the file name without '.toml'.")
-    model: Literal["disney", "pixar", "layered"] | None = Field(
+    model: Literal["disney", "pixar", "openpbr", "layered"] | None = Field(
         None, description="Reflectance model; may be left out when 'extends' names the parent."
     )
     description: str = Field("", description="One sentence for people browsing the library.")

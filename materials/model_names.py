@@ -8,5 +8,6 @@ from __future__ import annotations
 
 __all__ = ["PRESET_MODELS"]
 
-PRESET_MODELS: tuple[str, ...] = ("disney", "pixar")
-"""Models a preset file may name (besides ``layered``, a stack of them)."""
+PRESET_MODELS: tuple[str, ...] = ("disney", "pixar", "openpbr")
+"""Models a preset file may name (besides ``layered``, a stack of them); ``openpbr``
+holds an imported OpenPBR material as itself."""

@@ -10,7 +10,7 @@ model's own ``prepare`` on the numpy backend: a lobe lives where its weight is n
 everywhere, exactly as the model prunes it when it evaluates, samples and renders.
 
 >>> sorted(MODELS)
-['disney', 'measured', 'pixar', 'pixar_layered', 'sheen']
+['disney', 'measured', 'openpbr', 'pixar', 'pixar_layered', 'sheen']
 >>> from .params import DisneyParams
 >>> live_lobes(MODELS["disney"], DisneyParams(metallic=1.0, sheen=0.5))
 ('specular',)
@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from . import disney, measured, pixar, sheen
+from . import disney, measured, openpbr, pixar, sheen
 from .arrays import NumpyOps
 from .bsdf import Model
 from .errors import LookdevError
@@ -47,7 +47,15 @@ __all__ = [
 ]
 
 MODELS: dict[str, Model] = {
-    m.name: m for m in (disney.MODEL, sheen.MODEL, pixar.MODEL, pixar.LAYERED_MODEL, measured.MODEL)
+    m.name: m
+    for m in (
+        disney.MODEL,
+        sheen.MODEL,
+        pixar.MODEL,
+        pixar.LAYERED_MODEL,
+        measured.MODEL,
+        openpbr.MODEL,
+    )
 }
 """Every model by name; each renders in Mitsuba as the plugin ``lookdev_<name>``. A new
 model adds itself here (tests add toy models the same way)."""

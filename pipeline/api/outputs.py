@@ -54,10 +54,18 @@ class UsdExport:
     fidelity: dict[str, Any] = field(default_factory=dict)
     """material → its universal context measured against it (``report=True``):
     :class:`lookdev.pipeline.export.usd.fidelity.Fidelity`."""
+    contexts_fidelity: dict[str, Any] = field(default_factory=dict)
+    """material → every context measured against it, one ``Fidelity`` each (``report``)."""
 
     def to_json(self) -> dict[str, Any]:
-        """The summary ``lookdev export usd --json`` prints."""
+        """The summary ``lookdev export usd --json`` prints (with ``report``: ``fidelity``,
+        the universal context per material, and ``context_fidelity``, a row per material
+        × context)."""
         extra = {"fidelity": [f.to_json() for f in self.fidelity.values()]} if self.fidelity else {}
+        if self.contexts_fidelity:
+            extra["context_fidelity"] = [
+                f.to_json() for rows in self.contexts_fidelity.values() for f in rows
+            ]
         return extra | {
             "output": str(self.output),
             "files": [str(p) for p in self.files],
@@ -90,6 +98,7 @@ def export_usd(
     report: bool = False,
     collect: bool = False,
     preview_geometry: bool = False,
+    mtlx_surface: str = "openpbr",
 ) -> UsdExport:
     """Write materials as UsdShade materials under ``/Materials`` of ``path``.
 
@@ -138,6 +147,10 @@ def export_usd(
         referenced where they are, relative to ``path`` where possible.
     preview_geometry
         Add a sphere per material, bound to it, in a grid under ``/Materials/Geometry``.
+    mtlx_surface
+        The ``mtlx`` surface of Disney materials: ``"openpbr"`` (default, OpenPBR
+        Surface through :mod:`lookdev.pipeline.export.usd.openpbr_map`) or ``"disney"``
+        (``ND_disney_principled``).
 
     Returns
     -------
@@ -184,6 +197,7 @@ def export_usd(
         report=report,
         collect=collect,
         preview_geometry=preview_geometry,
+        mtlx_surface=mtlx_surface,
     )
     return UsdExport(
         result.files[0],
@@ -193,6 +207,7 @@ def export_usd(
         result.images,
         result.losses,
         result.fidelity,
+        result.contexts_fidelity,
     )
 
 
@@ -457,7 +472,10 @@ def proof(
         ``"universal"``: also proof, beside each material, its USD universal context as
         ``NAME-universal``: the UsdPreviewSurface values rendered by that surface's own
         BRDF (:func:`lookdev.pipeline.export.usd.fidelity.preview_hub`), what a DCC
-        preview shows.
+        preview shows. ``"mtlx"``: its ``mtlx`` context as ``NAME-mtlx``, the OpenPBR
+        Surface values rendered by the OpenPBR model
+        (:func:`lookdev.pipeline.export.usd.context_views.mtlx_hub`), what an OpenPBR
+        renderer shows.
     geometry
         A mesh (PLY, OBJ, or USD geometry) rendered in the cup's place beside the ball,
         with its own UVs (:mod:`lookdev.pipeline.proof.geometry`).
@@ -519,14 +537,18 @@ def proof(
     ibl_names = list(dict.fromkeys(ibls or ibl_module.builtin_names()))
     environments = [ibl_module.load(name, ibl_width) for name in ibl_names]
     loaded = [hub(m, batch.MAP_RESOLUTION, lib) for m in chosen]
-    if context not in (None, "source", "universal"):
+    if context not in (None, "source", "universal", "mtlx"):
         raise batch.ProofError(
-            f"unknown context {context!r}; allowed: universal", field=argument("context")
+            f"unknown context {context!r}; allowed: universal, mtlx", field=argument("context")
         )
     if context == "universal":
         from lookdev.pipeline.export.usd.fidelity import preview_hub
 
         loaded = [h for m in loaded for h in (m, preview_hub(m))]
+    if context == "mtlx":
+        from lookdev.pipeline.export.usd.context_views import mtlx_hub
+
+        loaded = [h for m in loaded for h in (m, mtlx_hub(m))]
     doc = batch.proof(
         loaded,
         environments,

@@ -74,6 +74,8 @@ def blend(
     sampler = MaskSampler(
         (height * dv, width * du), images, output_channels=_channels_bound(entries), extent=extent
     )
+    if entries[0].model == "openpbr":
+        return _openpbr(material, entries)
     if entries[0].model == "pixar":
         result = pixar.blend_stack(
             material.name,
@@ -138,6 +140,19 @@ class Textured:
 
     def __hash__(self) -> int:
         return hash((self.field, self.texture))
+
+
+def _openpbr(material: Any, entries: list[Entry]) -> BlendedMaterial:
+    """An ``openpbr`` preset (an OpenPBR material imported as itself): its constants;
+    it has no layering or texture rules of its own."""
+    if len(entries) > 1 or entries[0].decoded:
+        raise BlendError(
+            f"{material.name}: openpbr presets take constants only (no layers, no textures)",
+            field="model",
+        )
+    out = BlendedMaterial.of_params(entries[0].params, name=material.name)
+    out.description = material.description
+    return out
 
 
 def _values(entry: Entry) -> dict[str, Any]:

@@ -30,6 +30,16 @@ class PreviewOpacity(StrEnum):
     transmission = "transmission"
 
 
+class ImportOpenPBR(StrEnum):
+    disney = "disney"
+    itself = "itself"
+
+
+class MtlxSurface(StrEnum):
+    openpbr = "openpbr"
+    disney = "disney"
+
+
 def export_usd(
     presets: Annotated[
         list[str] | None,
@@ -101,8 +111,9 @@ def export_usd(
         bool,
         typer.Option(
             "--report",
-            help="Measure each material's UsdPreviewSurface against the material: "
-            "directional albedo over view angles (RMS, worst) and the highlight ratio.",
+            help="Measure every context of each material against the material (universal, "
+            "mtlx as OpenPBR and as ND_disney_principled, ri where its model is known): "
+            "directional albedo 0-85° (RMS, worst) and the highlight's energy and width.",
         ),
     ] = False,
     collect: Annotated[
@@ -120,17 +131,28 @@ def export_usd(
             help="Add a sphere per material, bound to it, so a DCC's default import shows it.",
         ),
     ] = False,
+    mtlx_surface: Annotated[
+        MtlxSurface,
+        typer.Option(
+            "--mtlx-surface",
+            help="The mtlx surface of Disney presets: 'openpbr' (OpenPBR Surface, what "
+            "current MaterialX renderers read; the mapping's losses are named) or 'disney' "
+            "(ND_disney_principled, Burley's parameters as they are).",
+        ),
+    ] = MtlxSurface.openpbr,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
     """Write presets as UsdShade materials that DCCs and their renderers read.
 
     Each preset becomes /Materials/NAME with up to three render contexts: **universal**
-    (UsdPreviewSurface, read everywhere), **mtlx** (MaterialX ND_disney_principled) and
-    **ri** (RenderMan PxrDisneyBsdf). What a context cannot express is printed as a
-    table, written as the Material's doc string and kept in the surface's customData
-    (under "losses" with --json). Glass keeps opacity 1 in UsdPreviewSurface unless
-    --preview-opacity transmission. Only what a material needs is written: inputs at the target's
-    default and lobes without weight are left out. Layered presets are blended and their
+    (UsdPreviewSurface, read everywhere), **mtlx** (MaterialX OpenPBR Surface, or
+    ND_disney_principled with --mtlx-surface disney) and **ri** (RenderMan
+    PxrDisneyBsdf). What a context cannot express is printed as a table, written as
+    the Material's doc string and kept in the surface's customData (under "losses"
+    with --json). Glass keeps opacity 1 in UsdPreviewSurface unless
+    --preview-opacity transmission. Only what a material needs is written: inputs at
+    the target's default and lobes without weight are left out. Layered presets are
+    blended and their
     varying parameters baked to EXR maps beside the file (UsdPreviewSurface has no mix
     node). With several presets, /Materials/Look carries a variant set that switches between
     them. A parameter read from one texture file references that file (its colour space
@@ -179,6 +201,7 @@ def export_usd(
             report=report,
             collect=collect,
             preview_geometry=preview_geometry,
+            mtlx_surface=mtlx_surface.value,
         )
     if as_json:
         print_json(result.to_json())
@@ -201,14 +224,17 @@ def export_usd(
         console.print(losses)
     else:
         console.print("every render context expresses every material fully")
-    if result.fidelity:
-        rows = sorted(result.fidelity.values(), key=lambda f: -f.rms)
+    if result.contexts_fidelity:
+        rows = [f for by in result.contexts_fidelity.values() for f in by]
+        rows.sort(key=lambda f: (f.material, f.context))
         fid = table(
-            "UsdPreviewSurface vs the material (albedo over 0-85°, highlight at 30°)",
-            ["material", "albedo RMS", "worst", "highlight preview/source"],
+            "Each context vs the material (albedo over 0-85°, highlight at 30°)",
+            ["material", "context", "albedo RMS", "worst", "highlight energy", "width"],
             [f.row() for f in rows],
         )
         console.print(fid)
+        for note in sorted({n for f in rows for n in f.notes}):
+            console.print(f"note: {note}", highlight=False)
 
 
 @contextmanager
@@ -257,6 +283,15 @@ def import_usd(
             "(default: refuse; --force replaces a preset in -o instead).",
         ),
     ] = False,
+    openpbr: Annotated[
+        ImportOpenPBR,
+        typer.Option(
+            "--openpbr",
+            help="OpenPBR Surface materials from other tools: 'disney' (translated to "
+            "Burley's parameters, losses named) or 'itself' (an openpbr preset holding "
+            "its inputs as they are, proofed by lookdev's OpenPBR model).",
+        ),
+    ] = ImportOpenPBR.disney,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
     """Read materials from a USD file back into presets.
@@ -287,6 +322,11 @@ def import_usd(
 
     skipped: list[str] = []
     found = read(file.expanduser(), skipped)
+    if openpbr is ImportOpenPBR.itself:
+        from lookdev.pipeline.export.usd.openpbr_import import import_as_openpbr
+
+        itself = import_as_openpbr(file.expanduser())
+        found = [itself.get(m.name, m) for m in found]
     names = import_names(found, _taken_names(output, rename), rename=rename)
     written = write_presets(found, output, force=force, names=names)
     if as_json:

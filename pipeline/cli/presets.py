@@ -72,9 +72,9 @@ def list_(
 
       lookdev presets list -L ~/looks --model layered --json
     """
-    if model is not None and model not in ("disney", "pixar", "layered"):
+    if model is not None and model not in ("disney", "pixar", "openpbr", "layered"):
         raise PresetError(
-            f"unknown model {model!r}; allowed: disney, pixar, layered", field="--model"
+            f"unknown model {model!r}; allowed: disney, pixar, openpbr, layered", field="--model"
         )
     from lookdev.library import listing
 

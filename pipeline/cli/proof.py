@@ -31,6 +31,7 @@ from .common import console, err_console, print_json, table
 
 class ProofContext(StrEnum):
     universal = "universal"
+    mtlx = "mtlx"
 
 
 class Rig(StrEnum):
@@ -218,7 +219,9 @@ def proof(
             "--context",
             help="'universal': also proof, beside each preset, its USD universal context "
             "as PRESET-universal: the UsdPreviewSurface values rendered by that surface's "
-            "own BRDF, what a DCC preview shows (export usd --report measures the difference).",
+            "own BRDF, what a DCC preview shows; 'mtlx': also PRESET-mtlx, its OpenPBR "
+            "Surface rendered by the OpenPBR model, what an OpenPBR renderer shows "
+            "(export usd --report measures both differences).",
         ),
     ] = None,
 ) -> None:

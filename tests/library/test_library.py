@@ -149,7 +149,7 @@ def test_builtin_files_validate_against_the_generated_json_schema():
         ('name = "a"\nmodel = "disney"\n[params]\nmetallic = true\n', "params.metallic", "number"),
         ('name = "a"\nmodel = "pixar"\n[params]\nclear = "0.5"\n', "params.clear", "number"),
         ('name = "a"\nmodel = "disney"\n[params]\nthin = 1\n', "params.thin", "boolean"),
-        ('name = "a"\nmodel = "phong"\n', "model", "'disney', 'pixar' or 'layered'"),
+        ('name = "a"\nmodel = "phong"\n', "model", "'disney', 'pixar', 'openpbr' or 'layered'"),
         ('name = "a"\n', None, "'model' is required"),
         ('name = "b"\nmodel = "disney"\n', "name", "differs from the file name"),
         ('name = "a"\nmodel = "disney"\ntags = "metal"\n', "tags", "list"),

@@ -33,6 +33,7 @@ def export_materials(
     report: bool = False,
     collect: bool = False,
     preview_geometry: bool = False,
+    mtlx_surface: str = "openpbr",
 ):
     """Write blended materials (:class:`~lookdev.pipeline.blend.BlendedMaterial`) as
     UsdShade materials to ``out``.
@@ -46,8 +47,8 @@ def export_materials(
     ``out`` and only copied into place when every file could be written.
     ``preview_opacity``: see :data:`.names.PREVIEW_OPACITY`. ``meters_per_unit``: the
     stage's ``metersPerUnit`` (lengths are written in its units). ``report``: measure each
-    material's universal context against the material (:mod:`.fidelity`), in the
-    result's ``fidelity``.
+    material's contexts against the material (:mod:`.fidelity`): the universal one in the
+    result's ``fidelity``, every one (both ``mtlx`` surfaces) in ``contexts_fidelity``.
     ``preview_opacity``: see :data:`.names.PREVIEW_OPACITY`. ``collect`` copies the
     presets' own texture files beside ``out``; ``preview_geometry`` adds a sphere per
     material (:func:`.writer.export_usd`).
@@ -67,14 +68,17 @@ def export_materials(
         texture_dir = Path(scratch, textures) if package else out.parent / textures
         sources = []
         measured: dict = {}
+        contexts_measured: dict = {}
         for material in materials:
             source = source_for(material, texture_dir, scratch=Path(scratch), bake=bake)
             source.record = preset_record(material)
             sources.append(source)
             if report:
-                from .fidelity import fidelity
+                from .fidelity import context_fidelity
 
-                measured[material.name] = fidelity(material, source, preview_opacity)
+                rows = context_fidelity(material, source, preview_opacity, meters_per_unit)
+                measured[material.name] = rows[0]  # the universal context
+                contexts_measured[material.name] = rows
             if progress is not None:
                 progress(len(sources), count or len(sources), material.name)
         result = write(
@@ -89,8 +93,10 @@ def export_materials(
             meters_per_unit=meters_per_unit,
             collect=collect,
             preview_geometry=preview_geometry,
+            mtlx_surface=mtlx_surface,
         )
         result.fidelity = measured
+        result.contexts_fidelity = contexts_measured
         return result
 
 

@@ -30,19 +30,32 @@ from lookdev.materials.preview_surface import MODEL as PREVIEW
 from lookdev.materials.preview_surface import PreviewParams
 from lookdev.pipeline.blend.result import BlendedMaterial
 
+from .context_views import preview_params, views
 from .names import table_for
 from .network import Connection, Source, plain_value
-from .preview import build, preview_defaults
+from .preview import build
 
 __all__ = [
     "ANGLES",
     "PREVIEW_SUFFIX",
     "Fidelity",
+    "Measured",
     "PreviewHub",
+    "compared",
+    "context_fidelity",
     "fidelity",
+    "source_measured",
+    "measure",
     "preview_hub",
     "preview_params",
 ]
+
+SHORT = {
+    "ND_open_pbr_surface_surfaceshader": "OpenPBR",
+    "ND_disney_principled": "disney_principled",
+    "ND_UsdPreviewSurface_surfaceshader": "UsdPreviewSurface",
+}
+"""Surface ids as the report table names them."""
 
 ANGLES = (0.0, 30.0, 45.0, 60.0, 75.0, 85.0)
 """View angles (degrees from the normal) at which albedo is compared."""
@@ -52,7 +65,8 @@ CHANNELS = "RGB"
 
 @dataclass(frozen=True)
 class Fidelity:
-    """One material's universal-context fidelity (see the module doc)."""
+    """One material's fidelity in one context (see the module doc). ``albedo_preview``
+    is the context's albedo (the name is the universal context's, kept for scripts)."""
 
     material: str
     albedo_source: list[list[float]]  # per angle, RGB
@@ -60,11 +74,26 @@ class Fidelity:
     rms: float  # over angles and channels
     worst: float  # largest |difference|
     worst_at: str  # "60° G"
-    highlight_ratio: float  # preview / source luminance of f·cos at the mirror direction
+    highlight_ratio: float  # context / source luminance of f·cos near the mirror direction
+    context: str = "universal"
+    surface: str = "UsdPreviewSurface"
+    highlight_width_source: float = 0.0  # degrees: the source's spread near the mirror
+    highlight_width: float = 0.0  # degrees: the context's
+    loss: str = ""  # what the network could not express (its surface's note)
+    notes: tuple[str, ...] = ()  # renderer behaviours that change the look
+    unavailable: str = ""  # why there is no figure (the context's model is not known)
 
     def to_json(self) -> dict[str, Any]:
+        if self.unavailable:  # no figures: null, not NaN (which JSON does not have)
+            blank = {k: None for k in ("albedo_preview", "rms", "worst", "highlight_ratio")}
+            return {**self._json(), **blank, "highlight_width_deg": None}
+        return self._json()
+
+    def _json(self) -> dict[str, Any]:
         return {
             "material": self.material,
+            "context": self.context,
+            "surface": self.surface,
             "angles_deg": list(ANGLES),
             "albedo_source": self.albedo_source,
             "albedo_preview": self.albedo_preview,
@@ -72,106 +101,152 @@ class Fidelity:
             "worst": self.worst,
             "worst_at": self.worst_at,
             "highlight_ratio": self.highlight_ratio,
+            "highlight_width_source_deg": self.highlight_width_source,
+            "highlight_width_deg": self.highlight_width,
+            "loss": self.loss,
+            "notes": list(self.notes),
+            "unavailable": self.unavailable,
         }
 
     def row(self) -> list[str]:
+        where = f"{self.context} {SHORT.get(self.surface, self.surface)}"
+        if self.unavailable:
+            return [self.material, where, "not available", "", "", ""]
         return [
             self.material,
+            where,
             f"{self.rms:.3f}",
             f"{self.worst:+.3f} at {self.worst_at}",
             f"{self.highlight_ratio:.2f}",
+            f"{self.highlight_width_source:.1f}° → {self.highlight_width:.1f}°",
         ]
-
-
-def preview_params(source: Source, preview_opacity: str = "keep") -> PreviewParams:
-    """The UsdPreviewSurface a DCC reads for ``source``: the universal network's values,
-    the surface's defaults where an input is not written, a map's centre texel (else its
-    mean) where an input is connected."""
-    net = build(source, preview_opacity)
-    surface = net.nodes[0]
-    values = dict(preview_defaults())
-    slots = {s.input: s for s in table_for("universal", source.model, preview_opacity)}
-    for name, (_, value) in surface.inputs.items():
-        value = plain_value(value)  # an interface input: the value it holds
-        if isinstance(value, Connection):
-            slot = slots.get(name)
-            if slot is None:
-                continue
-            value = slot.to_target(_centre(source, slot.param))
-        values[name] = value
-    return PreviewParams(
-        diffuse_color=_clip(values["diffuseColor"]),
-        use_specular_workflow=bool(values.get("useSpecularWorkflow", 0)),
-        specular_color=_clip(values["specularColor"]),
-        metallic=min(max(float(values["metallic"]), 0.0), 1.0),
-        roughness=min(max(float(values["roughness"]), 0.0), 1.0),
-        clearcoat=float(values["clearcoat"]),
-        clearcoat_roughness=min(max(float(values["clearcoatRoughness"]), 0.0), 1.0),
-        ior=float(values["ior"]),
-    )
-
-
-def _centre(source: Source, param: str) -> Any:
-    image = source.maps.get(param)
-    if image is None or image.pixels is None:
-        return source.live_values[param]
-    px = np.asarray(image.pixels, np.float64)
-    v = px[px.shape[0] // 2, px.shape[1] // 2]
-    return tuple(float(x) for x in v) if np.ndim(v) else float(v)
-
-
-def _clip(c: Any) -> tuple[float, float, float]:
-    c = np.broadcast_to(np.asarray(c, np.float64), (3,))
-    return tuple(float(x) for x in np.clip(c, 0.0, 1.0))
 
 
 HIGHLIGHT_CONE_DEG = 10.0
 """The highlight is the light reflected within this angle of the mirror direction."""
+WIDTH_CONE_DEG = 30.0
+"""The highlight's width: the RMS angle from the mirror direction of the light (luminance)
+reflected within this angle of it (the diffuse within it included, for both sides)."""
 
 
-def _measure(model, params, maps: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]:
-    """E(θ) per angle and channel by the model's own sampler (fixed seed), and the part
-    of it reflected within :data:`HIGHLIGHT_CONE_DEG` of the mirror direction (the
-    highlight's energy: finite for mirrors too, unlike a peak value)."""
+@dataclass(frozen=True)
+class Measured:
+    """Directional albedo split by where the light leaves, and the highlight's energy,
+    each (angles, RGB)."""
+
+    reflected: np.ndarray
+    transmitted: np.ndarray
+    highlight: np.ndarray
+    width: np.ndarray  # per angle: RMS angle (degrees) from the mirror within WIDTH_CONE_DEG
+
+    @property
+    def albedo(self) -> np.ndarray:
+        return self.reflected + self.transmitted
+
+
+def measure(model, params, maps: dict[str, Any], samples: int = SAMPLES) -> Measured:
+    """E(θ) per angle and channel by the model's own sampler (fixed seed), split into the
+    light leaving above and below the surface, and the part reflected within
+    :data:`HIGHLIGHT_CONE_DEG` of the mirror direction (the highlight's energy: finite
+    for mirrors too, unlike a peak value)."""
     from lookdev.materials.bsdf import draw
 
     rng = np.random.default_rng(7)
-    maps = {k: np.broadcast_to(v, (SAMPLES, *np.shape(v))) for k, v in maps.items()}
+    maps = {k: np.broadcast_to(v, (samples, *np.shape(v))) for k, v in maps.items()}
     cone = math.cos(math.radians(HIGHLIGHT_CONE_DEG))
-    albedo, highlight = [], []
+    up, down, highlight, width = [], [], [], []
+    wide = math.cos(math.radians(WIDTH_CONE_DEG))
     for deg in ANGLES:
         t = math.radians(deg)
         wo = np.array([math.sin(t), 0.0, math.cos(t)])
         mirror = np.array([-wo[0], 0.0, wo[2]])
-        u = rng.random((SAMPLES, 3))
-        wi, weight, _ = draw(model, params, np.broadcast_to(wo, (SAMPLES, 3)), u, **maps)
+        u = rng.random((samples, 3))
+        wi, weight, _ = draw(model, params, np.broadcast_to(wo, (samples, 3)), u, **maps)
         weight = np.where(np.isfinite(weight), weight, 0.0)
+        above = (wi[:, 2] >= 0.0)[:, None]
         near = (wi @ mirror) >= cone
-        albedo.append(weight.mean(axis=0))
+        up.append((weight * above).mean(axis=0))
+        down.append((weight * ~above).mean(axis=0))
         highlight.append((weight * near[:, None]).mean(axis=0))
-    return np.asarray(albedo), np.asarray(highlight)
+        cos_m = np.clip(wi @ mirror, -1.0, 1.0)
+        lum = np.where(cos_m >= wide, luminance(weight), 0.0)
+        theta = np.degrees(np.arccos(cos_m))
+        total = lum.sum()
+        width.append(math.sqrt(float((lum * theta**2).sum() / total)) if total > 0 else 0.0)
+    return Measured(np.asarray(up), np.asarray(down), np.asarray(highlight), np.asarray(width))
+
+
+def _ratio(a: float, b: float) -> float:
+    return a / b if b > 0.0 else math.inf if a > 0.0 else 1.0
+
+
+def compared(name: str, src: Measured, got: Measured, **about: Any) -> Fidelity:
+    """The :class:`Fidelity` of ``got`` (a context's model) against ``src`` (the
+    material's own): albedo RMS and worst over angles × channels, the highlight's energy
+    and width at the 30° view as ratios."""
+    a_src, a_got = src.albedo, got.albedo
+    diff = a_got - a_src
+    k = np.unravel_index(np.argmax(np.abs(diff)), diff.shape)
+    at = ANGLES.index(30.0)
+    return Fidelity(
+        name,
+        a_src.round(5).tolist(),
+        a_got.round(5).tolist(),
+        float(np.sqrt(np.mean(diff * diff))),
+        float(diff[k]),
+        f"{ANGLES[k[0]]:g}° {CHANNELS[k[1]]}",
+        _ratio(float(luminance(got.highlight[at])), float(luminance(src.highlight[at]))),
+        highlight_width_source=round(float(src.width[at]), 3),
+        highlight_width=round(float(got.width[at]), 3),
+        **about,
+    )
+
+
+def source_measured(hub: Any) -> Measured:
+    """The material's own model measured (at its centre texel when it varies)."""
+    params, maps = _source_params(hub)
+    return measure(hub.bsdf_model, params, maps)
 
 
 def fidelity(hub: Any, source: Source, preview_opacity: str = "keep") -> Fidelity:
     """Measure the universal context of ``source`` (made from ``hub``) against ``hub``."""
-    model = hub.bsdf_model
-    params, maps = _source_params(hub)
     preview = preview_params(source, preview_opacity)
-    a_src, hl_src = _measure(model, params, maps)
-    a_pre, hl_pre = _measure(PREVIEW, preview, {})
-    diff = a_pre - a_src
-    k = np.unravel_index(np.argmax(np.abs(diff)), diff.shape)
-    at = ANGLES.index(30.0)
-    h_src, h_pre = float(luminance(hl_src[at])), float(luminance(hl_pre[at]))
-    return Fidelity(
-        source.name,
-        a_src.round(5).tolist(),
-        a_pre.round(5).tolist(),
-        float(np.sqrt(np.mean(diff * diff))),
-        float(diff[k]),
-        f"{ANGLES[k[0]]:g}° {CHANNELS[k[1]]}",
-        h_pre / h_src if h_src > 0.0 else math.inf if h_pre > 0.0 else 1.0,
-    )
+    return compared(source.name, source_measured(hub), measure(PREVIEW, preview, {}))
+
+
+def context_fidelity(
+    hub: Any, source: Source, preview_opacity: str = "keep", meters_per_unit: float = 1.0
+) -> list[Fidelity]:
+    """Every context of ``source`` (both ``mtlx`` surfaces of a Disney material) measured
+    against ``hub`` (:mod:`.context_views`); a context whose model is not available gets
+    its reason instead of figures."""
+    src = source_measured(hub)
+    out = []
+    for view in views(source, preview_opacity, meters_per_unit):
+        about = {
+            "context": view.context,
+            "surface": view.surface,
+            "loss": view.loss,
+            "notes": tuple(view.notes),
+        }
+        if view.model is None:
+            nan = [[math.nan] * 3 for _ in ANGLES]
+            out.append(
+                Fidelity(
+                    source.name,
+                    src.albedo.round(5).tolist(),
+                    nan,
+                    math.nan,
+                    math.nan,
+                    "",
+                    math.nan,
+                    unavailable=view.unavailable,
+                    **about,
+                )  # fmt: skip
+            )
+            continue
+        out.append(compared(source.name, src, measure(view.model, view.params, {}), **about))
+    return out
 
 
 def _source_params(hub: Any) -> tuple[Any, dict[str, Any]]:

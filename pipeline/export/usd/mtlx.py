@@ -1,6 +1,7 @@
 """The ``mtlx`` context: MaterialX networks inside USD, and standalone ``.mtlx`` documents.
 
-The surface per model is chosen in :mod:`.names` (Disney → ``ND_disney_principled``).
+The surface per model is chosen in :mod:`.names`; a Disney material's is OpenPBR Surface
+(:mod:`.mtlx_openpbr`) unless ``ND_disney_principled`` is asked for.
 Maps are ``ND_image_*`` nodes reading the default texture coordinates. Layered
 materials exported live become ``ND_mix_*`` chains driven by mask images: Burley §5.7
 blends *parameters*, so each parameter that differs between layers gets its own chain
@@ -113,9 +114,17 @@ def node_defaults(node_id: str) -> dict[str, Any]:
     return out
 
 
-def build(source: Source, meters_per_unit: float = 1.0) -> Network:
+def build(source: Source, meters_per_unit: float = 1.0, surface: str = "openpbr") -> Network:
     """The MaterialX network of ``source`` (surface plus image nodes); lengths in scene
-    units of ``meters_per_unit`` (:func:`.network.subsurface_radius`)."""
+    units of ``meters_per_unit`` (:func:`.network.subsurface_radius`). ``surface``: a
+    Disney material's surface, ``openpbr`` (:mod:`.mtlx_openpbr`) or ``disney``
+    (``ND_disney_principled``)."""
+    if source.model == "disney" and surface == "openpbr":
+        import sys
+
+        from .mtlx_openpbr import build_disney
+
+        return build_disney(source, meters_per_unit, sys.modules[__name__])
     nodes: list[Node] = []
     node_id = SURFACE_IDS[("mtlx", source.model)]
     table = table_for("mtlx", source.model)

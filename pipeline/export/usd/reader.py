@@ -34,6 +34,7 @@ from lookdev.materials.textures import TextureInput
 
 from .foreign import FOREIGN_SURFACES, preview_extras, read_foreign, specular_workflow
 from .lobes import DEFAULTS, active_lobes, effective
+from .mtlx_openpbr import mapped_from_disney
 from .names import DERIVED_FROM, SURFACE_IDS, table_for
 from .network import (
     CONTEXT_OUTPUT,
@@ -264,6 +265,13 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
     for context in READABLE[model]:
         net = by_context.get(context)
         foreign = _foreign(net) if model == "disney" else None
+        if foreign is not None and mapped_from_disney(foreign) and result.contexts:
+            # lookdev's own Disney → OpenPBR mapping: the contexts already read hold
+            # Burley's parameters as they are; the mapping's inverse would lose some
+            if foreign.custom.get("loss"):
+                result.loss.append(f"{context}: {foreign.custom['loss']}")
+            result.contexts.append(context)
+            continue
         if foreign is not None:
             _read_foreign(foreign, spec.custom.get("meters_per_unit", 1.0), values, result)
             result.contexts.append(context)

@@ -24,7 +24,9 @@ from .live import live_stack
 from .lobes import DEFAULTS, canonical
 from .network import ExportError, Image, Source, source_from_params, untargeted
 
-SUPPORTED = registry.PRESET_MODELS  # a layered Pixar blend: see weights_source
+SUPPORTED = tuple(m for m in registry.PRESET_MODELS if m != "openpbr")
+"""Models with name tables (a layered Pixar blend: see weights_source); an ``openpbr``
+preset (an import kept as itself) is proofed, not re-exported."""
 
 
 def source_for(

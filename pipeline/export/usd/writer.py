@@ -21,6 +21,7 @@ from lookdev.library import files
 from lookdev.materials import colour
 
 from . import mtlx, preview, publish, ri
+from .mtlx_openpbr import MTLX_SURFACES
 from .names import PREVIEW_OPACITY
 from .network import (
     CONTEXT_OUTPUT,
@@ -48,9 +49,11 @@ def material_spec(
     contexts: tuple[str, ...],
     preview_opacity: str = "keep",
     meters_per_unit: float = 1.0,
+    mtlx_surface: str = "openpbr",
 ) -> MaterialSpec:
     """The networks of ``source`` for each of ``contexts`` and the material's metadata
-    (lengths in scene units of ``meters_per_unit``, the stage's)."""
+    (lengths in scene units of ``meters_per_unit``, the stage's; ``mtlx_surface``: see
+    :data:`.mtlx_openpbr.MTLX_SURFACES`)."""
     custom = {
         "preset": source.name,
         "model": source.model,
@@ -60,6 +63,8 @@ def material_spec(
     networks = [
         preview.build(source, preview_opacity)
         if c == "universal"
+        else mtlx.build(source, meters_per_unit, mtlx_surface)
+        if c == "mtlx"
         else BUILDERS[c](source, meters_per_unit)
         for c in contexts
     ]
@@ -311,6 +316,8 @@ class ExportResult:
     losses: dict[str, dict[str, str]] = field(default_factory=dict)
     fidelity: dict[str, Any] = field(default_factory=dict)
     """material → :class:`.fidelity.Fidelity` when the export was asked to measure."""
+    contexts_fidelity: dict[str, Any] = field(default_factory=dict)
+    """material → a :class:`.fidelity.Fidelity` per context (:func:`.fidelity.context_fidelity`)."""
 
 
 def losses_of(specs: list[MaterialSpec]) -> dict[str, dict[str, str]]:
@@ -337,6 +344,7 @@ def export_usd(
     meters_per_unit: float = 1.0,
     collect: bool = False,
     preview_geometry: bool = False,
+    mtlx_surface: str = "openpbr",
 ) -> ExportResult:
     """Export ``sources`` to ``out`` (``.usda``/``.usdc``/``.usd``, or ``.usdz`` to package).
 
@@ -348,7 +356,8 @@ def export_usd(
     lookdev's ``scatter_distance`` in metres) are written in those units.
     ``collect``: copy the presets' own texture files into ``<out stem>_textures`` beside
     ``out`` (a package always does). ``preview_geometry``: a sphere per material bound
-    to it. Nothing is left behind on error.
+    to it. ``mtlx_surface``: see :data:`.mtlx_openpbr.MTLX_SURFACES`. Nothing is left
+    behind on error.
     """
     out = Path(out)
     package = package or out.suffix == ".usdz"
@@ -373,7 +382,13 @@ def export_usd(
         raise ExportError(
             f"metersPerUnit {meters_per_unit!r}: give a positive finite number", where=str(out)
         )
-    specs = [material_spec(s, contexts, preview_opacity, meters_per_unit) for s in sources]
+    if mtlx_surface not in MTLX_SURFACES:
+        raise ExportError(
+            f"mtlx surface {mtlx_surface!r}: use {' or '.join(MTLX_SURFACES)}", where=str(out)
+        )
+    specs = [
+        material_spec(s, contexts, preview_opacity, meters_per_unit, mtlx_surface) for s in sources
+    ]
     _check_names(specs, out)
     if package:
         publish.collect(specs, Path(workdir or out.parent) / f"{out.stem}_textures")

@@ -139,7 +139,7 @@ def test_the_printed_table_lists_velvet_s_universal_losses(cli, tmp_path):
 
 def test_the_mtlx_sheen_note_says_what_materialx_does(tmp_path):
     out = tmp_path / "s.usda"
-    result = api.export_usd(["velvet", "satin"], out, ("mtlx",))
+    result = api.export_usd(["velvet", "satin"], out, ("mtlx",), mtlx_surface="disney")
     # ND_disney_principled's sheen is MaterialX's sheen_bsdf, mode conty_kulla, roughness
     # 0.3: velvet (Conty-Kulla, r = 0.3) is expressed; satin's Burley sheen is not.
     assert "sheen" not in result.losses["velvet"]["mtlx"]

@@ -76,7 +76,7 @@ def test_export_report_prints_and_carries_the_fidelity(cli, tmp_path):
         "export", "usd", "gold", "plastic_glossy", "glass_clear", "-o", str(out), "--report"
     )
     assert result.code == 0, result.err
-    assert "UsdPreviewSurface vs the material" in result.out
+    assert "Each context vs the material" in result.out
     summary = json.loads(
         cli("export", "usd", "gold", "glass_clear", "-o", str(out), "--report", "--json").out
     )
@@ -126,7 +126,9 @@ def test_subsurface_radius_is_in_scene_units(tmp_path):
     out = tmp_path / "s.usda"
     # Burley 2012's blend: no distance
     blend_2012 = BlendedMaterial.of_params(DisneyParams(subsurface=0.5), name="blend_2012")
-    result = api.export_usd(["marble", blend_2012], out, ("mtlx",), meters_per_unit=0.01)
+    result = api.export_usd(
+        ["marble", blend_2012], out, ("mtlx",), meters_per_unit=0.01, mtlx_surface="disney"
+    )
     stage = Usd.Stage.Open(str(out))
     assert stage.GetMetadata("metersPerUnit") == 0.01
 
@@ -142,8 +144,13 @@ def test_subsurface_radius_is_in_scene_units(tmp_path):
 
 
 def test_frosted_glass_is_a_named_loss_in_materialx(tmp_path):
-    result = api.export_usd(["glass_frosted", "glass_clear"], tmp_path / "g.usda", ("mtlx",))
+    result = api.export_usd(
+        ["glass_frosted", "glass_clear"], tmp_path / "g.usda", ("mtlx",), mtlx_surface="disney"
+    )
     assert "renders clear" in result.losses["glass_frosted"]["mtlx"]
+    # OpenPBR refracts with specular_roughness: nothing to lose there
+    openpbr = api.export_usd(["glass_frosted"], tmp_path / "o.usda", ("mtlx",))
+    assert "renders clear" not in openpbr.losses["glass_frosted"]["mtlx"]
     assert "renders clear" not in result.losses["glass_clear"].get("mtlx", "")
 
 
@@ -208,7 +215,9 @@ def test_a_solid_with_a_distance_exports_a_scattering_subsurface(tmp_path):
     interior, so each Disney target gets weight 1, the per-channel radius in scene
     units, and (RenderMan) the base colour as its subsurface colour."""
     out = tmp_path / "s.usda"
-    result = api.export_usd(["skin"], out, ("universal", "mtlx", "ri"), meters_per_unit=0.01)
+    result = api.export_usd(
+        ["skin"], out, ("universal", "mtlx", "ri"), meters_per_unit=0.01, mtlx_surface="disney"
+    )
     stage = Usd.Stage.Open(str(out))
     radius = _radius_cm("skin")  # ≈ 0.86 mm × (1, 0.49, 0.27), in centimetres
     mtlx = _inputs(stage, "skin", "mtlx_surface")
@@ -253,7 +262,7 @@ def test_thin_and_distance_free_subsurface_keep_the_2012_weight(tmp_path):
     thin = BlendedMaterial.of_params(
         DisneyParams(subsurface=0.4, thin=True, scatter_distance=0.01), name="thin"
     )
-    api.export_usd([thin], out, ("mtlx", "ri"))
+    api.export_usd([thin], out, ("mtlx", "ri"), mtlx_surface="disney")
     stage = Usd.Stage.Open(str(out))
     assert _inputs(stage, "thin", "mtlx_surface")["subsurface"] == pytest.approx(0.4)
     assert _inputs(stage, "thin", "ri_surface")["subsurface"] == pytest.approx(0.4)

@@ -287,8 +287,12 @@ def test_specular_gamma_round_trips_through_custom_data(tmp_path):
     assert found.params == {"metallic": 1.0, "roughness": 0.4, "specular_gamma": 3.0}
     assert all("specular_gamma=3" in line and "GGX roughness" in line for line in found.loss)
     stage = Usd.Stage.Open(str(out))
-    for node in ("preview_surface", "mtlx_surface", "ri_surface"):
-        written = stage.GetPrimAtPath(f"/Materials/m/{node}").GetAttribute("inputs:roughness")
+    for node, name in (
+        ("preview_surface", "roughness"),
+        ("mtlx_surface", "specular_roughness"),  # OpenPBR Surface
+        ("ri_surface", "roughness"),
+    ):
+        written = stage.GetPrimAtPath(f"/Materials/m/{node}").GetAttribute(f"inputs:{name}")
         assert written.Get() == pytest.approx(0.35677, abs=1e-4)  # lookdev.materials.highlight
 
 
@@ -322,12 +326,22 @@ def test_energy_compensation_is_a_named_loss_carried_through_custom_data(tmp_pat
     # Oren-Nayar diffuse only): every context names the loss, customData carries it back.
     params = DisneyParams(metallic=1.0, roughness=0.6, energy_compensation=True)
     out = tmp_path / "ms.usda"
-    export_usd([source_from_params("m", "disney", params)], out)
+    export_usd([source_from_params("m", "disney", params)], out, mtlx_surface="disney")
     (found,) = import_usd(out)
     assert found.params == {"metallic": 1.0, "roughness": 0.6, "energy_compensation": True}
     assert len(found.loss) == 3
     assert all("energy_compensation=True" in line for line in found.loss)
     off = tmp_path / "off.usda"
-    export_usd([source_from_params("m", "disney", params.replace(energy_compensation=False))], off)
+    plain_params = params.replace(energy_compensation=False)
+    export_usd([source_from_params("m", "disney", plain_params)], off, mtlx_surface="disney")
     (plain,) = import_usd(off)
     assert "energy_compensation" not in plain.params and not plain.loss
+    # OpenPBR's lobes always keep the multiple-scattering energy: the switch on is what
+    # it expresses, the switch off is its named loss
+    export_usd([source_from_params("m", "disney", params)], out)
+    (found,) = import_usd(out)
+    assert [line.split(":")[0] for line in found.loss] == ["universal", "ri"]
+    export_usd([source_from_params("m", "disney", plain_params)], off)
+    (plain,) = import_usd(off)
+    assert len(plain.loss) == 1 and "multiple_scattering" not in plain.loss[0]
+    assert plain.loss[0].startswith("mtlx:") and "single-scattering" in plain.loss[0]
