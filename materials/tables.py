@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["bilinear", "gather", "on_device"]
+__all__ = ["bilinear", "device_tables", "gather", "on_device"]
 
 _DEVICE_TABLES: dict[tuple[type, int], Any] = {}
 
@@ -28,6 +28,13 @@ def on_device(float_type: type, flat: np.ndarray) -> Any:
     if key not in _DEVICE_TABLES:
         _DEVICE_TABLES[key] = float_type(flat)
     return _DEVICE_TABLES[key]
+
+
+def device_tables() -> list[Any]:
+    """Every table copied so far (:func:`on_device`): what a frozen function that runs a
+    model must take among its inputs (``dr.freeze`` refuses a variable made before its
+    recording that it was not given)."""
+    return list(_DEVICE_TABLES.values())
 
 
 def gather(xp: Any, flat: np.ndarray, index: Any) -> Any:

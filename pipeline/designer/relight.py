@@ -42,6 +42,7 @@ from typing import Any
 import numpy as np
 
 from lookdev.materials.arrays import DrJitOps
+from lookdev.materials.tables import device_tables
 
 from .gbuffer import GBuffer, Hits
 
@@ -160,7 +161,7 @@ def _material_pass(model: Any, params: Any, shadows: bool) -> Any:
     """The material's pass for one structure (see the module docstring), to be frozen."""
     xp = DrJitOps.for_mitsuba()
 
-    def shade(scene: Any, emitter: Any, g: dict, values: dict, seed: Any, spp: int, n: int):
+    def shade(scene, emitter, g: dict, values: dict, seed, spp: int, n: int, tables: list):
         import drjit as dr
         import mitsuba as mi
 
@@ -205,7 +206,7 @@ def _material_pass(model: Any, params: Any, shadows: bool) -> Any:
 def _other_pass(shadows: bool) -> Any:
     """The pass of everything but the material: diffuse objects, mirrors, background."""
 
-    def shade(scene: Any, emitter: Any, g: dict, seed: Any, spp: int, n: int) -> Any:
+    def shade(scene, emitter, g: dict, seed, spp: int, n: int, tables: list) -> Any:
         import drjit as dr
         import mitsuba as mi
 
@@ -262,6 +263,11 @@ class Relighter:
         self.model = None
         self.params = None
 
+    def _unfrozen(self, part: str) -> Any:
+        if part == "material":
+            return _material_pass(self.model, self.params, self.shadows)
+        return _other_pass(self.shadows)
+
     def _frozen(self, fn: Any) -> Any:
         import drjit as dr
 
@@ -303,7 +309,20 @@ class Relighter:
         else:
             fn = self._other
             args = (hits.arrays, seed_, spp, hits.width)
-        value = fn(self.scene, self.emitter, *args)
+        # The models' look-up tables are inputs too (tables.device_tables).
+        try:
+            value = fn(self.scene, self.emitter, *args, device_tables())
+        except RuntimeError:
+            if not hasattr(fn, "n_recordings"):
+                raise
+            # A model whose kernel reads a variable the recording cannot see (measured:
+            # the Conty-Kulla sheen of velvet) is traced on every pass instead.
+            fn = getattr(fn, "__wrapped__", None) or self._unfrozen(part)
+            if part == "material":
+                self._material_passes[self.key] = fn
+            else:
+                self._other = fn
+            value = fn(self.scene, self.emitter, *args, device_tables())
         dr.eval(value)
         rgb = np.stack([value[c].numpy() for c in range(3)], axis=1)
         return hits.pixel, rgb[: hits.count]

@@ -138,6 +138,7 @@ class TruthMode:
         self.part.reset()
         self.passes = 0
         self.changed_at = time.monotonic()
+        self._still = False
         self.denoised: np.ndarray | None = None
         self.denoised_spp = 0
 
@@ -216,6 +217,9 @@ class TruthMode:
 
     def step(self) -> np.ndarray:
         """One pass (unless converged); the accumulated raw image (H, W, 3) float32."""
+        # Still as the step began: a slow pass must not make the first frame after an
+        # edit look still and pay for a denoise.
+        self._still = self.still
         if not self.part.converged:
             spp = max(1, min(self.pass_spp, self.max_spp - self.part.spp))
             seed = ((self.seed & 0xFFF) << 20) | (self.passes & 0xFFFFF)
@@ -238,7 +242,7 @@ class TruthMode:
         doubled since the last one (or refinement stopped); None before."""
         from lookdev.pipeline.proof import denoise
 
-        if not (self.still or self.converged) or not self.part.spp:
+        if not (self._still or self.converged) or not self.part.spp:
             return None
         stale = self.denoised is None or self.part.spp >= 2 * self.denoised_spp
         if stale or (self.converged and self.denoised_spp != self.part.spp):

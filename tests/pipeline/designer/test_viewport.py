@@ -187,3 +187,16 @@ def test_resize_keeps_the_framing_in_both_modes():
     view.set_mode("truth")
     assert view.step().rgb.shape == (2 * H, 2 * W, 3)
     view.close()
+
+
+def test_a_table_reading_sheen_renders_in_designer_mode():
+    """The Conty-Kulla sheen reads look-up tables; its pass renders (frozen, or traced
+    each pass where the recording cannot see a variable it reads)."""
+    from lookdev.pipeline.designer.viewport import Viewport
+
+    view = Viewport(hub(sheen=1.0, sheen_model="conty_kulla"), width=W, height=H, rig="none")
+    for _ in range(3):
+        frame = view.step()
+    inside = _material(view)
+    assert np.all(np.isfinite(frame.rgb)) and frame.rgb[inside].mean() > 0
+    view.close()
