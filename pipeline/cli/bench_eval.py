@@ -27,7 +27,8 @@ def eval_(
     """Evaluate the Disney BSDF on N direction pairs: numpy, Dr.Jit and Mitsuba's principled.
 
     Eight materials share the pairs, so every lobe runs; all three are timed in one run.
-    The figures are throughput ratios to Mitsuba's C++ plugin: Dr.Jit ≥ 0.5, numpy ≥ 0.1.
+    The figures are throughput ratios to Mitsuba's C++ plugin in CPU seconds: Dr.Jit ≥ 0.5
+    (frozen, as renders replay it: ≥ 1.5), numpy ≥ 0.1; --json adds each material's.
     First-call (tracing + compile) times are shown apart and excluded from the rates.
     """
     with Progress(console=err_console, transient=True, disable=as_json) as bar:
@@ -45,8 +46,16 @@ def eval_(
         ["numpy float64", result["evals_per_s_numpy_float64"], "", ""],
         ["numpy float32, no lobe pruned", result["evals_per_s_numpy_every_lobe"], "", ""],
         ["Dr.Jit (ours)", result["evals_per_s_drjit"], result["drjit_first_call_s"], ""],
+        ["Dr.Jit, prepare in every call", result["evals_per_s_drjit_prepare_each_call"], "", ""],
+        [
+            "Dr.Jit, frozen",
+            result["evals_per_s_drjit_frozen"],
+            result["drjit_frozen_first_call_s"],
+            "",
+        ],
         ["Mitsuba principled", result["evals_per_s_mitsuba"], result["mitsuba_first_call_s"], ""],
         ["ratio Dr.Jit / Mitsuba", result["ratio_drjit_to_mitsuba"], "", "≥ 0.5"],
+        ["ratio Dr.Jit frozen / Mitsuba", result["ratio_drjit_frozen_to_mitsuba"], "", "≥ 1.5"],
         [
             f"ratio numpy ({result['numpy_dtype']}) / Mitsuba",
             result["ratio_numpy_to_mitsuba"],
