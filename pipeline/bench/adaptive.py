@@ -34,7 +34,7 @@ import numpy as np
 
 from .measure import relative_mse
 
-__all__ = ["AdaptiveSettings", "CASES", "IBLS", "PRESETS", "bench_case", "classes", "run"]
+__all__ = ["AdaptiveSettings", "CASES", "IBLS", "PRESETS", "bench_case", "classes", "run", "tasks"]
 
 PRESETS = ("plastic_glossy", "gold", "glass_clear", "skin", "rusty_car_paint")
 IBLS = ("sky", "studio", "real")
@@ -233,3 +233,35 @@ def run(s: AdaptiveSettings, progress: Any = None) -> list[dict[str, Any]]:
             first = (str(exc).splitlines() or [""])[0]
             out.append({"preset": preset, "ibl": name, "skipped": f"{type(exc).__name__}: {first}"})
     return out
+
+
+def tasks(s: AdaptiveSettings, report: Any) -> list[tuple[str, Any]]:
+    """One task per case for :func:`.error.run`: each appends its result to
+    ``report.adaptive`` and returns its rows (relMSE against CPU seconds)."""
+    from .measure import Row
+
+    def task(preset: str, name: str) -> list[Row]:
+        from lookdev.pipeline.export.mitsuba import register_plugins
+
+        register_plugins()
+        data = {"preset": preset, "ibl": name, **bench_case(preset, name, s).data}
+        report.adaptive.append(data)
+        ref = f"{data['reference']['spp']} spp"
+        rows = []
+        for method in ("uniform", "adaptive", "adaptive_checked"):
+            m = data[method]
+            spp = m.get("spp", m.get("spp_mean"))
+            rows.append(
+                Row(
+                    "adaptive",
+                    f"{preset} × {name}",
+                    method.replace("_", " + "),
+                    f"{spp} spp",
+                    m["relmse"],
+                    m["cpu_s"],
+                    reference=ref,
+                )  # fmt: skip
+            )
+        return rows
+
+    return [(f"adaptive {p} × {n}", lambda p=p, n=n: task(p, n)) for p, n in s.cases]
