@@ -20,7 +20,8 @@ errors (:func:`blend`), so where samples have made the raw pixel better than the
 denoiser's guess, the raw pixel wins: more samples never make a shown frame worse (the
 denoiser's output alone can: OIDN's bias on glass grew with samples). The shown pixel's
 residual is taken as the smaller of the two estimates (the errors are correlated, so the
-blend's would be optimistic).
+blend's would be optimistic). Pixels of negative light — a chart patch outside the working
+space's gamut — are shown raw: OIDN's HDR input is [0, ∞) and would clamp them.
 """
 
 from __future__ import annotations
@@ -80,6 +81,9 @@ def check(
     left = box_mean(np.square(raw_error), BIAS_WINDOW) / (side * side)
     bias = np.maximum(np.square(box_mean(diff, BIAS_WINDOW)) - left, 0.0)
     residual = np.sqrt(box_mean(variance, WINDOW) + bias)
+    # Negative light (a chart patch outside the working gamut, the cyan's red) is clamped
+    # by OIDN's HDR input: such pixels are shown raw, their residual the raw one.
+    residual = np.where((image < 0).any(axis=-1), np.inf, residual)
     shown, weight = blend(image, d, raw_error, residual)
     final = np.minimum(raw_error, residual)
     return Checked(shown, d, final, variance, bias, float(weight.mean()))
@@ -99,6 +103,8 @@ def blend(
     s2 = np.square(np.asarray(raw_error, np.float64))
     r2 = np.square(np.asarray(residual, np.float64))
     total = s2 + r2
-    weight = np.where(total > 0, r2 / np.where(total > 0, total, 1.0), 0.0)
+    with np.errstate(invalid="ignore"):
+        weight = np.where(total > 0, r2 / np.where(total > 0, total, 1.0), 0.0)
+    weight = np.where(np.isinf(r2), 1.0, weight)  # no denoised estimate: raw
     out = weight[..., None] * raw + (1.0 - weight[..., None]) * denoised
     return out.astype(np.float32), weight

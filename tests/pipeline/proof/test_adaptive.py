@@ -189,3 +189,13 @@ def test_a_gaussian_filter_is_refused_for_per_pixel_sampling():
     t = turntable.Turntable(bsdf, env, (8, 8), depth, rig="none", pixel_filter="gaussian")
     with pytest.raises(ValueError, match="box pixel filter"):
         adaptive.PixelRenderer(t.scene, t.camera_index)
+
+
+def test_negative_light_is_shown_raw_not_clamped_by_the_denoiser():
+    """A patch outside the working gamut (negative red) keeps its raw value."""
+    a = b = np.full((6, 6, 3), 0.3)
+    a, b = a.copy(), b.copy()
+    a[:3, :3, 0] = b[:3, :3, 0] = -0.05
+    raw = adaptive.pixel_error(a, b) + 0.01
+    c = checked.check(a, b, raw, lambda im: np.maximum(im, 0.0))  # OIDN's clamp
+    assert np.allclose(c.image[:3, :3, 0], -0.05) and np.allclose(c.residual[:3, :3], raw[:3, :3])
