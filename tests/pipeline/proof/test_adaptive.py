@@ -199,3 +199,19 @@ def test_negative_light_is_shown_raw_not_clamped_by_the_denoiser():
     raw = adaptive.pixel_error(a, b) + 0.01
     c = checked.check(a, b, raw, lambda im: np.maximum(im, 0.0))  # OIDN's clamp
     assert np.allclose(c.image[:3, :3, 0], -0.05) and np.allclose(c.residual[:3, :3], raw[:3, :3])
+
+
+@pytest.mark.render
+def test_the_bench_item_measures_all_three_methods_and_the_estimate_per_class():
+    from lookdev.pipeline.bench import adaptive as bench
+    from lookdev.pipeline.bench import error
+
+    assert "adaptive" in error.ITEMS
+    s = bench.AdaptiveSettings(cases=(("plastic_glossy", "studio"),), resolution=(24, 12),
+                               reference_spp=32, max_spp=32)  # fmt: skip
+    (case,) = bench.run(s)
+    assert "skipped" not in case, case.get("skipped")
+    for method in ("uniform", "adaptive", "adaptive_checked"):
+        assert case[method]["relmse"] > 0 and case[method]["cpu_s"] > 0
+    assert set(case["adaptive"]["estimate_check"]) == {"smooth", "edges", "hot"}
+    assert case["uniform"]["cpu_to_target"] == "predicted"
