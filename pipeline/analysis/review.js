@@ -10,7 +10,7 @@
   const FPS = 6;
   const hasDenoised = data.proofs.some((p) => p.frames.some((f) => f.denoised));
   // a batch that was denoised (the main job's default) opens on the denoised frames
-  const state = { denoised: hasDenoised };
+  const state = { denoised: hasDenoised, difference: false };
   const views = []; // everything that shows frames: redrawn when the toggle changes
 
   function el(tag, attrs, ...children) {
@@ -61,6 +61,10 @@
       parts.push("the brightest 0.1 % of pixels hold " + num(100 * f.firefly_share, 2) +
         " % of the remaining error" + (f.firefly_share > 0.5 ? " (fireflies)" : ""));
     parts.push(f.clamp === null ? "radiance not clamped" : "radiance clamped at " + num(f.clamp) + " (biased)");
+    if (f.residual !== undefined && f.residual !== null)
+      parts.push("denoised residual " + num(f.residual) + " (raw noise " + num(f.noise_raw) + ")");
+    if (f.converged !== undefined && f.converged !== null)
+      parts.push(num(100 * f.converged, 4) + " % of pixels met the target");
     if (f.stop !== null) parts.push("stopped by: " + f.stop);
     return parts.join("; ");
   }
@@ -97,6 +101,7 @@
   }
 
   function source(f) {
+    if (state.difference && f.difference) return { src: f.difference, which: "difference" };
     const denoised = state.denoised && f.denoised;
     return { src: denoised ? f.denoised : f.raw, which: denoised ? "denoised" : "raw" };
   }
@@ -403,7 +408,19 @@
       ? "denoised frames where the proof has them; switch off to check the raw frame"
       : "this batch has no denoised frames";
     return el("div", { id: "toolbar" }, el("label", {}, box, " show denoised"),
-      el("span", { class: "note" }, note));
+      el("span", { class: "note" }, note), differenceToggle());
+  }
+
+  /* What the denoiser changed: 0.5 + 4 × (view(denoised) − view(raw)), grey = unchanged. */
+  function differenceToggle() {
+    const has = data.proofs.some((p) => p.frames.some((f) => f.difference));
+    const box = el("input", { type: "checkbox", id: "difference", disabled: !has });
+    box.addEventListener("change", () => {
+      state.difference = box.checked;
+      views.forEach((v) => v.redraw());
+    });
+    return el("label", { title: "grey: unchanged; brighter/darker: what denoising added/removed (×4)" },
+      box, " show denoised − raw (×4)");
   }
 
   const main = document.getElementById("review");

@@ -33,6 +33,8 @@ ASSETS = ("review.js", "review.css")
 FRAME_FIELDS = ("spp", "noise", "noise_target", "time_s", "stop", "firefly_share", "clamp")
 """Per-frame numbers the page shows (the proof manifest's fields)."""
 _OLD_NAMES = {"noise": "noise_relative", "time_s": "seconds"}
+CHECK_FIELDS = ("noise_raw", "converged", "residual")
+"""Per-pixel sampling's numbers (``residual``: the checked denoiser's, under ``denoise``)."""
 
 
 def copy_assets(out_dir: Path) -> list[Path]:
@@ -93,7 +95,19 @@ def _frame(
         if isinstance(value, float) and not math.isfinite(value):
             value = None  # JSON has no NaN or infinity
         record[key] = value if isinstance(value, int | float | str) else None
+    _checks(folder, info, record, web, base)
     return record
+
+
+def _checks(folder: Path, info: dict, record: dict, web: Any, base: Path) -> None:
+    """:data:`CHECK_FIELDS` and the difference view (denoised − raw) into ``record``."""
+    checked = info.get("denoise") if isinstance(info.get("denoise"), dict) else {}
+    for key in CHECK_FIELDS:
+        value = info.get(key, checked.get(key))
+        ok = isinstance(value, int | float) and math.isfinite(value)
+        record[key] = value if ok else None
+    difference = _image(folder, info, ("difference_png",))
+    record["difference"] = None if difference is None else url(web(difference), base)
 
 
 def _label(info: dict[str, Any], path: Path) -> str:

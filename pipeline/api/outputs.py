@@ -404,6 +404,7 @@ def proof(
     context: str | None = None,
     geometry: PathLike | None = None,
     denoise: bool | None = None,
+    adaptive: bool | None = None,
 ) -> dict[str, Any]:
     """Render turntable proofs (Burley §6.1): every material under every IBL.
 
@@ -465,6 +466,12 @@ def proof(
         by albedo and normal images rendered with it, beside the raw frame
         (:mod:`lookdev.pipeline.proof.denoise`); a :class:`DenoiseError` when ``pyoidn``
         is not installed. None: ``DEFAULT_DENOISE`` (on); False for raw frames only.
+        With per-pixel sampling the denoised frame is checked (its residual estimated,
+        :mod:`lookdev.pipeline.proof.checked`) and the target applies to it.
+    adaptive
+        Sample each frame per pixel to ``noise`` (display RMS; the default with a target
+        and the box filter, :mod:`lookdev.pipeline.proof.adaptive`); False for whole-frame
+        passes to a relative noise on luminance.
     progress
         Called with a :class:`lookdev.pipeline.proof.batch.Progress` about twice a second
         and as each proof finishes (``frames_done``, ``frames_total``, ``finished``).
@@ -511,6 +518,7 @@ def proof(
             pixel_filter=pixel_filter,
             rig=rig,
             denoise=denoise,
+            adaptive=proof_settings.DEFAULT_ADAPTIVE if adaptive is None else adaptive,
         ),
         jobs,
     )

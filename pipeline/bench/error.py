@@ -16,6 +16,8 @@ energy     a white rough metal's furnace |1 − E| with ``energy_compensation`` 
            by roughness, against the eval time the table look-up costs (:mod:`.energy`)
 mainjob    the main job's old and new default frame against converged references, and
            each frame's noise estimate against its measured error (:mod:`.quality`)
+adaptive   uniform, per-pixel adaptive and adaptive + checked denoising at equal CPU
+           time, and the estimate per pixel class (:mod:`.adaptive`)
 ========== ==============================================================================
 
 Outputs: a Rich table, ``error_bench.json`` (every row, the settings and the machine)
@@ -39,11 +41,15 @@ from lookdev.library import files
 from lookdev.materials.bsdf import Model
 from lookdev.materials.errors import LookdevError
 
+from . import adaptive as adaptive_bench
 from . import denoise as denoise_bench
 from . import measure, quality
 from .measure import Row
 
-ITEMS = ("render", "albedo", "lambda", "precision", "denoise", "sheen_lambda", "energy", "mainjob")
+ITEMS = (
+    "render", "albedo", "lambda", "precision", "denoise", "sheen_lambda", "energy", "mainjob",
+    "adaptive",
+)  # fmt: skip
 
 RENDER_IBL = "studio"
 # Proof-render cases: label → built-in preset name.
@@ -73,6 +79,9 @@ class Settings:
     energy_samples: int = 16384
     denoise: denoise_bench.DenoiseSettings = field(default_factory=denoise_bench.DenoiseSettings)
     mainjob: quality.ErrorSettings = field(default_factory=quality.ErrorSettings)
+    adaptive: adaptive_bench.AdaptiveSettings = field(
+        default_factory=adaptive_bench.AdaptiveSettings
+    )
 
     @classmethod
     def quick(cls) -> Settings:
@@ -90,6 +99,7 @@ class Settings:
             energy_samples=2048,
             denoise=denoise_bench.DenoiseSettings.quick(),
             mainjob=quality.ErrorSettings.quick(),
+            adaptive=adaptive_bench.AdaptiveSettings.quick(),
         )
 
 
@@ -99,6 +109,7 @@ class Report:
     skipped: dict[str, str] = field(default_factory=dict)  # "item: case" → reason
     denoise: list[denoise_bench.Case] = field(default_factory=list)
     mainjob: list[dict[str, Any]] = field(default_factory=list)  # quality.error_case each
+    adaptive: list[dict[str, Any]] = field(default_factory=list)  # adaptive.bench_case each
 
     def to_json(self, settings: Settings) -> dict[str, Any]:
         return {
@@ -115,6 +126,7 @@ class Report:
             "skipped": self.skipped,
             "denoise": [case.as_json() for case in self.denoise],
             "mainjob": self.mainjob,
+            "adaptive": self.adaptive,
         }
 
 
@@ -277,6 +289,8 @@ def run(
         tasks.append(("energy", lambda: energy.bench_energy(samples=n)))
     if "mainjob" in items:
         tasks += quality.tasks(settings.mainjob, report)
+    if "adaptive" in items:
+        tasks += adaptive_bench.tasks(settings.adaptive, report)
     for done, (name, task) in enumerate(tasks):
         progress(name, done, len(tasks))
         try:
@@ -326,6 +340,9 @@ MARKERS = {
     "denoised": "*",
     "old default": "s",
     "new default": "*",
+    "uniform": "s",
+    "adaptive": "o",
+    "adaptive + checked": "*",
 }
 
 
@@ -394,4 +411,5 @@ ERROR_NAMES = {
     "sheen_lambda": "relative RMS error of Λ",
     "energy": "white furnace max |1 − E|",
     "mainjob": "relative MSE of the frame as shown",
+    "adaptive": "relative MSE at equal CPU time",
 }

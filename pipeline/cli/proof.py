@@ -18,12 +18,15 @@ from rich.progress import (
 )
 
 from lookdev.pipeline.proof.settings import (
+    DEFAULT_ADAPTIVE,
     DEFAULT_DENOISE,
     DEFAULT_FRAMES,
     DEFAULT_LIGHT_FRAMES,
     DEFAULT_MAX_SPP,
     DEFAULT_NOISE,
+    DEFAULT_PIXEL_MAX_SPP,
     DEFAULT_RESOLUTION,
+    UNIFORM_NOISE,
 )
 
 from .common import console, err_console, print_json, table
@@ -81,8 +84,11 @@ def proof(
         float | None,
         typer.Option(
             "--noise",
-            help="Render each frame in passes until its estimated relative RMS noise is at "
-            f"most this [default: {DEFAULT_NOISE:g}].",
+            help="Render each frame until its relative RMS noise on luminance is at most "
+            f"this [default: {UNIFORM_NOISE:g}]. With --adaptive: until every pixel's "
+            "estimated RMS error on the image shown (display code values 0-1, after the "
+            "view; the checked denoised frame when denoising) is at most this "
+            f"[default: {DEFAULT_NOISE:g}].",
             show_default=False,
         ),
     ] = None,
@@ -90,8 +96,8 @@ def proof(
         int | None,
         typer.Option(
             "--max-spp",
-            help=f"The most samples per pixel a frame may take to reach --noise "
-            f"[default: {DEFAULT_MAX_SPP}].",
+            help="The most samples a frame may take to reach --noise [default: "
+            f"{DEFAULT_MAX_SPP}; a pixel's {DEFAULT_PIXEL_MAX_SPP} with --adaptive].",
             show_default=False,
         ),
     ] = None,
@@ -203,6 +209,15 @@ def proof(
             "the raw frame, which is kept. --no-denoise: raw frames only.",
         ),
     ] = DEFAULT_DENOISE,
+    adaptive: Annotated[
+        bool,
+        typer.Option(
+            "--adaptive/--no-adaptive",
+            help="Sample per pixel: each pass renders only the pixels whose A/B estimate "
+            "is above --noise (box filter), and the denoised frame is checked. Off by "
+            "default: whole-frame passes (docs/measurements/adaptive.md says why).",
+        ),
+    ] = DEFAULT_ADAPTIVE,
     report: Annotated[
         bool,
         typer.Option(
@@ -230,9 +245,11 @@ def proof(
     Each proof turns the element through --frames frames, then the lighting through
     --light-frames frames, and writes under OUTPUT/PRESET/IBL/: EXR frames, tone-mapped PNG
     frames, a labelled contact.png and a manifest.json. Each frame is rendered in passes
-    until its estimated relative noise is at most --noise, or --max-spp or --time-budget
-    is reached (or at a fixed --spp); its manifest entry records the spp, the noise
-    reached, why it stopped, its time and the share of its error in fireflies.
+    per pixel until its pixels' estimated error on the image shown is at most --noise
+    (each pass renders only the pixels still above it), or --max-spp or --time-budget is
+    reached (or at a fixed --spp); its manifest entry records the mean and largest spp,
+    the noise reached (raw, and the checked denoised residual), the share of pixels that
+    met the target, why it stopped, its time and the share of its error in fireflies.
     Re-running skips frames the manifests vouch for, so an interrupted batch resumes
     where it stopped.
 
@@ -298,6 +315,7 @@ def proof(
             context=None if context is None else context.value,
             geometry=geometry,
             denoise=denoise,
+            adaptive=adaptive,
         )
     if as_json:
         print_json(doc)

@@ -215,6 +215,11 @@ def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
         interior=material_interior(job.material),
     )
     guides = denoise.guide_renderer(table) if s.denoise else None
+    if s.per_pixel():
+        from .pixelframe import render_pixel_frames
+
+        yield from render_pixel_frames(job.folder, table, guides, todo, s)
+        return
     for frame in todo:
         r = render_frame(table, frame, **s.sampling())
         stem = job.folder / f"frame_{frame.index:03d}"

@@ -63,6 +63,10 @@ ORIENTATION = {
 """The IBL orientation every proof and exported scene uses (module docstring)."""
 GENERATOR_VERSION = 1  # bump when the generator's maths changes: invalidates the cache
 DEFAULT_WIDTH = 512
+REAL_HDR = Path(__file__).resolve().parents[2] / "tests" / "data" / "venice_sunset_1k.hdr"
+"""A real sky (Poly Haven's Venice Sunset, CC0; source beside it in ``tests/data``): the
+standing real-light IBL of the proof tests and of ``lookdev bench error``. Present in a
+source checkout, not in an installed wheel."""
 SUFFIXES = (".exr", ".hdr")
 
 Rgb = tuple[float, float, float]
@@ -379,6 +383,16 @@ def read_image(path: Path) -> np.ndarray:
     return np.clip(np.nan_to_num(pixels, nan=0.0, posinf=0.0), 0.0, None).astype(np.float32)
 
 
+def check_latlong(pixels: np.ndarray, path: Path | str) -> None:
+    """Refuse, in one line, an image that is not a 2:1 lat-long map (a square EXR, a
+    cube-map cross, a photo): resampled to 2:1 it would be stretched without a word."""
+    h, w = pixels.shape[:2]
+    if w != 2 * h:
+        raise IblError(
+            f"{w}×{h} is not a lat-long map (width must be twice the height)", where=str(path)
+        )
+
+
 def resample(pixels: np.ndarray, width: int) -> np.ndarray:
     """Lat-long pixels at ``width`` × ``width/2`` (OpenImageIO's filtered resize)."""
     import OpenImageIO as oiio
@@ -413,6 +427,7 @@ def load(
         path.unlink(missing_ok=True)
         path = resolve(name_or_path, width)
         image = read_image(path)
+    check_latlong(image, path)
     # the proof renders in the working space: an ACEScg one gets the IBL converted (OCIO)
     pixels = colour.to_working(resample(image, width), file_space(path))
     pixels = np.clip(pixels, 0.0, None) * np.float32(2.0**exposure)

@@ -5,8 +5,11 @@ proof's key (so changing any of them re-renders), what the manifests record, and
 ``lookdev proof`` and :func:`lookdev.proof` fill in; :func:`check` holds every range.
 
 Sampling is either a fixed count (``spp``: one pass, the manifests' ``stop`` reads
-``"spp"``) or a noise target (``noise``: passes until the estimated relative noise of the
-frame is at most it, or ``max_spp`` / ``time_budget`` is reached; :mod:`.passes`).
+``"spp"``) or a noise target (``noise``). With a target and the box pixel filter, frames
+are sampled per pixel (:mod:`.adaptive`): ``noise`` is then the RMS error each pixel may
+have on the image a person sees (display code values 0–1, after the view transform) and
+``max_spp`` a pixel's cap; with ``adaptive=False`` (or a Gaussian filter) whole-frame
+passes run to a relative RMS on luminance (:mod:`.passes`), as before.
 """
 
 from __future__ import annotations
@@ -23,7 +26,10 @@ from .rig import DEFAULT_RIG, RIGS
 from .turntable import Frame, frames
 
 __all__ = [
+    "DEFAULT_ADAPTIVE",
     "DEFAULT_DENOISE",
+    "DEFAULT_PIXEL_MAX_SPP",
+    "UNIFORM_NOISE",
     "DEFAULT_FRAMES",
     "DEFAULT_LIGHT_FRAMES",
     "DEFAULT_MAX_SPP",
@@ -37,12 +43,24 @@ __all__ = [
     "check",
 ]
 
-DEFAULT_NOISE = 0.05
-"""The relative-noise target of a proof when no ``spp`` is given: 5 % RMS, clean grain."""
+DEFAULT_NOISE = 0.02
+"""A pixel's target when no ``spp`` is given: 0.02 RMS in display code values, ≈ 5 of 255
+8-bit steps, on the frame shown (the checked denoised one when denoising). Chosen from
+the wall time against target curve (docs/measurements/adaptive.md)."""
+DEFAULT_PIXEL_MAX_SPP = 256
+"""A pixel's sample cap under per-pixel sampling, unless ``max_spp`` is given."""
+UNIFORM_NOISE = 0.05
+"""The whole-frame relative-noise target of ``adaptive=False`` (5 % RMS on luminance)."""
+DEFAULT_ADAPTIVE = False
+"""Whether a target with the box filter samples per pixel (:mod:`.adaptive`); off until it
+is shown to pay: measured (docs/measurements/adaptive.md), its checked residual reads
+1.5–6× below the error against references, it was not shown cheaper than uniform passes
+at equal error, and the main job would take an estimated 30–60 minutes instead of 5.
+``--adaptive`` (``adaptive=True``) turns it on."""
 DEFAULT_MAX_SPP = 4
 """The sample cap of a frame rendered to a noise target, unless ``max_spp`` is given.
-Chosen by measurement with the frames and denoising below (README, "How the defaults
-were chosen"; ``lookdev bench mainjob`` and ``lookdev bench error --item mainjob``):
+Chosen by measurement with the frames and denoising below (docs/measurements/mainjob.md;
+``lookdev bench mainjob`` and ``lookdev bench error --item mainjob``):
 denoised, a frame's relMSE × CPU time was lowest at 4 of caps 4, 8, 16 in all four
 sampled cases, since the denoised error falls slowly with samples (8 bought 1.3× lower
 error for 1.4× the time). No frame of the main job reaches 5 % within it (their
@@ -111,6 +129,7 @@ class Settings:
     """The OCIO config, working space and view the batch was asked in (workers are other
     processes, perhaps on other machines: they enter these, not their own defaults)."""
     denoise: bool = DEFAULT_DENOISE  # also write each frame denoised (OIDN, .denoise), raw kept
+    adaptive: bool = DEFAULT_ADAPTIVE  # per-pixel sampling to the target (.adaptive)
 
     def __post_init__(self) -> None:
         if self.spp is not None:
@@ -130,10 +149,16 @@ class Settings:
                     field=argument("spp"),
                 )
             return
+        pixel = self.per_pixel()
         if self.noise is None:
-            object.__setattr__(self, "noise", DEFAULT_NOISE)
+            object.__setattr__(self, "noise", DEFAULT_NOISE if pixel else UNIFORM_NOISE)
         if self.max_spp is None:
-            object.__setattr__(self, "max_spp", DEFAULT_MAX_SPP)
+            object.__setattr__(self, "max_spp", DEFAULT_PIXEL_MAX_SPP if pixel else DEFAULT_MAX_SPP)
+
+    def per_pixel(self) -> bool:
+        """True when frames are sampled per pixel (:mod:`.adaptive`): a target, the box
+        filter, ``adaptive`` on."""
+        return self.spp is None and self.adaptive and self.pixel_filter == "box"
 
     def frames(self) -> list[Frame]:
         return frames(self.element_frames, self.light_frames)
@@ -187,6 +212,8 @@ def check(settings: Settings, jobs: int | None = None) -> Settings:
             field=argument("pixel_filter"),
         )
     spp = s.spp if s.spp is not None else min(s.max_spp, _pass_spp())
+    if s.per_pixel():  # a pass launches in pieces of at most adaptive.MAX_LANES samples
+        spp = 1
     samples = s.resolution[0] * s.resolution[1] * spp
     if samples > MAX_SAMPLES:
         raise ProofError(

@@ -25,6 +25,7 @@ TINY = E.Settings(
     lambda_reference_nodes=512,
     precision_pairs=500,
     mainjob=Q.ErrorSettings.quick(),
+    adaptive=E.adaptive_bench.AdaptiveSettings.quick(),
 )
 
 
