@@ -10,7 +10,6 @@ is refused in one line, or renamed with ``rename``.
 
 from __future__ import annotations
 
-import os
 import re
 from pathlib import Path
 
@@ -108,22 +107,27 @@ def write_presets(
             )
         targets = [output]
     else:
-        if not output.is_dir():
-            what = "is a file, not a folder" if output.exists() else "folder does not exist"
-            raise ExportError(f"{what} (give a folder or a .toml file)", where=str(output))
+        if output.exists() and not output.is_dir():
+            raise ExportError(
+                "is a file, not a folder (give a folder or a .toml file)", where=str(output)
+            )
         targets = [output / f"{name}.toml" for name in names]
     texts = [preset_toml(m, name) for m, name in zip(found, names, strict=True)]
     for path, text in zip(targets, texts, strict=True):
         check_preset(text, str(path), stem=path.stem)
     for path in targets:
-        if not path.parent.is_dir() or not os.access(path.parent, os.W_OK):
-            raise ExportError("folder does not exist or is not writable", where=str(path))
+        try:
+            files.check_folder(path.parent)
+        except files.WriteError as exc:
+            raise ExportError(exc.message, where=str(path)) from None
         if path.exists() and not force:
             raise ExportError(
                 "a preset file of that name exists; give --force to replace it", where=str(path)
             )
-    for path, text in zip(targets, texts, strict=True):
-        _write_atomic(path, text)
+    with files.Transaction() as staged:  # all or none, the folder made as `mkdir -p`
+        for path, text in zip(targets, texts, strict=True):
+            staged.folder(path.parent)
+            staged.temp_for(path).write_bytes(text.encode("utf-8"))
     return targets
 
 
@@ -131,7 +135,3 @@ def check_preset(text: str, where: str, stem: str | None = None) -> None:
     """Raise the one line ``presets validate`` would print if ``text`` is not a valid preset
     (its own parameters: references are not resolved here)."""
     parse_preset(text.encode("utf-8"), where=where, stem=stem)
-
-
-def _write_atomic(path: Path, text: str) -> None:
-    files.atomic_write(path, text)

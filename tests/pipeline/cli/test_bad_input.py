@@ -466,7 +466,7 @@ def test_a_mask_under_an_opaque_layer_is_still_checked(tmp_path, no_render):
 def test_an_unwritable_output_is_found_before_loading(cli, tmp_path, no_render):
     f = tmp_path / "file"
     f.write_text("x")
-    one_line_error(cli("proof", "gold", "--ibl", "studio", "-o", str(f / "out")), "not writable")
+    one_line_error(cli("proof", "gold", "--ibl", "studio", "-o", str(f / "out")), "file is a file")
 
 
 @pytest.mark.slow
