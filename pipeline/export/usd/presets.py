@@ -15,6 +15,7 @@ from pathlib import Path
 
 from lookdev.library import PresetFile, dump_preset, files
 from lookdev.library.preset import parse_preset
+from lookdev.materials.errors import LookdevError
 
 from .network import ExportError
 from .reader import Imported
@@ -129,6 +130,23 @@ def write_presets(
             staged.folder(path.parent)
             staged.temp_for(path).write_bytes(text.encode("utf-8"))
     return targets
+
+
+def screen(found: list[Imported], refused: list[str]) -> list[Imported]:
+    """The materials whose preset validates as ``presets validate`` would; each other one
+    is refused in one line naming its prim, the field and the value (appended to
+    ``refused``), so one bad value never stops the rest of a file."""
+    from .reader import refusal
+
+    kept = []
+    for m in found:
+        try:
+            check_preset(preset_toml(m), f"{preset_name(m.name)}.toml")
+        except LookdevError as exc:
+            refused.append(refusal(m.prim or m.name, exc))
+            continue
+        kept.append(m)
+    return kept
 
 
 def check_preset(text: str, where: str, stem: str | None = None) -> None:

@@ -52,6 +52,12 @@ from .preview import preview_defaults
 from .record import network_digest, read_record
 
 TEXTURE_FILE_INPUT = {"UsdUVTexture": "file", "PxrTexture": "filename"}
+PRIM_KEY = "prim_path"
+"""Where :func:`read_networks` keeps a material's prim path in ``MaterialSpec.custom``."""
+MTLX_IMAGES = ("ND_image_", "ND_tiledimage_", "ND_UsdUVTexture")
+"""MaterialX image nodes (by id prefix): their ``file`` is the texture an input reads."""
+DATA_IMAGES = ("_float", "_vector2", "_vector3", "_vector4")
+"""MaterialX image node id endings whose values are data (no colour transform)."""
 READ_ORDER = ("universal", "ri", "mtlx")
 READABLE = {
     "disney": READ_ORDER,
@@ -77,6 +83,8 @@ class Imported:
     loss: list[str] = field(default_factory=list)
     document: dict[str, Any] | None = None
     """The whole preset, when the file carried lookdev's record (an exact round trip)."""
+    prim: str = ""
+    """The Material's prim path in the file (what a refusal names)."""
 
 
 def read_networks(stage) -> list[MaterialSpec]:
@@ -95,7 +103,7 @@ def read_networks(stage) -> list[MaterialSpec]:
             net = _network(material, context, output_name)
             if net is not None:
                 networks.append(net)
-        custom = {**_custom(prim), "meters_per_unit": units}
+        custom = {**_custom(prim), "meters_per_unit": units, PRIM_KEY: str(prim.GetPath())}
         specs.append(MaterialSpec(custom.get("preset", prim.GetName()), networks, custom))
     return specs
 
@@ -178,6 +186,8 @@ def _collect(prim, nodes: dict[str, Node]) -> None:
                 _collect(attr.GetPrim(), nodes)
             elif attr.HasAuthoredValue():
                 node.inputs[inp.GetBaseName()] = (kind, _plain(attr.Get()))
+                if attr.HasColorSpace():
+                    node.color_spaces[inp.GetBaseName()] = str(attr.GetColorSpace())
             break
     node.custom.update(_custom(prim))
 
@@ -197,17 +207,23 @@ SKIPPED_WHY = {
     "parameters; import its layers' presets instead",
 }
 """Why a material of a given ``model`` (customData) cannot be imported."""
-NO_SURFACE = "no UsdPreviewSurface, ND_disney_principled or PxrDisneyBsdf surface"
+NO_SURFACE = (
+    "no UsdPreviewSurface, ND_disney_principled, PxrDisneyBsdf, OpenPBR, Standard Surface "
+    "or glTF PBR surface"
+)
 
 
-def import_usd(path: Path, skipped: list[str] | None = None) -> list[Imported]:
-    """Read every material of the USD file ``path`` into presets.
+def import_usd(
+    path: Path, skipped: list[str] | None = None, refused: list[str] | None = None
+) -> list[Imported]:
+    """Read every material of the USD file ``path`` into presets, as far as it can.
 
     A material that cannot become a preset (a layered Pixar material, a surface lookdev
     does not read) is never dropped silently: its name and the reason are appended to
-    ``skipped`` when a list is given, and named in the error when nothing is readable.
-    A value a preset would reject (out of range, NaN, infinity) is refused in one line
-    naming the file, the material and the field: an import never clamps silently.
+    ``skipped``. A value a preset would reject (out of range, NaN, infinity) refuses its
+    material, never the file: one line naming the prim, the field and the value is
+    appended to ``refused``; an import never clamps silently. When nothing is readable
+    the error names every skipped and refused material.
     """
     from pxr import Tf, Usd
 
@@ -219,28 +235,38 @@ def import_usd(path: Path, skipped: list[str] | None = None) -> list[Imported]:
         stage = Usd.Stage.Open(str(path))
     except Tf.ErrorException:
         raise ExportError("USD cannot open it", where=str(path)) from None
-    found, left = [], []
+    found, left, bad = [], [], []
     spaces = colour_spaces(stage)
     for spec in read_networks(stage):
+        prim = spec.custom.get(PRIM_KEY, spec.name)
         try:
             imported = _imported(spec, spaces.get(spec.name, ""))
         except LookdevError as exc:
-            raise ExportError(
-                exc.message, where=f"{path}: material {spec.name!r}", field=exc.field
-            ) from None
+            bad.append(refusal(prim, exc))
+            continue
         if imported is None:
             why = SKIPPED_WHY.get(spec.custom.get("model", "disney"), NO_SURFACE)
             left.append(f"{spec.name!r} ({why})")
         else:
+            imported.prim = prim
             found.append(imported)
     if skipped is not None:
         skipped.extend(left)
+    if refused is not None:
+        refused.extend(bad)
     if not found:
         detail = f"; skipped {', '.join(left)}" if left else ""
+        detail += f"; refused {'; '.join(bad)}" if bad else ""
         raise ExportError(
-            f"no material to import: none has a {NO_SURFACE[3:]}{detail}", where=str(path)
+            f"no material to import: none has a {NO_SURFACE[3:]}{detail}",
+            where=str(path),
         )
     return found
+
+
+def refusal(prim: str, exc: LookdevError) -> str:
+    """The one line naming a refused material's prim, the field and the value."""
+    return ": ".join(p for p in (prim, exc.field, exc.message) if p)
 
 
 def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
@@ -265,15 +291,19 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
         net = by_context.get(context)
         foreign = _foreign(net) if model == "disney" else None
         if foreign is not None:
-            _read_foreign(foreign, spec.custom.get("meters_per_unit", 1.0), values, result)
+            units = spec.custom.get("meters_per_unit", 1.0)
+            if _read_foreign(foreign, net, units, values, result):
+                spelling = "specular"
             result.contexts.append(context)
             continue
-        surface = _surface(net, context, model)
+        surface, read_as = _surface(net, context, model), context
+        if surface is None and context == "mtlx" and model == "disney":
+            surface, read_as = _mtlx_preview(net), "universal"
         if surface is None:
             continue
         units = spec.custom.get("meters_per_unit", 1.0)
-        _read_surface(net, surface, context, model, values, result, units)
-        if context == "universal":
+        _read_surface(net, surface, read_as, model, values, result, units)
+        if read_as == "universal":
             nodes = {n.name: n for n in net.nodes}
             result.loss.extend(preview_extras(surface, nodes, _texture_file))
             if model == "disney" and _specular_workflow(surface, values, result):
@@ -298,7 +328,59 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
         values.update({k: spec.custom[k] for k in CARRIED if k in spec.custom})
     _to_preset_space(values, space, result)
     result.params = _preset_params(values, model, spelling)
+    _settle_maps(result)
     return result
+
+
+def _settle_maps(result: Imported) -> None:
+    """Keep only maps a preset can load: the file (a UDIM tile) exists and OpenImageIO
+    reads it; a UsdUVTexture output names the file's channel by USD's rule (one channel:
+    r, g, b and rgb repeat it, a is 1; two: r, g, b and rgb repeat the first, a is the
+    second; three: a is 1). What is dropped is named."""
+    import OpenImageIO as oiio
+
+    for param, tex in list(result.maps.items()):
+        path = Path(tex.texture)
+        tiles = sorted(path.parent.glob(path.name.replace("<UDIM>", "[0-9]" * 4)))
+        first = tiles[0] if "<UDIM>" in path.name and tiles else path
+        image = oiio.ImageInput.open(str(first)) if first.is_file() else None
+        if image is None:
+            what = "does not exist" if not first.is_file() else "cannot be read"
+            result.loss.append(f"the map {tex.texture} of {param} {what} (not imported)")
+            del result.maps[param]
+            continue
+        channels = image.spec().nchannels
+        image.close()
+        index = usd_channel(tex.channel, channels)
+        if index == "one":  # alpha of a file without alpha: 1, through scale and offset
+            result.params[param] = _round(tex.scale + tex.offset)
+            result.loss.append(
+                f"{param} reads the alpha of {tex.texture}, which has {channels} channel(s): "
+                f"1 by USD's rule, imported as the constant {result.params[param]:g}"
+            )
+            del result.maps[param]
+        elif index != tex.channel:
+            result.maps[param] = tex.model_copy(update={"channel": index})
+
+
+def usd_channel(output: str | int | None, channels: int) -> str | int | None:
+    """The file channel a UsdUVTexture output reads in a file of ``channels`` channels
+    (USD's rule, see :func:`_settle_maps`): a channel, None for the default (the first
+    three or a grey one), ``"one"`` for the constant 1; ``output`` unchanged when the
+    file has it, or when it is not a UsdUVTexture output.
+
+    >>> [usd_channel(c, 1) for c in ("r", "g", "a", "rgb")]
+    [0, 0, 'one', None]
+    >>> [usd_channel(c, 2) for c in ("b", "a", "rgb")], usd_channel("a", 3), usd_channel("g", 4)
+    ([0, 1, 0], 'one', 'g')
+    """
+    if output not in ("r", "g", "b", "a", "rgb"):
+        return output
+    if output == "a":
+        return output if channels >= 4 else 1 if channels == 2 else "one"
+    if output == "rgb":
+        return 0 if channels == 2 else None
+    return output if channels >= 3 else 0
 
 
 def _foreign(net: Network | None) -> Node | None:
@@ -309,17 +391,48 @@ def _foreign(net: Network | None) -> Node | None:
     return node if node is not None and node.id in FOREIGN_SURFACES else None
 
 
-def _read_foreign(surface: Node, units: float, values: dict[str, Any], result: Imported):
+def _read_foreign(surface: Node, net: Network, units: float, values, result: Imported) -> bool:
+    """An OpenPBR, Standard Surface or glTF surface into ``values`` and ``result.maps``
+    (:func:`.foreign.read_foreign`); True when its F0 is spelled as ``specular`` (a
+    specular weight of 0)."""
     from .mtlx import node_defaults
 
     read, maps, losses = read_foreign(surface, node_defaults(surface.id), units)
     values.update(read)
     if "ior" in read:
         values["specular"] = ior_to_specular(read["ior"])
-    for param, name in maps.items():
-        result.loss.append(f"mtlx: {surface.id} {name} is a connected network (not imported)")
-        values.pop(param, None)
+    nodes = {n.name: n for n in net.nodes}
+    for param, (name, conn, scale) in maps.items():
+        texture = _image_input(nodes, conn, scale) if scale else None
+        if texture is None:
+            result.loss.append(f"mtlx: {surface.id} {name} is a connected network (not imported)")
+        else:
+            result.maps[param] = texture
     result.loss.extend(f"mtlx: {line}" for line in losses)
+    if read.get("specular") == 0.0 and "ior" not in read:
+        values["ior"] = specular_to_ior(0.0)  # F0 0: spelled as Burley's specular 0
+        return True
+    return False
+
+
+def _image_input(nodes: dict[str, Node], conn: Connection, scale: float) -> TextureInput | None:
+    """The texture of a MaterialX image node feeding an input (its file and the file's
+    colour space; ``scale`` the weight and conversion of the input), or None."""
+    node = nodes.get(conn.node)
+    if node is None or not node.id.startswith(MTLX_IMAGES):
+        return None
+    path = _texture_file(nodes, conn)
+    if path is None:
+        return None
+    fields: dict[str, Any] = {"texture": str(path)}
+    space = node.color_spaces.get("file")
+    if node.id.endswith(DATA_IMAGES):
+        fields["colorspace"] = "Raw"  # MaterialX converts colour images only
+    elif space:
+        fields["colorspace"] = space
+    if scale != 1.0:
+        fields["scale"] = scale
+    return TextureInput.parse(fields)
 
 
 def _specular_workflow(surface: Node, values: dict[str, Any], result: Imported) -> bool:
@@ -340,6 +453,17 @@ def _specular_workflow(surface: Node, values: dict[str, Any], result: Imported) 
     values["ior"] = specular_to_ior(values["specular"])
     result.loss.extend(losses)
     return True
+
+
+MTLX_PREVIEW = "ND_UsdPreviewSurface_surfaceshader"
+"""MaterialX's UsdPreviewSurface: the same inputs as the universal surface, read alike."""
+
+
+def _mtlx_preview(net: Network | None) -> Node | None:
+    if net is None:
+        return None
+    node = next((n for n in net.nodes if n.name == net.terminal.node), None)
+    return node if node is not None and node.id == MTLX_PREVIEW else None
 
 
 def _surface(net: Network | None, context: str, model: str) -> Node | None:
