@@ -53,6 +53,11 @@ from .record import network_digest, read_record
 
 TEXTURE_FILE_INPUT = {"UsdUVTexture": "file", "PxrTexture": "filename"}
 PRIM_KEY = "prim_path"
+DOC_KEY = "material_doc"
+"""Where :func:`read_networks` keeps the Material's ``doc`` (lookdev's loss lines)."""
+UNTARGETED = ("sheen_model", "sheen_roughness", "sheen_lambda", "specular_gamma")
+"""Disney values no network carries (kept in ``customData``); without it, the ones the
+Material's ``doc`` names (:func:`.network.noted_values`) are read from there."""
 """Where :func:`read_networks` keeps a material's prim path in ``MaterialSpec.custom``."""
 MTLX_IMAGES = ("ND_image_", "ND_tiledimage_", "ND_UsdUVTexture")
 """MaterialX image nodes (by id prefix): their ``file`` is the texture an input reads."""
@@ -104,6 +109,7 @@ def read_networks(stage) -> list[MaterialSpec]:
             if net is not None:
                 networks.append(net)
         custom = {**_custom(prim), "meters_per_unit": units, PRIM_KEY: str(prim.GetPath())}
+        custom[DOC_KEY] = prim.GetDocumentation() or ""
         specs.append(MaterialSpec(custom.get("preset", prim.GetName()), networks, custom))
     return specs
 
@@ -245,7 +251,7 @@ def import_usd(
             bad.append(refusal(prim, exc))
             continue
         if imported is None:
-            why = SKIPPED_WHY.get(spec.custom.get("model", "disney"), NO_SURFACE)
+            why = SKIPPED_WHY.get(spec.custom.get("model") or model_of(spec.networks), NO_SURFACE)
             left.append(f"{spec.name!r} ({why})")
         else:
             imported.prim = prim
@@ -277,7 +283,7 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
         result.params = dict(document.get("params", {}))
         result.contexts.append("record")
         return result
-    model = spec.custom.get("model", "disney")
+    model = spec.custom.get("model") or model_of(spec.networks)
     values = dict(DEFAULTS[model])
     result = Imported(spec.name, model, {})
     if edited:
@@ -313,6 +319,10 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
             result.loss.append(f"{context}: {surface.custom['loss']}")
     if not result.contexts:
         return None
+    if model == "pixar" and document is None and "ri" in by_context:
+        result.loss.append(_pixar_unread(model))
+    if model == "disney" and document is None:
+        _untargeted_from_doc(spec, values, result)
     if model == "disney" and "specular_gamma" in spec.custom:
         # No target has GTR's γ: the writer kept it, and the roughness it was authored
         # with (the surfaces carry the GGX roughness matched to it), in customData.
@@ -381,6 +391,75 @@ def usd_channel(output: str | int | None, channels: int) -> str | int | None:
     if output == "rgb":
         return 0 if channels == 2 else None
     return output if channels >= 3 else 0
+
+
+def model_of(networks: list[Network]) -> str:
+    """The model of a Material without lookdev's ``customData`` (a DCC re-saved it), from
+    its networks: RenderMan's ``PxrSurface`` is lookdev's Pixar model (its layered form
+    when the MaterialX network is a UsdPreviewSurface), as is OpenPBR at lookdev's
+    MaterialX surface prim; anything else is read as Disney (a foreign OpenPBR or
+    Standard Surface among them)."""
+    from . import mtlx, ri
+
+    ids = {
+        net.context: next((n.id for n in net.nodes if n.name == net.terminal.node), "")
+        for net in networks
+    }
+    names = {net.context: net.terminal.node for net in networks}
+    if ids.get("ri") == SURFACE_IDS[("ri", "pixar")] and names.get("ri") == ri.SURFACE:
+        layered = ids.get("mtlx") == SURFACE_IDS[("mtlx", "pixar_weights")]
+        return "pixar_weights" if layered else "pixar"
+    if ids.get("mtlx") == SURFACE_IDS[("mtlx", "pixar")] and names.get("mtlx") == mtlx.SURFACE:
+        return "pixar"
+    return "disney"
+
+
+def _pixar_unread(model: str) -> str:
+    """The loss line of a Pixar material read without its record: the parameters only
+    PxrSurface carries, as Smits' derived lobe weights, which do not invert."""
+    readable = {
+        slot.param
+        for context in READABLE[model]
+        for slot in table_for(context, model)
+        if context == "universal" or slot.param not in DERIVED_FROM
+    }
+    spelled = F0_KEYS | {F0_SPELLING[model][1]}  # the F0 is read, in any spelling
+    unread = sorted(k for k in DEFAULTS[model] if k not in readable | spelled)
+    return (
+        "ri: without lookdev's record, " + ", ".join(unread) + " are read at their defaults "
+        "(PxrSurface carries them only as Smits' derived lobe weights, which do not invert)"
+    )
+
+
+def _untargeted_from_doc(spec: MaterialSpec, values: dict[str, Any], result: Imported) -> None:
+    """Without the record: the Disney values no network carries, from the ``doc``'s loss
+    lines when they name them; a live sheen whose model nothing names is a named loss."""
+    from .network import noted_values
+
+    missing = tuple(k for k in UNTARGETED if k not in spec.custom)
+    noted = noted_values(spec.custom.get(DOC_KEY, ""), missing)
+    if "sheen_lambda" in noted:
+        spec.custom.update(
+            {k: noted[k] for k in ("sheen_lambda", "sheen_model", "sheen_roughness") if k in noted}
+        )
+        noted = {k: v for k, v in noted.items() if k not in spec.custom}
+    if "specular_gamma" in noted:
+        spec.custom["specular_gamma"] = noted.pop("specular_gamma")
+        result.loss.append(
+            "specular_gamma read from the Material's doc: the roughness is the GGX one the "
+            "networks carry (the authored GTR roughness was in customData)"
+        )
+    values.update(noted)
+    if (
+        values.get("sheen", 0.0) > 0.0
+        and "sheen_model" not in noted
+        and "sheen_model" not in spec.custom
+    ):
+        result.loss.append(
+            "no record and no doc name the sheen model: read as Burley's sheen "
+            "(sheen_model disney); MaterialX renders ND_disney_principled's sheen as "
+            "Conty-Kulla at roughness 0.3"
+        )
 
 
 def _foreign(net: Network | None) -> Node | None:
