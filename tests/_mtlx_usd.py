@@ -8,7 +8,8 @@ becomes a ``Material`` whose ``outputs:mtlx:surface`` reads a ``Shader`` with
 the Material's interface inputs (``inputs:base_color``) that the shader's inputs connect
 to; a ``nodegraph`` becomes a ``NodeGraph`` under the Material whose outputs connect to
 its nodes' ``Shader`` prims; a ``filename`` input is an ``asset`` with the file's
-``colorSpace`` metadata.
+``colorSpace`` metadata; the document's ``colorspace`` (``lin_rec709``, ``acescg``)
+is the Material's ``UsdColorSpaceAPI`` colour space (by USD's name, ``lin_ap1_scene``).
 
 Used by the foreign-import tests and by ``python tests/_mtlx_usd.py OUT.usda FILE…``.
 """
@@ -164,10 +165,12 @@ def wrap(mtlx_files: list[Path], out: Path) -> list[str]:
     import MaterialX as mx
     from pxr import Usd, UsdGeom, UsdShade
 
+    from lookdev.materials import colour
+
     library = mx.createDocument()
     mx.loadLibraries(mx.getDefaultDataLibraryFolders(), mx.getDefaultDataSearchPath(), library)
     stage = Usd.Stage.CreateInMemory()
-    UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+    UsdGeom.SetStageMetersPerUnit(stage, 0.01)  # centimetres, as the usd-wg MaterialXTest stages
     written = []
     for file in mtlx_files:
         file = Path(file)
@@ -180,6 +183,9 @@ def wrap(mtlx_files: list[Path], out: Path) -> list[str]:
             material = UsdShade.Material.Define(
                 stage, scope.AppendChild(_slug(material_node.getName()))
             )
+            if doc.getColorSpace():  # the document's colour space names its colour values
+                space = Usd.ColorSpaceAPI.Apply(material.GetPrim())
+                space.CreateColorSpaceNameAttr(colour.interop_id(doc.getColorSpace()))
             surface_in = material_node.getInput("surfaceshader")
             surface = surface_in.getConnectedNode() if surface_in is not None else None
             if surface is None:

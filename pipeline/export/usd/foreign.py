@@ -16,6 +16,7 @@ OpenPBR                           Standard Surface            Disney (Burley 201
 ================================  ==========================  ===================================
 base_color × base_weight          base_color × base           base_color (opaque part)
 transmission_color                transmission_color          base_color (glass part, see below)
+subsurface_color                  subsurface_color            base_color (subsurface part)
 base_metalness                    metalness                   metallic
 specular_roughness                specular_roughness          roughness
 specular_ior                      specular_IOR                ior
@@ -35,7 +36,8 @@ for the opaque base, which glass usually leaves at weight 0. So the glass part's
 is ``transmission_color``: base_color = mix(base_color × weight, transmission_color,
 transmission). Clear glass (Standard Surface's ``base = 0``, ``transmission = 1``) stays
 clear; where transmission is partial and the two colours differ, one Disney colour holds
-both, and that is named.
+both, and that is named. The subsurface likewise: Burley's takes ``base_color``, theirs
+``subsurface_color``, mixed in by the subsurface weight.
 
 A dead lobe's inputs are not read (:data:`GATES`): at weight 0 a value (a velvet's
 ``specular_IOR = 0``) shows nothing, so it neither refuses the material nor reaches the
@@ -134,8 +136,12 @@ SPECULAR_WEIGHT = {OPENPBR: "specular_weight", STANDARD: "specular", GLTF: "spec
 """The weight of the dielectric specular: at 0 (and no glass) it is Burley's ``specular``
 0; any other value below 1 has no Disney parameter (named)."""
 
-TRANSMISSION_COLOUR = {OPENPBR: "transmission_color", STANDARD: "transmission_color"}
-"""The input that tints the glass (see the module note), per surface."""
+TINTS: dict[str, tuple[tuple[str, str], ...]] = {
+    OPENPBR: (("spec_trans", "transmission_color"), ("subsurface", "subsurface_color")),
+    STANDARD: (("spec_trans", "transmission_color"), ("subsurface", "subsurface_color")),
+}
+"""Per surface, (our weight, their colour input): the colour of the glass and of the
+subsurface, which Burley takes from ``base_color`` (see the module note), in order."""
 
 GATES: dict[str, dict[str, tuple[str, ...]]] = {
     OPENPBR: {
@@ -265,7 +271,9 @@ def read_foreign(
         values[param] = convert(value) if convert else value
     if "sheen" in values:
         values["sheen_model"] = "conty_kulla"
-    read_here = _glass_colour(surface, given, values, maps, losses)
+    read_here: set[str] = set()
+    for weight, name in TINTS.get(surface.id, ()):
+        read_here |= _tint(surface, weight, name, given, values, maps, losses)
     weight_name = SPECULAR_WEIGHT.get(surface.id)
     if weight_name and _is_zero(given(weight_name)) and not values.get("spec_trans", 0.0) > 0:
         values.pop("ior", None)
@@ -288,34 +296,33 @@ def _is_zero(value: Any) -> bool:
     return all(v == 0 for v in value) if isinstance(value, tuple) else value == 0
 
 
-def _glass_colour(surface: Node, given, values, maps, losses) -> set[str]:
-    """Burley's glass is tinted by ``base_color``; theirs by ``transmission_color``: the
-    glass part's colour goes into ``base_color`` (see the module note). The inputs it
-    read."""
-    name = TRANSMISSION_COLOUR.get(surface.id)
-    weight = values.get("spec_trans", 0.0)
-    if name is None or "spec_trans" in maps or not weight > 0.0:
+def _tint(surface: Node, param: str, name: str, given, values, maps, losses) -> set[str]:
+    """Burley's glass and subsurface take ``base_color``; theirs take ``name``
+    (``transmission_color``, ``subsurface_color``): mixed into ``base_color`` by the
+    lobe's weight ``param`` (see the module note). The inputs it read."""
+    weight = values.get(param, 0.0)
+    if param in maps or not weight > 0.0:
         return set()
     tint = given(name)
     if isinstance(tint, Connection):
-        losses.append(f"{surface.id} {name} is a connected map: the glass keeps base_color")
+        losses.append(f"{surface.id} {name} is a connected map: base_color keeps the base's")
         return {name}
     if tint is None:
         return set()
     tint = np.broadcast_to(np.asarray(tint, dtype=np.float64), (3,))
     if weight >= 1.0:
-        maps.pop("base_color", None)  # the opaque base shows nothing under full glass
+        maps.pop("base_color", None)  # at full weight the base's own colour shows nothing
         values["base_color"] = tuple(float(c) for c in tint)
         return {name}
     if "base_color" in maps:
-        losses.append(f"{surface.id} {name}: the glass part takes the base colour map")
+        losses.append(f"{surface.id} {name}: the {param} part takes the base colour map")
         return {name}
     base = np.broadcast_to(np.asarray(values.get("base_color", 0.0), dtype=np.float64), (3,))
     mixed = (1.0 - weight) * base + weight * tint
     values["base_color"] = tuple(float(c) for c in mixed)
     if np.max(np.abs(base - tint)) > 1e-6:
         losses.append(
-            f"{surface.id} transmission {weight:g}: base_color {_short(tuple(base))} and "
+            f"{surface.id} {param} {weight:g}: base_color {_short(tuple(base))} and "
             f"{name} {_short(tuple(tint))} share one Disney base_color "
             f"{_short(tuple(round(float(c), 4) for c in mixed))}"
         )

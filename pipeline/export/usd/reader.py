@@ -141,10 +141,24 @@ def _to_preset_space(values: dict[str, Any], space: str, result: Imported) -> No
     except colour.ColourError:
         result.loss.append(f"colour space {space!r} is unknown to the OCIO config: kept as is")
         return
+    if colour.canonical(colour.PRESET_LINEAR) == source:
+        return
     for key, value in values.items():
-        if isinstance(value, tuple) and len(value) == 3:
-            converted = colour.convert(value, source, colour.PRESET_LINEAR)
-            values[key] = tuple(float(v) for v in np.clip(converted, 0.0, None))
+        if not (isinstance(value, tuple) and len(value) == 3):
+            continue
+        converted = np.asarray(colour.convert(value, source, colour.PRESET_LINEAR), float)
+        if key == "scatter_distance_scale":  # per channel over the largest, as split_distances
+            top = float(converted.max())
+            if top > 0.0:
+                values["scatter_distance"] = values.get("scatter_distance", 0.0) * top
+                converted = converted / top
+        clipped = np.clip(converted, 0.0, 1.0)
+        if np.max(np.abs(clipped - converted)) > 1e-6:
+            shown = ", ".join(f"{c:.4g}" for c in converted)
+            result.loss.append(
+                f"{key} ({shown}) in linear Rec.709 is outside a preset's [0, 1]: clipped"
+            )
+        values[key] = tuple(float(v) for v in clipped)
 
 
 def _custom(prim) -> dict[str, Any]:
