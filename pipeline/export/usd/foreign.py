@@ -215,6 +215,34 @@ UNREAD: dict[str, tuple[str, ...]] = {
 }
 """Inputs with no Disney parameter: named as losses when authored away from the default."""
 
+UNREAD_GATES: dict[str, dict[str, str]] = {
+    OPENPBR: {
+        "specular_color": "specular_weight",
+        "coat_color": "coat_weight",
+        "coat_ior": "coat_weight",
+        "geometry_coat_normal": "coat_weight",
+        "thin_film_weight": "thin_film_weight",
+        "transmission_depth": "transmission_weight",
+        "subsurface_color": "subsurface_weight",
+        "fuzz_color": "fuzz_weight",
+        "fuzz_roughness": "fuzz_weight",
+        "emission_color": "emission_luminance",
+    },
+    STANDARD: {
+        "specular_color": "specular",
+        "coat_color": "coat",
+        "coat_IOR": "coat",
+        "coat_normal": "coat",
+        "transmission_depth": "transmission",
+        "subsurface_color": "subsurface",
+        "sheen_color": "sheen",
+        "sheen_roughness": "sheen",
+        "emission_color": "emission",
+    },
+}
+"""An unread input → the weight of its lobe: at weight 0 it shows nothing, so it is no
+loss (a velvet's ``specular_color`` at ``specular = 0``)."""
+
 FOREIGN_SURFACES = frozenset(TABLES)
 
 
@@ -280,8 +308,10 @@ def read_foreign(
         values["specular"] = 0.0
         read_here.add(weight_name)
     _read_radius(values, maps, losses, surface.id, meters_per_unit)
+    unread_gates = UNREAD_GATES.get(surface.id, {})
     for name in UNREAD[surface.id]:
-        if name in read_here:
+        gate = unread_gates.get(name)
+        if name in read_here or (gate is not None and _is_zero(given(gate))):
             continue
         if name in surface.inputs and not _at_default(surface.inputs[name][1], defaults.get(name)):
             value = surface.inputs[name][1]

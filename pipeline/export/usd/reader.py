@@ -464,11 +464,8 @@ def _untargeted_from_doc(spec: MaterialSpec, values: dict[str, Any], result: Imp
             "networks carry (the authored GTR roughness was in customData)"
         )
     values.update(noted)
-    if (
-        values.get("sheen", 0.0) > 0.0
-        and "sheen_model" not in noted
-        and "sheen_model" not in spec.custom
-    ):
+    named = "sheen_model" in noted or "sheen_model" in spec.custom
+    if values.get("sheen", 0.0) > 0.0 and values.get("sheen_model") == "disney" and not named:
         result.loss.append(
             "no record and no doc name the sheen model: read as Burley's sheen "
             "(sheen_model disney); MaterialX renders ND_disney_principled's sheen as "
