@@ -5,6 +5,7 @@ encodes them), one refusal line per bad material, exit 3 when partly imported.""
 from __future__ import annotations
 
 import json
+import re
 import shutil
 import sys
 from pathlib import Path
@@ -235,3 +236,35 @@ def test_usd_uv_texture_channels_follow_usds_rule(tmp_path, output, channels, wa
         text = lookdev.pipeline.export.usd.presets.preset_toml(found)
         preset = parse_preset(text.encode(), where="t.toml", stem=found.name)
         assert preset.params["roughness"]["texture"].endswith("t.png")
+
+
+def _render_mean(preset: str, tmp_path: Path) -> float:
+    """Mean luminance of lookdev's own render of ``preset`` (a sphere under the studio
+    IBL, 24x24, 64 spp, one seed)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[3]))
+    from _mitsuba_helpers import mitsuba_module
+
+    mi = mitsuba_module()
+    import lookdev.pipeline.export.mitsuba as export
+
+    export.register_plugins()
+    scene = tmp_path / f"{Path(preset).stem}.xml"
+    lookdev.export_mitsuba(preset, scene, ibl="studio", resolution=(24, 24), spp=64)
+    image = np.asarray(mi.render(mi.load_file(str(scene)), seed=1))[..., :3]
+    return float((image @ np.array([0.2126, 0.7152, 0.0722])).mean())
+
+
+def test_imported_standard_surface_glass_renders_as_clear_glass(cli, tmp_path, examples):
+    _, doc = _import(cli, examples[0], tmp_path / "out")
+    (path,) = [
+        p
+        for p, m in zip(doc["written"], doc["materials"], strict=True)
+        if m["prim"].endswith("standard_surface_glass/Glass")
+    ]
+    clear = _render_mean("glass_clear", tmp_path)
+    black = tmp_path / "black" / Path(path).name  # its base colour (base = 0) as the glass's
+    black.parent.mkdir()
+    text = re.sub(r"(?m)^base_color = .*$", "base_color = [0.0, 0.0, 0.0]", Path(path).read_text())
+    black.write_text(text)
+    assert _render_mean(path, tmp_path) == pytest.approx(clear, rel=0.02)
+    assert _render_mean(str(black), tmp_path) < 0.7 * clear
