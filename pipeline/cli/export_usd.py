@@ -241,8 +241,8 @@ def import_usd(
         typer.Option(
             "--output",
             "-o",
-            help="Preset .toml to write (a folder when the file holds several materials); "
-            "default: print the TOML.",
+            help="Preset .toml to write (a folder when the file holds several materials; "
+            "made if missing); default: print the TOML.",
         ),
     ] = None,
     force: Annotated[
@@ -261,7 +261,7 @@ def import_usd(
 ) -> None:
     """Read materials from a USD file back into presets.
 
-    Reads UsdPreviewSurface, OpenPBR and Standard Surface networks from any tool
+    Reads UsdPreviewSurface, OpenPBR, Standard Surface and glTF PBR networks from any tool
     (values followed through the Material's interface inputs), and gives a lookdev
     export back exactly (its preset travels in the Material's customData). A parameter
     fed by a texture becomes the preset's texture table for it (file, channel, colour
