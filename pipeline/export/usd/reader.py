@@ -409,11 +409,12 @@ def usd_channel(output: str | int | None, channels: int) -> str | int | None:
 
 def model_of(networks: list[Network]) -> str:
     """The model of a Material without lookdev's ``customData`` (a DCC re-saved it), from
-    its networks: RenderMan's ``PxrSurface`` is lookdev's Pixar model (its layered form
-    when the MaterialX network is a UsdPreviewSurface), as is OpenPBR at lookdev's
-    MaterialX surface prim; anything else is read as Disney (a foreign OpenPBR or
-    Standard Surface among them)."""
-    from . import mtlx, ri
+    its networks: RenderMan's ``PxrSurface`` at lookdev's ri surface prim is lookdev's
+    Pixar model (its layered form when the MaterialX network is a UsdPreviewSurface);
+    anything else is read as Disney (``PxrDisneyBsdf``, ``ND_disney_principled``, and a
+    foreign OpenPBR or Standard Surface). Without a ri network an OpenPBR surface does not
+    tell lookdev's Pixar export from a Disney one or another tool's, and reads as Disney."""
+    from . import ri
 
     ids = {
         net.context: next((n.id for n in net.nodes if n.name == net.terminal.node), "")
@@ -423,8 +424,6 @@ def model_of(networks: list[Network]) -> str:
     if ids.get("ri") == SURFACE_IDS[("ri", "pixar")] and names.get("ri") == ri.SURFACE:
         layered = ids.get("mtlx") == SURFACE_IDS[("mtlx", "pixar_weights")]
         return "pixar_weights" if layered else "pixar"
-    if ids.get("mtlx") == SURFACE_IDS[("mtlx", "pixar")] and names.get("mtlx") == mtlx.SURFACE:
-        return "pixar"
     return "disney"
 
 
