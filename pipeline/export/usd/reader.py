@@ -49,9 +49,9 @@ from .network import (
 )
 from .pixar import ior_to_normal_fresnel
 from .preview import preview_defaults
+from .read_maps import image_input, round32, settle_maps, texture_file, texture_input
 from .record import network_digest, read_record
 
-TEXTURE_FILE_INPUT = {"UsdUVTexture": "file", "PxrTexture": "filename"}
 PRIM_KEY = "prim_path"
 DOC_KEY = "material_doc"
 """Where :func:`read_networks` keeps the Material's ``doc`` (lookdev's loss lines)."""
@@ -59,10 +59,6 @@ UNTARGETED = ("sheen_model", "sheen_roughness", "sheen_lambda", "specular_gamma"
 """Disney values no network carries (kept in ``customData``); without it, the ones the
 Material's ``doc`` names (:func:`.network.noted_values`) are read from there."""
 """Where :func:`read_networks` keeps a material's prim path in ``MaterialSpec.custom``."""
-MTLX_IMAGES = ("ND_image_", "ND_tiledimage_", "ND_UsdUVTexture")
-"""MaterialX image nodes (by id prefix): their ``file`` is the texture an input reads."""
-DATA_IMAGES = ("_float", "_vector2", "_vector3", "_vector4")
-"""MaterialX image node id endings whose values are data (no colour transform)."""
 READ_ORDER = ("universal", "ri", "mtlx")
 READABLE = {
     "disney": READ_ORDER,
@@ -325,7 +321,7 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
         _read_surface(net, surface, read_as, model, values, result, units)
         if read_as == "universal":
             nodes = {n.name: n for n in net.nodes}
-            result.loss.extend(preview_extras(surface, nodes, _texture_file))
+            result.loss.extend(preview_extras(surface, nodes, texture_file))
             if model == "disney" and _specular_workflow(surface, values, result):
                 spelling = "specular"
         result.contexts.append(context)
@@ -352,59 +348,8 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
         values.update({k: spec.custom[k] for k in CARRIED if k in spec.custom})
     _to_preset_space(values, space, result)
     result.params = _preset_params(values, model, spelling)
-    _settle_maps(result)
+    settle_maps(result)
     return result
-
-
-def _settle_maps(result: Imported) -> None:
-    """Keep only maps a preset can load: the file (a UDIM tile) exists and OpenImageIO
-    reads it; a UsdUVTexture output names the file's channel by USD's rule (one channel:
-    r, g, b and rgb repeat it, a is 1; two: r, g, b and rgb repeat the first, a is the
-    second; three: a is 1). What is dropped is named."""
-    import OpenImageIO as oiio
-
-    for param, tex in list(result.maps.items()):
-        path = Path(tex.texture)
-        tiles = sorted(path.parent.glob(path.name.replace("<UDIM>", "[0-9]" * 4)))
-        first = tiles[0] if "<UDIM>" in path.name and tiles else path
-        image = oiio.ImageInput.open(str(first)) if first.is_file() else None
-        if image is None:
-            what = "does not exist" if not first.is_file() else "cannot be read"
-            result.loss.append(f"the map {tex.texture} of {param} {what} (not imported)")
-            del result.maps[param]
-            continue
-        channels = image.spec().nchannels
-        image.close()
-        index = usd_channel(tex.channel, channels)
-        if index == "one":  # alpha of a file without alpha: 1, through scale and offset
-            result.params[param] = _round(tex.scale + tex.offset)
-            result.loss.append(
-                f"{param} reads the alpha of {tex.texture}, which has {channels} channel(s): "
-                f"1 by USD's rule, imported as the constant {result.params[param]:g}"
-            )
-            del result.maps[param]
-        elif index != tex.channel:
-            result.maps[param] = tex.model_copy(update={"channel": index})
-
-
-def usd_channel(output: str | int | None, channels: int) -> str | int | None:
-    """The file channel a UsdUVTexture output reads in a file of ``channels`` channels
-    (USD's rule, see :func:`_settle_maps`): a channel, None for the default (the first
-    three or a grey one), ``"one"`` for the constant 1; ``output`` unchanged when the
-    file has it, or when it is not a UsdUVTexture output.
-
-    >>> [usd_channel(c, 1) for c in ("r", "g", "a", "rgb")]
-    [0, 0, 'one', None]
-    >>> [usd_channel(c, 2) for c in ("b", "a", "rgb")], usd_channel("a", 3), usd_channel("g", 4)
-    ([0, 1, 0], 'one', 'g')
-    """
-    if output not in ("r", "g", "b", "a", "rgb"):
-        return output
-    if output == "a":
-        return output if channels >= 4 else 1 if channels == 2 else "one"
-    if output == "rgb":
-        return 0 if channels == 2 else None
-    return output if channels >= 3 else 0
 
 
 def model_of(networks: list[Network]) -> str:
@@ -492,7 +437,7 @@ def _read_foreign(surface: Node, net: Network, units: float, values, result: Imp
         values["specular"] = ior_to_specular(read["ior"])
     nodes = {n.name: n for n in net.nodes}
     for param, (name, conn, scale) in maps.items():
-        texture = _image_input(nodes, conn, scale) if scale else None
+        texture = image_input(nodes, conn, scale) if scale else None
         if texture is None:
             result.loss.append(f"mtlx: {surface.id} {name} is a connected network (not imported)")
         else:
@@ -502,26 +447,6 @@ def _read_foreign(surface: Node, net: Network, units: float, values, result: Imp
         values["ior"] = specular_to_ior(0.0)  # F0 0: spelled as Burley's specular 0
         return True
     return False
-
-
-def _image_input(nodes: dict[str, Node], conn: Connection, scale: float) -> TextureInput | None:
-    """The texture of a MaterialX image node feeding an input (its file and the file's
-    colour space; ``scale`` the weight and conversion of the input), or None."""
-    node = nodes.get(conn.node)
-    if node is None or not node.id.startswith(MTLX_IMAGES):
-        return None
-    path = _texture_file(nodes, conn)
-    if path is None:
-        return None
-    fields: dict[str, Any] = {"texture": str(path)}
-    space = node.color_spaces.get("file")
-    if node.id.endswith(DATA_IMAGES):
-        fields["colorspace"] = "Raw"  # MaterialX converts colour images only
-    elif space:
-        fields["colorspace"] = space
-    if scale != 1.0:
-        fields["scale"] = scale
-    return TextureInput.parse(fields)
 
 
 def _specular_workflow(surface: Node, values: dict[str, Any], result: Imported) -> bool:
@@ -588,7 +513,7 @@ def _read_surface(net, surface, context, model, values, result, units: float = 1
             continue
         given = surface.inputs.get(slot.input)
         if given is not None and isinstance(given[1], Connection):
-            texture = _texture_input(nodes, given[1], slot)  # None for a live mix chain
+            texture = texture_input(nodes, given[1], slot)  # None for a live mix chain
             if texture is not None and slot.texture_linear is None:
                 result.loss.append(
                     f"{context}: {slot.input} reads the map {texture.texture} through a "
@@ -628,53 +553,6 @@ def _defaults(context: str, node_id: str) -> dict[str, Any] | None:
     return None
 
 
-WRAP = {"repeat": "periodic", "clamp": "clamp", "black": "black", "mirror": "mirror"}
-"""UsdUVTexture ``wrapS`` → :class:`TextureInput` ``wrap``."""
-COLOUR_SPACE = {"raw": "Raw", "sRGB": "sRGB - Texture"}
-"""UsdUVTexture ``sourceColorSpace`` → the OCIO config's name (``auto``: by file rule)."""
-
-
-def _texture_input(nodes: dict[str, Node], conn: Connection, slot) -> TextureInput | None:
-    """The :class:`TextureInput` of the texture node feeding ``slot``: its file, output
-    channel, colour space, UsdUVTexture scale/bias as scale/offset and wrap. The slot's
-    own conversion is not applied (it is named by the input it feeds)."""
-    path = _texture_file(nodes, conn)
-    if path is None:
-        return None
-    node = nodes[conn.node]
-    fields: dict[str, Any] = {"texture": str(path)}
-    if conn.output in ("r", "g", "b", "a", "rgb"):
-        fields["channel"] = conn.output
-    space = node.inputs.get("sourceColorSpace", (None, None))[1]
-    if space in COLOUR_SPACE:
-        fields["colorspace"] = COLOUR_SPACE[space]
-    channel = {"r": 0, "g": 1, "b": 2, "a": 3}.get(conn.output, 0)
-    scale = node.inputs.get("scale", (None, None))[1]
-    bias = node.inputs.get("bias", (None, None))[1]
-    s = float(scale[channel]) if isinstance(scale, tuple) else 1.0
-    o = float(bias[channel]) if isinstance(bias, tuple) else 0.0
-    # The input is a·param + b (the slot's affine map): param = (texel·s + o − b)/a.
-    a, b = slot.texture_linear or (1.0, 0.0)
-    s, o = s / a, (o - b) / a
-    if s != 1.0:
-        fields["scale"] = s
-    if o != 0.0:
-        fields["offset"] = o
-    wrap = node.inputs.get("wrapS", (None, None))[1]
-    if wrap in WRAP:
-        fields["wrap"] = WRAP[wrap]
-    return TextureInput.parse(fields)
-
-
-def _texture_file(nodes: dict[str, Node], conn: Connection) -> Path | None:
-    node = nodes.get(conn.node)
-    if node is None:
-        return None
-    key = TEXTURE_FILE_INPUT.get(node.id, "file")
-    value = node.inputs.get(key, (None, None))[1]
-    return value.path if isinstance(value, Image) else None
-
-
 F0_SPELLING = {
     "disney": ("ior", "specular", ior_to_specular),
     "pixar": ("eta", "normal_fresnel", ior_to_normal_fresnel),
@@ -688,7 +566,7 @@ def _preset_params(values: dict[str, Any], model: str, spelling: str) -> dict:
     defaults = DEFAULTS[model]
     read, other, convert = F0_SPELLING[model]
     params = {
-        k: _round(v)
+        k: round32(v)
         for k, v in live.items()
         if k in defaults and k not in F0_KEYS | {other} and not same_or_eq(v, defaults[k])
     }
@@ -696,16 +574,5 @@ def _preset_params(values: dict[str, Any], model: str, spelling: str) -> dict:
     key, value = ("ior", ior) if spelling == "ior" else (other, convert(ior))
     reference = defaults[read] if key == "ior" else defaults[other]
     if not same_or_eq(value, reference):
-        params[key] = _round(value)
+        params[key] = round32(value)
     return params
-
-
-def _round(v: Any) -> Any:
-    """float32-stored values as the shortest decimal that reads back the same float32."""
-    import numpy as np
-
-    if isinstance(v, float):
-        return float(np.format_float_positional(np.float32(v), unique=True))
-    if isinstance(v, tuple):
-        return tuple(_round(x) for x in v)
-    return v
