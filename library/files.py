@@ -21,6 +21,10 @@ The rules, written once:
   with code 128 + signal) so the same ``finally`` runs. Only SIGKILL cannot be caught: a
   later write of the same file removes the temporaries of dead processes of this host, and
   :func:`scratch_folder` sweeps scratch folders of dead or hour-old writers.
+- **Folders.** Every command that writes a file creates the folder it goes into, and the
+  missing parents (``mkdir -p``), through :func:`make_folder`; :func:`check_folder` says
+  before any work whether that will succeed. A write that fails removes the folders it
+  created (:meth:`Transaction.folder`).
 - **One line.** An ``OSError`` becomes :class:`WriteError`: ``cannot write PATH: No space
   left on device``.
 
@@ -57,7 +61,9 @@ __all__ = [
     "atomic_write",
     "failure_reason",
     "cache_root",
+    "check_folder",
     "is_temporary",
+    "make_folder",
     "new_file_mode",
     "remove_quietly",
     "scratch_folder",
@@ -101,6 +107,37 @@ def failure_reason(path: str | os.PathLike, message: str) -> str:
             return os.strerror(errno.ENOSPC)
     lines = [line.strip() for line in str(message).splitlines() if line.strip()]
     return lines[-1] if lines else "unknown error"
+
+
+# -- folders ---------------------------------------------------------------------------
+
+
+def check_folder(folder: str | os.PathLike) -> Path:
+    """Raise :class:`WriteError` unless files can be written in ``folder``: it exists and is
+    writable, or its nearest existing ancestor is a writable folder it can be made in."""
+    folder = Path(folder)
+    existing = next((p for p in (folder, *folder.parents) if p.exists()), Path("."))
+    if not existing.is_dir():
+        raise WriteError(f"cannot create folder {os.fspath(folder)}: {existing} is a file")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        what = "is not writable" if existing == folder else f"cannot be made in {existing}"
+        raise WriteError(f"folder {os.fspath(folder)} {what}: {os.strerror(errno.EACCES)}")
+    return folder
+
+
+def make_folder(folder: str | os.PathLike, created: list[Path] | None = None) -> Path:
+    """Create ``folder`` and its missing parents: the one rule for the folder of every file
+    a command writes. The folders it made are appended to ``created`` (outermost first),
+    so a write that fails can remove them; a failure is one :class:`WriteError` line."""
+    folder = check_folder(folder)
+    missing = [p for p in (folder, *folder.parents) if not p.exists()]
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise WriteError(f"cannot create folder {os.fspath(folder)}: {exc.strerror}") from None
+    if created is not None:
+        created += reversed(missing)
+    return folder
 
 
 # -- modes -----------------------------------------------------------------------------
@@ -294,15 +331,9 @@ class Transaction:
         return name
 
     def folder(self, path: str | os.PathLike) -> Path:
-        """Create ``path`` (and parents) if missing; an abort removes what it created."""
-        path = Path(path)
-        missing = [p for p in (path, *path.parents) if not p.exists()]
-        try:
-            path.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise write_error(path, exc) from None
-        self.created += reversed(missing)
-        return path
+        """Create ``path`` (and parents) if missing (:func:`make_folder`); an abort removes
+        what it created."""
+        return make_folder(path, self.created)
 
     def temp_for(self, path: str | os.PathLike) -> Path:
         """A new, empty temporary for ``path`` (beside the file a link at ``path`` leads to)."""

@@ -402,7 +402,7 @@ def figure(
 def save_figure(fig: Any, path: str | Path) -> Path:
     """Write the figure atomically (temporary file, then rename) and close it."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    files.make_folder(path.parent)
     try:
         with files.atomic_path(path) as tmp:
             fig.savefig(tmp, dpi=110)

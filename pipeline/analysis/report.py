@@ -222,7 +222,7 @@ def web_image(src: Path, out_dir: Path, exposure: float = 0.0) -> Path:
     except ProofImageError as exc:
         raise ReportError(f"cannot read frame: {exc.message}", where=str(src)) from None
     img = to_8bit(view(rgb, exposure))
-    dst.parent.mkdir(parents=True, exist_ok=True)
+    files.make_folder(dst.parent)
     out = oiio.ImageBuf(oiio.ImageSpec(img.shape[1], img.shape[0], 3, oiio.UINT8))
     out.set_pixels(oiio.ROI(), img)
     with files.atomic_path(dst) as tmp:

@@ -396,7 +396,7 @@ def plot_error_vs_time(report: Report, path: Path) -> Path:
 
 def write_outputs(report: Report, settings: Settings, out_dir: Path) -> dict[str, Path]:
     """``error_bench.json`` and ``error_bench.png`` in ``out_dir``, each written whole."""
-    out_dir.mkdir(parents=True, exist_ok=True)
+    files.make_folder(out_dir)
     js = out_dir / "error_bench.json"
     files.atomic_write(js, json.dumps(report.to_json(settings), indent=2) + "\n")
     return {"json": js, "plot": plot_error_vs_time(report, out_dir / "error_bench.png")}

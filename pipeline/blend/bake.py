@@ -45,18 +45,14 @@ def bake(
 ) -> dict[str, Path]:
     """Write the maps and the sidecar; returns ``{map name: path, "sidecar": path}``."""
     out_dir = Path(out_dir)
-    try:
-        created = not out_dir.exists()
-        out_dir.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise BlendError(f"cannot create {out_dir}: {exc.strerror}", where=blended.name) from None
+    created: list[Path] = []
+    files.make_folder(out_dir, created)
     arrays = blended.arrays
     names = {name: f"{blended.name}_{name}.exr" for name in arrays}
     sidecar = out_dir / f"{blended.name}.json"
     stale = _listed_files(sidecar) - set(names.values())
     with files.Transaction() as staged:  # renamed into place together, the sidecar last
-        if created:
-            staged.created.append(out_dir)  # a failed first bake leaves no empty folder
+        staged.created += created  # a failed first bake leaves no empty folder
         for i, (name, array) in enumerate(arrays.items()):
             final = out_dir / names[name]
             space = colour_space_of(array, data=name.endswith("normal_map"))

@@ -267,8 +267,8 @@ def import_usd(
         typer.Option(
             "--output",
             "-o",
-            help="Preset .toml to write (a folder when the file holds several materials); "
-            "default: print the TOML.",
+            help="Preset .toml to write (a folder when the file holds several materials; "
+            "made if missing); default: print the TOML.",
         ),
     ] = None,
     force: Annotated[
@@ -296,7 +296,7 @@ def import_usd(
 ) -> None:
     """Read materials from a USD file back into presets.
 
-    Reads UsdPreviewSurface, OpenPBR and Standard Surface networks from any tool
+    Reads UsdPreviewSurface, OpenPBR, Standard Surface and glTF PBR networks from any tool
     (values followed through the Material's interface inputs), and gives a lookdev
     export back exactly (its preset travels in the Material's customData). A parameter
     fed by a texture becomes the preset's texture table for it (file, channel, colour
@@ -312,21 +312,33 @@ def import_usd(
 
       lookdev import usd library.usda -o imported/
 
-    A material that cannot become a preset (a layered Pixar material) is named in one
-    line and the command exits 2 after writing the others; a value a preset would reject
-    (out of range, NaN, infinity) is refused, never clamped; an existing preset file is
-    replaced only with --force.
+    Foreign files import as far as they can: a material that cannot become a preset (a
+    layered Pixar material, a surface lookdev does not read) is skipped and a value a
+    preset would reject (out of range, NaN, infinity; never clamped) refuses its
+    material, each in one line on stderr naming the prim, the field and the value, and
+    the others are written. An input on a lobe whose weight is 0 is not read. An existing
+    preset file is replaced only with --force.
+
+    Exit status: 0 every material imported; 3 partly imported (some written, some
+    skipped or refused: the lines say which); 2 bad input (nothing importable, a file
+    that is not USD, a name clash, an unwritable -o).
     """
-    from lookdev.pipeline.export.usd.presets import import_names, write_presets
+    from lookdev.pipeline.export.usd.presets import import_names, screen, write_presets
     from lookdev.pipeline.export.usd.reader import import_usd as read
 
     skipped: list[str] = []
-    found = read(file.expanduser(), skipped)
+    refused: list[str] = []
+    found = read(file.expanduser(), skipped, refused)
     if openpbr is ImportOpenPBR.itself:
         from lookdev.pipeline.export.usd.openpbr_import import import_as_openpbr
 
         itself = import_as_openpbr(file.expanduser())
         found = [itself.get(m.name, m) for m in found]
+    found = screen(found, refused)
+    if not found:
+        from lookdev.pipeline.export.usd.network import ExportError
+
+        raise ExportError("no material to import: refused " + "; ".join(refused), where=str(file))
     names = import_names(found, _taken_names(output, rename), rename=rename)
     written = write_presets(found, output, force=force, names=names)
     if as_json:
@@ -336,6 +348,7 @@ def import_usd(
                 "materials": [
                     {
                         "name": m.name,
+                        "prim": m.prim,
                         "preset": name,
                         "model": m.model,
                         "params": m.params,
@@ -351,6 +364,7 @@ def import_usd(
                 ],
                 "written": [str(p) for p in written],
                 "skipped": skipped,
+                "refused": refused,
             }
         )
     elif output is None:
@@ -363,14 +377,18 @@ def import_usd(
             console.print(f"wrote [bold]{path}[/]")
             for line in m.loss:
                 console.print(f"  loss: {line}", markup=False, highlight=False)
-    if skipped:
-        from lookdev.pipeline.export.usd.network import ExportError
+    if skipped or refused:
+        for line in skipped:  # one line each, never wrapped
+            typer.echo(f"lookdev: skipped {line}", err=True)
+        for line in refused:
+            typer.echo(f"lookdev: refused {line}", err=True)
+        total = len(found) + len(skipped) + len(refused)
+        typer.echo(f"lookdev: partly imported: {len(found)} of {total} materials", err=True)
+        raise typer.Exit(PARTLY_IMPORTED)
 
-        raise ExportError(
-            f"imported {len(found)} of {len(found) + len(skipped)} materials; skipped "
-            + ", ".join(skipped),
-            where=str(file),
-        )
+
+PARTLY_IMPORTED = 3
+"""``lookdev import usd``'s exit status when some materials were written and some not."""
 
 
 def _taken_names(output: Path | None, rename: bool) -> set[str]:

@@ -164,8 +164,7 @@ def run_job(job: Job) -> dict[str, Any]:
 
 
 def _run_job(job: Job, variant: str) -> dict[str, Any]:
-    folder = job.folder
-    folder.mkdir(parents=True, exist_ok=True)
+    folder = files.make_folder(job.folder)
     done = read_manifest(folder, job.key)
     todo = [f for f in job.settings.frames() if f.index not in done]
     doc = {
@@ -298,8 +297,8 @@ def _sampling_label(s: Settings) -> str:
 # -- a batch (runs in the parent) ----------------------------------------------------------
 def check_writable(out: Path) -> None:
     """Fail early, in one line, when ``out`` cannot hold the proofs."""
+    files.make_folder(out)
     try:
-        out.mkdir(parents=True, exist_ok=True)
         probe = out / f".lookdev-write-test-{os.getpid()}"
         probe.write_bytes(b"")
         probe.unlink()

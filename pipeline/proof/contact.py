@@ -145,7 +145,7 @@ def _atomic_write(path: Path, suffix: str, write) -> Path:
     """
     path = Path(path)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
+        files.make_folder(path.parent)
         with files.atomic_path(path) as tmp:  # the one write path: modes, signals, cleanup
             error = write(str(tmp))
             if error is not None:

@@ -80,7 +80,7 @@ def write_material_info(out: Path, hubs: list[Any]) -> list[Path]:
     written = []
     for hub in hubs:
         path = Path(out) / _slug(hub.name) / FILE
-        path.parent.mkdir(parents=True, exist_ok=True)
+        files.make_folder(path.parent)
         files.atomic_write(path, json.dumps(describe(hub), indent=2) + "\n")
         written.append(path)
     return written

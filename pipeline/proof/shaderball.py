@@ -130,7 +130,7 @@ def write_ply(mesh: MeshData, path: Path) -> Path:
     vertices = np.concatenate([mesh.positions, mesh.normals, mesh.uvs], axis=1).astype("<f4")
     faces = np.zeros(f, dtype=[("n", "u1"), ("i", "<u4", 3)])
     faces["n"], faces["i"] = 3, mesh.faces
-    path.parent.mkdir(parents=True, exist_ok=True)
+    files.make_folder(path.parent)
     return files.atomic_write(path, header.encode("ascii") + vertices.tobytes() + faces.tobytes())
 
 

@@ -278,7 +278,7 @@ def write_exr(data: np.ndarray, path: Path, space: str | None = None) -> Path:
     """Write a float32 (H, W, C) array in ``space`` as an EXR, row 0 first, atomically."""
     path = Path(path)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
+        files.make_folder(path.parent)
         with files.atomic_path(path) as tmp:
             exr.write_exr(tmp, data, space, shown=path)
     except OSError as exc:

@@ -10,7 +10,6 @@ leaves no half-written scene behind.
 from __future__ import annotations
 
 import contextlib
-import os
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from pathlib import Path
@@ -173,7 +172,7 @@ def export_scene(material: Any, path: str | Path, **scene_options: Any) -> dict[
     Returns the scene dict that was written (texture paths absolute).
     """
     path = Path(path)
-    _check_writable(path.parent)
+    files.make_folder(path.parent)
     textures = path.parent.resolve() / f"{path.stem}_textures"
     existed = textures.exists()
     try:
@@ -187,17 +186,6 @@ def export_scene(material: Any, path: str | Path, **scene_options: Any) -> dict[
     return scene
 
 
-def _check_writable(folder: Path) -> None:
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise MitsubaExportError(
-            f"cannot create the folder: {exc.strerror}", where=str(folder)
-        ) from None
-    if not os.access(folder, os.W_OK):
-        raise MitsubaExportError("the folder is not writable", where=str(folder))
-
-
 def _atomic_write(path: Path, text: str) -> None:
-    _check_writable(path.parent)
+    files.make_folder(path.parent)
     files.atomic_write(path, text)

@@ -429,6 +429,34 @@ def loss_note(source: Source, context: str, mapped: set[str], extra: str = "") -
     return "; ".join(parts + source.notes)
 
 
+_NOTED = re.compile(r"\b([a-z_]+)=([A-Za-z_]+|[-+]?[0-9][0-9.eE+-]*)(?=[,;\s]|$)")
+
+
+def noted_values(doc: str, keys: tuple[str, ...]) -> dict[str, Any]:
+    """The scalar values of ``keys`` that :func:`loss_note` named (``key=value``) in a
+    Material's ``doc``: what a DCC keeps of a value no network carries when it drops
+    lookdev's ``customData``. Words stay strings; ``True``/``False`` become bools.
+
+    >>> noted_values("mtlx: X cannot express sheen_model=conty_kulla, sheen_roughness=0.7",
+    ...              ("sheen_model", "sheen_roughness"))
+    {'sheen_model': 'conty_kulla', 'sheen_roughness': 0.7}
+    """
+    out: dict[str, Any] = {}
+    for key, text in _NOTED.findall(doc or ""):
+        if key not in keys or key in out:
+            continue
+        if text in ("True", "False"):
+            out[key] = text == "True"
+        elif text[0].isalpha() or text[0] == "_":
+            out[key] = text
+        else:
+            try:
+                out[key] = float(text)
+            except ValueError:
+                continue
+    return out
+
+
 def lobe_coverage(source: Source, context: str, preview_opacity: str = "keep") -> dict[str, str]:
     """Each of the model's lobes in ``context``: ``"dead"`` (no weight: nothing written),
     ``"written"`` (live, and the context carries it: a base lobe, or one of the

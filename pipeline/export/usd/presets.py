@@ -10,12 +10,12 @@ is refused in one line, or renamed with ``rename``.
 
 from __future__ import annotations
 
-import os
 import re
 from pathlib import Path
 
 from lookdev.library import PresetFile, dump_preset, files
 from lookdev.library.preset import parse_preset
+from lookdev.materials.errors import LookdevError
 
 from .network import ExportError
 from .reader import Imported
@@ -108,30 +108,48 @@ def write_presets(
             )
         targets = [output]
     else:
-        if not output.is_dir():
-            what = "is a file, not a folder" if output.exists() else "folder does not exist"
-            raise ExportError(f"{what} (give a folder or a .toml file)", where=str(output))
+        if output.exists() and not output.is_dir():
+            raise ExportError(
+                "is a file, not a folder (give a folder or a .toml file)", where=str(output)
+            )
         targets = [output / f"{name}.toml" for name in names]
     texts = [preset_toml(m, name) for m, name in zip(found, names, strict=True)]
     for path, text in zip(targets, texts, strict=True):
         check_preset(text, str(path), stem=path.stem)
     for path in targets:
-        if not path.parent.is_dir() or not os.access(path.parent, os.W_OK):
-            raise ExportError("folder does not exist or is not writable", where=str(path))
+        try:
+            files.check_folder(path.parent)
+        except files.WriteError as exc:
+            raise ExportError(exc.message, where=str(path)) from None
         if path.exists() and not force:
             raise ExportError(
                 "a preset file of that name exists; give --force to replace it", where=str(path)
             )
-    for path, text in zip(targets, texts, strict=True):
-        _write_atomic(path, text)
+    with files.Transaction() as staged:  # all or none, the folder made as `mkdir -p`
+        for path, text in zip(targets, texts, strict=True):
+            staged.folder(path.parent)
+            staged.temp_for(path).write_bytes(text.encode("utf-8"))
     return targets
+
+
+def screen(found: list[Imported], refused: list[str]) -> list[Imported]:
+    """The materials whose preset validates as ``presets validate`` would; each other one
+    is refused in one line naming its prim, the field and the value (appended to
+    ``refused``), so one bad value never stops the rest of a file."""
+    from .reader import refusal
+
+    kept = []
+    for m in found:
+        try:
+            check_preset(preset_toml(m), f"{preset_name(m.name)}.toml")
+        except LookdevError as exc:
+            refused.append(refusal(m.prim or m.name, exc))
+            continue
+        kept.append(m)
+    return kept
 
 
 def check_preset(text: str, where: str, stem: str | None = None) -> None:
     """Raise the one line ``presets validate`` would print if ``text`` is not a valid preset
     (its own parameters: references are not resolved here)."""
     parse_preset(text.encode("utf-8"), where=where, stem=stem)
-
-
-def _write_atomic(path: Path, text: str) -> None:
-    files.atomic_write(path, text)

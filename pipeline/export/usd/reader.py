@@ -50,9 +50,16 @@ from .network import (
 )
 from .pixar import ior_to_normal_fresnel
 from .preview import preview_defaults
+from .read_maps import image_input, round32, settle_maps, texture_file, texture_input
 from .record import network_digest, read_record
 
-TEXTURE_FILE_INPUT = {"UsdUVTexture": "file", "PxrTexture": "filename"}
+PRIM_KEY = "prim_path"
+DOC_KEY = "material_doc"
+"""Where :func:`read_networks` keeps the Material's ``doc`` (lookdev's loss lines)."""
+UNTARGETED = ("sheen_model", "sheen_roughness", "sheen_lambda", "specular_gamma")
+"""Disney values no network carries (kept in ``customData``); without it, the ones the
+Material's ``doc`` names (:func:`.network.noted_values`) are read from there."""
+"""Where :func:`read_networks` keeps a material's prim path in ``MaterialSpec.custom``."""
 READ_ORDER = ("universal", "ri", "mtlx")
 READABLE = {
     "disney": READ_ORDER,
@@ -78,6 +85,8 @@ class Imported:
     loss: list[str] = field(default_factory=list)
     document: dict[str, Any] | None = None
     """The whole preset, when the file carried lookdev's record (an exact round trip)."""
+    prim: str = ""
+    """The Material's prim path in the file (what a refusal names)."""
 
 
 def read_networks(stage) -> list[MaterialSpec]:
@@ -96,7 +105,8 @@ def read_networks(stage) -> list[MaterialSpec]:
             net = _network(material, context, output_name)
             if net is not None:
                 networks.append(net)
-        custom = {**_custom(prim), "meters_per_unit": units}
+        custom = {**_custom(prim), "meters_per_unit": units, PRIM_KEY: str(prim.GetPath())}
+        custom[DOC_KEY] = prim.GetDocumentation() or ""
         specs.append(MaterialSpec(custom.get("preset", prim.GetName()), networks, custom))
     return specs
 
@@ -128,10 +138,24 @@ def _to_preset_space(values: dict[str, Any], space: str, result: Imported) -> No
     except colour.ColourError:
         result.loss.append(f"colour space {space!r} is unknown to the OCIO config: kept as is")
         return
+    if colour.canonical(colour.PRESET_LINEAR) == source:
+        return
     for key, value in values.items():
-        if isinstance(value, tuple) and len(value) == 3:
-            converted = colour.convert(value, source, colour.PRESET_LINEAR)
-            values[key] = tuple(float(v) for v in np.clip(converted, 0.0, None))
+        if not (isinstance(value, tuple) and len(value) == 3):
+            continue
+        converted = np.asarray(colour.convert(value, source, colour.PRESET_LINEAR), float)
+        if key == "scatter_distance_scale":  # per channel over the largest, as split_distances
+            top = float(converted.max())
+            if top > 0.0:
+                values["scatter_distance"] = values.get("scatter_distance", 0.0) * top
+                converted = converted / top
+        clipped = np.clip(converted, 0.0, 1.0)
+        if np.max(np.abs(clipped - converted)) > 1e-6:
+            shown = ", ".join(f"{c:.4g}" for c in converted)
+            result.loss.append(
+                f"{key} ({shown}) in linear Rec.709 is outside a preset's [0, 1]: clipped"
+            )
+        values[key] = tuple(float(v) for v in clipped)
 
 
 def _custom(prim) -> dict[str, Any]:
@@ -179,6 +203,8 @@ def _collect(prim, nodes: dict[str, Node]) -> None:
                 _collect(attr.GetPrim(), nodes)
             elif attr.HasAuthoredValue():
                 node.inputs[inp.GetBaseName()] = (kind, _plain(attr.Get()))
+                if attr.HasColorSpace():
+                    node.color_spaces[inp.GetBaseName()] = str(attr.GetColorSpace())
             break
     node.custom.update(_custom(prim))
 
@@ -198,17 +224,23 @@ SKIPPED_WHY = {
     "parameters; import its layers' presets instead",
 }
 """Why a material of a given ``model`` (customData) cannot be imported."""
-NO_SURFACE = "no UsdPreviewSurface, ND_disney_principled or PxrDisneyBsdf surface"
+NO_SURFACE = (
+    "no UsdPreviewSurface, ND_disney_principled, PxrDisneyBsdf, OpenPBR, Standard Surface "
+    "or glTF PBR surface"
+)
 
 
-def import_usd(path: Path, skipped: list[str] | None = None) -> list[Imported]:
-    """Read every material of the USD file ``path`` into presets.
+def import_usd(
+    path: Path, skipped: list[str] | None = None, refused: list[str] | None = None
+) -> list[Imported]:
+    """Read every material of the USD file ``path`` into presets, as far as it can.
 
     A material that cannot become a preset (a layered Pixar material, a surface lookdev
     does not read) is never dropped silently: its name and the reason are appended to
-    ``skipped`` when a list is given, and named in the error when nothing is readable.
-    A value a preset would reject (out of range, NaN, infinity) is refused in one line
-    naming the file, the material and the field: an import never clamps silently.
+    ``skipped``. A value a preset would reject (out of range, NaN, infinity) refuses its
+    material, never the file: one line naming the prim, the field and the value is
+    appended to ``refused``; an import never clamps silently. When nothing is readable
+    the error names every skipped and refused material.
     """
     from pxr import Tf, Usd
 
@@ -220,28 +252,38 @@ def import_usd(path: Path, skipped: list[str] | None = None) -> list[Imported]:
         stage = Usd.Stage.Open(str(path))
     except Tf.ErrorException:
         raise ExportError("USD cannot open it", where=str(path)) from None
-    found, left = [], []
+    found, left, bad = [], [], []
     spaces = colour_spaces(stage)
     for spec in read_networks(stage):
+        prim = spec.custom.get(PRIM_KEY, spec.name)
         try:
             imported = _imported(spec, spaces.get(spec.name, ""))
         except LookdevError as exc:
-            raise ExportError(
-                exc.message, where=f"{path}: material {spec.name!r}", field=exc.field
-            ) from None
+            bad.append(refusal(prim, exc))
+            continue
         if imported is None:
-            why = SKIPPED_WHY.get(spec.custom.get("model", "disney"), NO_SURFACE)
+            why = SKIPPED_WHY.get(spec.custom.get("model") or model_of(spec.networks), NO_SURFACE)
             left.append(f"{spec.name!r} ({why})")
         else:
+            imported.prim = prim
             found.append(imported)
     if skipped is not None:
         skipped.extend(left)
+    if refused is not None:
+        refused.extend(bad)
     if not found:
         detail = f"; skipped {', '.join(left)}" if left else ""
+        detail += f"; refused {'; '.join(bad)}" if bad else ""
         raise ExportError(
-            f"no material to import: none has a {NO_SURFACE[3:]}{detail}", where=str(path)
+            f"no material to import: none has a {NO_SURFACE[3:]}{detail}",
+            where=str(path),
         )
     return found
+
+
+def refusal(prim: str, exc: LookdevError) -> str:
+    """The one line naming a refused material's prim, the field and the value."""
+    return ": ".join(p for p in (prim, exc.field, exc.message) if p)
 
 
 def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
@@ -252,7 +294,7 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
         result.params = dict(document.get("params", {}))
         result.contexts.append("record")
         return result
-    model = spec.custom.get("model", "disney")
+    model = spec.custom.get("model") or model_of(spec.networks)
     values = dict(DEFAULTS[model])
     result = Imported(spec.name, model, {})
     if edited:
@@ -273,17 +315,21 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
             result.contexts.append(context)
             continue
         if foreign is not None:
-            _read_foreign(foreign, spec.custom.get("meters_per_unit", 1.0), values, result)
+            units = spec.custom.get("meters_per_unit", 1.0)
+            if _read_foreign(foreign, net, units, values, result):
+                spelling = "specular"
             result.contexts.append(context)
             continue
-        surface = _surface(net, context, model)
+        surface, read_as = _surface(net, context, model), context
+        if surface is None and context == "mtlx" and model == "disney":
+            surface, read_as = _mtlx_preview(net), "universal"
         if surface is None:
             continue
         units = spec.custom.get("meters_per_unit", 1.0)
-        _read_surface(net, surface, context, model, values, result, units)
-        if context == "universal":
+        _read_surface(net, surface, read_as, model, values, result, units)
+        if read_as == "universal":
             nodes = {n.name: n for n in net.nodes}
-            result.loss.extend(preview_extras(surface, nodes, _texture_file))
+            result.loss.extend(preview_extras(surface, nodes, texture_file))
             if model == "disney" and _specular_workflow(surface, values, result):
                 spelling = "specular"
         result.contexts.append(context)
@@ -291,6 +337,10 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
             result.loss.append(f"{context}: {surface.custom['loss']}")
     if not result.contexts:
         return None
+    if model == "pixar" and document is None and "ri" in by_context:
+        result.loss.append(_pixar_unread(model))
+    if model == "disney" and document is None:
+        _untargeted_from_doc(spec, values, result)
     if model == "disney" and "specular_gamma" in spec.custom:
         # No target has GTR's γ: the writer kept it, and the roughness it was authored
         # with (the surfaces carry the GGX roughness matched to it), in customData.
@@ -306,7 +356,73 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
         values.update({k: spec.custom[k] for k in CARRIED if k in spec.custom})
     _to_preset_space(values, space, result)
     result.params = _preset_params(values, model, spelling)
+    settle_maps(result)
     return result
+
+
+def model_of(networks: list[Network]) -> str:
+    """The model of a Material without lookdev's ``customData`` (a DCC re-saved it), from
+    its networks: RenderMan's ``PxrSurface`` at lookdev's ri surface prim is lookdev's
+    Pixar model (its layered form when the MaterialX network is a UsdPreviewSurface);
+    anything else is read as Disney (``PxrDisneyBsdf``, ``ND_disney_principled``, and a
+    foreign OpenPBR or Standard Surface). Without a ri network an OpenPBR surface does not
+    tell lookdev's Pixar export from a Disney one or another tool's, and reads as Disney."""
+    from . import ri
+
+    ids = {
+        net.context: next((n.id for n in net.nodes if n.name == net.terminal.node), "")
+        for net in networks
+    }
+    names = {net.context: net.terminal.node for net in networks}
+    if ids.get("ri") == SURFACE_IDS[("ri", "pixar")] and names.get("ri") == ri.SURFACE:
+        layered = ids.get("mtlx") == SURFACE_IDS[("mtlx", "pixar_weights")]
+        return "pixar_weights" if layered else "pixar"
+    return "disney"
+
+
+def _pixar_unread(model: str) -> str:
+    """The loss line of a Pixar material read without its record: the parameters only
+    PxrSurface carries, as Smits' derived lobe weights, which do not invert."""
+    readable = {
+        slot.param
+        for context in READABLE[model]
+        for slot in table_for(context, model)
+        if context == "universal" or slot.param not in DERIVED_FROM
+    }
+    spelled = F0_KEYS | {F0_SPELLING[model][1]}  # the F0 is read, in any spelling
+    unread = sorted(k for k in DEFAULTS[model] if k not in readable | spelled)
+    return (
+        "ri: without lookdev's record, " + ", ".join(unread) + " are read at their defaults "
+        "(PxrSurface carries them only as Smits' derived lobe weights, which do not invert)"
+    )
+
+
+def _untargeted_from_doc(spec: MaterialSpec, values: dict[str, Any], result: Imported) -> None:
+    """Without the record: the Disney values no network carries, from the ``doc``'s loss
+    lines when they name them; a live sheen whose model nothing names is a named loss."""
+    from .network import noted_values
+
+    missing = tuple(k for k in UNTARGETED if k not in spec.custom)
+    noted = noted_values(spec.custom.get(DOC_KEY, ""), missing)
+    if "sheen_lambda" in noted:
+        spec.custom.update(
+            {k: noted[k] for k in ("sheen_lambda", "sheen_model", "sheen_roughness") if k in noted}
+        )
+        noted = {k: v for k, v in noted.items() if k not in spec.custom}
+    if "specular_gamma" in noted:
+        spec.custom["specular_gamma"] = noted.pop("specular_gamma")
+        result.loss.append(
+            "specular_gamma read from the Material's doc: the roughness is the GGX one the "
+            "networks carry (the authored GTR roughness was in customData)"
+        )
+    values.update(noted)
+    named = "sheen_model" in noted or "sheen_model" in spec.custom
+    if values.get("sheen", 0.0) > 0.0 and values.get("sheen_model") == "disney" and not named:
+        result.loss.append(
+            "no record and no doc name the sheen model: read as Burley's sheen "
+            "(sheen_model disney); MaterialX renders ND_disney_principled's sheen as "
+            "Conty-Kulla at roughness 0.3"
+        )
 
 
 def _foreign(net: Network | None) -> Node | None:
@@ -317,17 +433,28 @@ def _foreign(net: Network | None) -> Node | None:
     return node if node is not None and node.id in FOREIGN_SURFACES else None
 
 
-def _read_foreign(surface: Node, units: float, values: dict[str, Any], result: Imported):
+def _read_foreign(surface: Node, net: Network, units: float, values, result: Imported) -> bool:
+    """An OpenPBR, Standard Surface or glTF surface into ``values`` and ``result.maps``
+    (:func:`.foreign.read_foreign`); True when its F0 is spelled as ``specular`` (a
+    specular weight of 0)."""
     from .mtlx import node_defaults
 
     read, maps, losses = read_foreign(surface, node_defaults(surface.id), units)
     values.update(read)
     if "ior" in read:
         values["specular"] = ior_to_specular(read["ior"])
-    for param, name in maps.items():
-        result.loss.append(f"mtlx: {surface.id} {name} is a connected network (not imported)")
-        values.pop(param, None)
+    nodes = {n.name: n for n in net.nodes}
+    for param, (name, conn, scale) in maps.items():
+        texture = image_input(nodes, conn, scale) if scale else None
+        if texture is None:
+            result.loss.append(f"mtlx: {surface.id} {name} is a connected network (not imported)")
+        else:
+            result.maps[param] = texture
     result.loss.extend(f"mtlx: {line}" for line in losses)
+    if read.get("specular") == 0.0 and "ior" not in read:
+        values["ior"] = specular_to_ior(0.0)  # F0 0: spelled as Burley's specular 0
+        return True
+    return False
 
 
 def _specular_workflow(surface: Node, values: dict[str, Any], result: Imported) -> bool:
@@ -348,6 +475,17 @@ def _specular_workflow(surface: Node, values: dict[str, Any], result: Imported) 
     values["ior"] = specular_to_ior(values["specular"])
     result.loss.extend(losses)
     return True
+
+
+MTLX_PREVIEW = "ND_UsdPreviewSurface_surfaceshader"
+"""MaterialX's UsdPreviewSurface: the same inputs as the universal surface, read alike."""
+
+
+def _mtlx_preview(net: Network | None) -> Node | None:
+    if net is None:
+        return None
+    node = next((n for n in net.nodes if n.name == net.terminal.node), None)
+    return node if node is not None and node.id == MTLX_PREVIEW else None
 
 
 def _surface(net: Network | None, context: str, model: str) -> Node | None:
@@ -383,7 +521,7 @@ def _read_surface(net, surface, context, model, values, result, units: float = 1
             continue
         given = surface.inputs.get(slot.input)
         if given is not None and isinstance(given[1], Connection):
-            texture = _texture_input(nodes, given[1], slot)  # None for a live mix chain
+            texture = texture_input(nodes, given[1], slot)  # None for a live mix chain
             if texture is not None and slot.texture_linear is None:
                 result.loss.append(
                     f"{context}: {slot.input} reads the map {texture.texture} through a "
@@ -423,53 +561,6 @@ def _defaults(context: str, node_id: str) -> dict[str, Any] | None:
     return None
 
 
-WRAP = {"repeat": "periodic", "clamp": "clamp", "black": "black", "mirror": "mirror"}
-"""UsdUVTexture ``wrapS`` → :class:`TextureInput` ``wrap``."""
-COLOUR_SPACE = {"raw": "Raw", "sRGB": "sRGB - Texture"}
-"""UsdUVTexture ``sourceColorSpace`` → the OCIO config's name (``auto``: by file rule)."""
-
-
-def _texture_input(nodes: dict[str, Node], conn: Connection, slot) -> TextureInput | None:
-    """The :class:`TextureInput` of the texture node feeding ``slot``: its file, output
-    channel, colour space, UsdUVTexture scale/bias as scale/offset and wrap. The slot's
-    own conversion is not applied (it is named by the input it feeds)."""
-    path = _texture_file(nodes, conn)
-    if path is None:
-        return None
-    node = nodes[conn.node]
-    fields: dict[str, Any] = {"texture": str(path)}
-    if conn.output in ("r", "g", "b", "a", "rgb"):
-        fields["channel"] = conn.output
-    space = node.inputs.get("sourceColorSpace", (None, None))[1]
-    if space in COLOUR_SPACE:
-        fields["colorspace"] = COLOUR_SPACE[space]
-    channel = {"r": 0, "g": 1, "b": 2, "a": 3}.get(conn.output, 0)
-    scale = node.inputs.get("scale", (None, None))[1]
-    bias = node.inputs.get("bias", (None, None))[1]
-    s = float(scale[channel]) if isinstance(scale, tuple) else 1.0
-    o = float(bias[channel]) if isinstance(bias, tuple) else 0.0
-    # The input is a·param + b (the slot's affine map): param = (texel·s + o − b)/a.
-    a, b = slot.texture_linear or (1.0, 0.0)
-    s, o = s / a, (o - b) / a
-    if s != 1.0:
-        fields["scale"] = s
-    if o != 0.0:
-        fields["offset"] = o
-    wrap = node.inputs.get("wrapS", (None, None))[1]
-    if wrap in WRAP:
-        fields["wrap"] = WRAP[wrap]
-    return TextureInput.parse(fields)
-
-
-def _texture_file(nodes: dict[str, Node], conn: Connection) -> Path | None:
-    node = nodes.get(conn.node)
-    if node is None:
-        return None
-    key = TEXTURE_FILE_INPUT.get(node.id, "file")
-    value = node.inputs.get(key, (None, None))[1]
-    return value.path if isinstance(value, Image) else None
-
-
 F0_SPELLING = {
     "disney": ("ior", "specular", ior_to_specular),
     "pixar": ("eta", "normal_fresnel", ior_to_normal_fresnel),
@@ -483,7 +574,7 @@ def _preset_params(values: dict[str, Any], model: str, spelling: str) -> dict:
     defaults = DEFAULTS[model]
     read, other, convert = F0_SPELLING[model]
     params = {
-        k: _round(v)
+        k: round32(v)
         for k, v in live.items()
         if k in defaults and k not in F0_KEYS | {other} and not same_or_eq(v, defaults[k])
     }
@@ -491,16 +582,5 @@ def _preset_params(values: dict[str, Any], model: str, spelling: str) -> dict:
     key, value = ("ior", ior) if spelling == "ior" else (other, convert(ior))
     reference = defaults[read] if key == "ior" else defaults[other]
     if not same_or_eq(value, reference):
-        params[key] = _round(value)
+        params[key] = round32(value)
     return params
-
-
-def _round(v: Any) -> Any:
-    """float32-stored values as the shortest decimal that reads back the same float32."""
-    import numpy as np
-
-    if isinstance(v, float):
-        return float(np.format_float_positional(np.float32(v), unique=True))
-    if isinstance(v, tuple):
-        return tuple(_round(x) for x in v)
-    return v

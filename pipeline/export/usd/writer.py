@@ -258,25 +258,21 @@ class Staging(files.Transaction):
 
 
 def check_writable(path: Path) -> None:
-    """Raise :class:`ExportError` unless ``path`` can be created in an existing folder."""
-    folder = path.parent
-    if not folder.is_dir():
-        what = "is a file, not a folder" if folder.exists() else "does not exist"
-        raise ExportError(f"folder {folder} {what}", where=str(path))
-    if not os.access(folder, os.W_OK | os.X_OK):
-        raise ExportError(f"folder {folder} is not writable", where=str(path))
+    """Raise :class:`ExportError` unless ``path`` can be written, its folder existing or
+    creatable (:func:`lookdev.library.files.check_folder`; the write makes it)."""
+    try:
+        files.check_folder(path.parent)
+    except files.WriteError as exc:
+        raise ExportError(exc.message, where=str(path)) from None
     if path.exists() and path.is_dir():
         raise ExportError("is a folder; give a file name", where=str(path))
 
 
 def check_folder(folder: Path) -> None:
-    """A folder to write into: existing, or creatable in an existing, writable parent."""
-    if folder.is_dir():
-        check_writable(folder / "x.usda")
-    elif folder.exists():
+    """A folder to write into: existing, or creatable (the write makes it)."""
+    if folder.exists() and not folder.is_dir():
         raise ExportError("is a file; --split takes a folder", where=str(folder))
-    else:
-        check_writable(folder)
+    check_writable(folder / "x.usda")
 
 
 def images_of(specs: list[MaterialSpec]) -> list[Image]:
@@ -399,6 +395,9 @@ def export_usd(
     check_images(images)
     layout = {"name": out.name, "geometry": preview_geometry, "meters_per_unit": meters_per_unit}
     with Staging() as staging:  # commits on success; removes every temporary otherwise
+        for path in (out, mtlx_path):
+            if path is not None:
+                staging.folder(Path(path).parent)  # made as `mkdir -p`; removed on failure
         if package:
             written = _write_package(
                 specs, images, out, Path(workdir or out.parent), staging, layout
@@ -447,7 +446,7 @@ def _write_package(specs, images, out: Path, workdir: Path, staging: Staging, la
 
     for image in images:
         if image.write:
-            image.path.parent.mkdir(parents=True, exist_ok=True)
+            files.make_folder(image.path.parent)
             publish.write_image(image, lambda p: p, image.path)
     root = workdir / f"{out.stem}.usdc"  # the package's root layer keeps the output's name
     if root.exists():  # not a private folder: never overwrite what is there

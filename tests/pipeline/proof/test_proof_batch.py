@@ -301,7 +301,7 @@ def test_proof_command_default_executor_is_a_process_pool(cli, tmp_path):
         (["no_such_preset"], "no_such_preset"),
         (["gold", "--ibl", "missing.exr"], "missing.exr: no such IBL file"),
         (["gold", "--ibl", "JUNK"], "cannot decode"),
-        (["gold", "-o", "FILE/sub"], "not writable"),
+        (["gold", "-o", "FILE/sub"], "file is a file"),
         (["gold", "--ibl", "studio", "--ibl", "STUDIO_EXR"], "two IBLs would share"),
     ],
 )

@@ -125,8 +125,7 @@ def _one_line_error(result) -> str:
 @pytest.mark.parametrize(
     "target, words",
     [
-        ("missing/dir/out.usda", "does not exist"),
-        ("afile.txt/out.usda", "is a file, not a folder"),  # issue 13: it exists
+        ("afile.txt/out.usda", "afile.txt is a file"),  # issue 13: it exists
         ("out.txt", "not a USD file name"),
     ],
 )

@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -186,9 +187,11 @@ def test_openpbr_and_standard_surface_are_read(tmp_path, shader_id, inputs, want
     preset = _preset(found)
     for key, value in want.items():
         assert preset.params[key] == pytest.approx(value), key
-    base = preset.params["base_color"]
-    scale = 0.5 if shader_id.startswith("ND_standard") else 1.0  # base_weight default 1
-    assert base == pytest.approx(tuple(c * scale for c in (0.8, 0.4, 0.2)), rel=1e-6)
+    base = preset.params.get("base_color", (1.0, 1.0, 1.0))
+    if preset.params.get("spec_trans") == 1.0:  # glass: tinted by transmission_color (white)
+        assert base == pytest.approx((1.0, 1.0, 1.0))
+    else:
+        assert base == pytest.approx((0.8, 0.4, 0.2), rel=1e-6)  # base_weight default 1
     if "emission_luminance" in inputs:
         assert any("emission_luminance" in line for line in found.loss)
 
@@ -224,12 +227,22 @@ def test_a_foreign_radius_is_read_per_channel_only_where_it_scatters(
     assert any("subsurface weight 0.5" in line for line in found[0.5].loss)
 
 
+def _png(path: Path, channels: int) -> None:
+    import OpenImageIO as oiio
+
+    out = oiio.ImageOutput.create(str(path))
+    out.open(str(path), oiio.ImageSpec(2, 2, channels, oiio.UINT8))
+    out.write_image(np.full((2, 2, channels), 128, np.uint8))
+    out.close()
+
+
 def test_a_texture_feeding_an_input_is_kept_as_a_texture_input(tmp_path):
     path = tmp_path / "tex.usda"
     stage = _stage(path)
     _, shader = _surface(stage, "/Looks/T", "UsdPreviewSurface")
     tex = UsdShade.Shader.Define(stage, "/Looks/T/Rough")
     tex.CreateIdAttr("UsdUVTexture")
+    _png(tmp_path / "rough.png", 3)
     tex.CreateInput("file", T.Asset).Set("./rough.png")
     tex.CreateInput("sourceColorSpace", T.Token).Set("raw")
     tex.CreateInput("scale", T.Float4).Set((0.5, 0.5, 0.5, 1.0))

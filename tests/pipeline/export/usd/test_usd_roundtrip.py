@@ -170,6 +170,12 @@ def test_foreign_preview_surface_imports(tmp_path):
     surface.CreateInput("ior", Sdf.ValueTypeNames.Float).Set(1.6)
     tex = UsdShade.Shader.Define(stage, "/Looks/Ceramic/Rough")
     tex.CreateIdAttr("UsdUVTexture")
+    import OpenImageIO as oiio
+
+    grey = oiio.ImageOutput.create(str(tmp_path / "rough.png"))  # one channel
+    grey.open(str(tmp_path / "rough.png"), oiio.ImageSpec(2, 2, 1, oiio.UINT8))
+    grey.write_image(np.full((2, 2, 1), 100, np.uint8))
+    grey.close()
     tex.CreateInput("file", Sdf.ValueTypeNames.Asset).Set("./rough.png")
     out = tex.CreateOutput("r", Sdf.ValueTypeNames.Float)
     surface.CreateInput("roughness", Sdf.ValueTypeNames.Float).ConnectToSource(out)
@@ -180,6 +186,7 @@ def test_foreign_preview_surface_imports(tmp_path):
     assert found.params["base_color"] == (0.9, 0.85, 0.8)
     assert found.params["ior"] == pytest.approx(1.6)  # a foreign file spells the F0 as IOR
     assert Path(found.maps["roughness"].texture).name == "rough.png"
+    assert found.maps["roughness"].channel == 0  # `r` of a one-channel file: its channel
 
 
 scale = st.sampled_from([0.0, 1.0]) | st.floats(0.0, 2.0)
