@@ -78,10 +78,6 @@ def test_quickstart_runs_as_written_in_a_fresh_folder(tmp_path):
     assert any(line.startswith("lookdev presets new") and "--from" in line for line in lines)
     script = [
         "set -euo pipefail",
-        # TEMPORARY: `export usd -o pub/…` does not yet create its folder; helper h-import's
-        # fix (every writing command creates its folders) removes the need. The integrator
-        # deletes this line at merge.
-        "mkdir -p pub",
         *(_shrunk(line) for line in lines),
     ]
     env = dict(os.environ)
