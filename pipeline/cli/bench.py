@@ -743,3 +743,7 @@ app.command("noise")(noise_)
 app.command("proof")(proof_)
 app.command("subsurface")(subsurface_)
 app.command("usd")(usd_)
+
+from .bench_dcc import dcc_  # noqa: E402  (its heavy imports are inside the command)
+
+app.command("dcc")(dcc_)
