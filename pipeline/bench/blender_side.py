@@ -204,6 +204,12 @@ def render(bpy: Any, request: dict[str, Any]) -> dict[str, Any]:
             obj = bpy.context.active_object
             bpy.ops.object.shade_smooth()
         obj.name = f"object_{i}"
+        if obj.type == "MESH" and obj.data.uv_layers:
+            # The USD importer names a mesh's UV map after its primvar, and lookdev's
+            # texture readers ask for "st".
+            obj.data.uv_layers[0].name = "st"
+        if "uv_frame" in spec:
+            _mitsuba_sphere_uv(obj, Matrix(spec["uv_frame"]))
         obj.matrix_world = Matrix(spec["matrix"])
         if "albedo" in spec:
             grey = bpy.data.materials.new(f"grey_{i}")
@@ -229,6 +235,26 @@ def render(bpy: Any, request: dict[str, Any]) -> dict[str, Any]:
         bpy.ops.render.render(write_still=True)
         frames[name] = path
     return {"version": bpy.app.version_string, "frames": frames}
+
+
+def _mitsuba_sphere_uv(obj: Any, frame: Any) -> None:
+    """UVs as Mitsuba's sphere has them: in the sphere's local frame (``frame`` takes
+    Blender's object coordinates there) u = atan2(y, x) / 2π, θ from +z; written as USD's
+    st (t = 1 − θ/π), so a map shows where the proof shows it."""
+    mesh = obj.data
+    layer = mesh.uv_layers["st"]
+    for poly in mesh.polygons:
+        uvs = []
+        for loop in poly.loop_indices:
+            p = frame @ mesh.vertices[mesh.loops[loop].vertex_index].co
+            u = (math.atan2(p.y, p.x) / (2 * math.pi)) % 1.0
+            theta = math.acos(max(-1.0, min(1.0, p.z / max(p.length, 1e-12))))
+            uvs.append([u, 1.0 - theta / math.pi])
+        if max(uv[0] for uv in uvs) - min(uv[0] for uv in uvs) > 0.5:
+            for uv in uvs:  # a face across the seam: keep it on one side
+                uv[0] += 1.0 if uv[0] < 0.5 else 0.0
+        for loop, uv in zip(poly.loop_indices, uvs, strict=True):
+            layer.data[loop].uv = uv
 
 
 def main(argv: list[str]) -> int:

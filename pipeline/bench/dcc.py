@@ -117,7 +117,12 @@ def blender_scene(environment: Path, resolution: tuple[int, int]) -> dict[str, A
             "fov_x_deg": fov,
         },
         "objects": [
-            {"kind": "sphere", "matrix": _matrix4(np.eye(3), z @ shaderball.BALL_CENTER)},
+            {
+                "kind": "sphere",
+                "matrix": _matrix4(np.eye(3), z @ shaderball.BALL_CENTER),
+                # Blender's object axes → the ball's own (lookdev's world axes).
+                "uv_frame": z.T.tolist(),
+            },
             # The cup PLY is written in the proof's world already (cup_to_world(0) = 1).
             {"kind": "ply", "file": str(shaderball.cup_ply()), "matrix": _matrix4(z)},
             {
