@@ -2,8 +2,8 @@
 
 A ``UsdGeomSphere`` gprim is a renderer's shape, not a DCC's: Blender's importer turns
 it into a mesh of its own and drops its material binding. A ``UsdGeomMesh`` with
-vertex normals (shaded smooth, no subdivision) and an ``st`` primvar (longitude → u, latitude → v, so
-maps show) arrives bound in Blender's default import.
+vertex normals (shaded smooth, no subdivision) and an ``st`` primvar (longitude → u,
+latitude → v, so maps show) arrives bound in Blender's default import.
 """
 
 from __future__ import annotations
