@@ -238,9 +238,10 @@ def render(bpy: Any, request: dict[str, Any]) -> dict[str, Any]:
 
 
 def _mitsuba_sphere_uv(obj: Any, frame: Any) -> None:
-    """UVs as Mitsuba's sphere has them: in the sphere's local frame (``frame`` takes
-    Blender's object coordinates there) u = atan2(y, x) / 2π, θ from +z; written as USD's
-    st (t = 1 − θ/π), so a map shows where the proof shows it."""
+    """UVs from the sphere's local frame (``frame`` takes Blender's object coordinates
+    there): u = atan2(y, x) / 2π, θ from +z, written as st (t = 1 − θ/π). Meant to be
+    Mitsuba's sphere parametrisation; the maps do not yet land where the proof shows
+    them (the bench's measurements page says so)."""
     mesh = obj.data
     layer = mesh.uv_layers["st"]
     for poly in mesh.polygons:

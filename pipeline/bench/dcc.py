@@ -10,7 +10,9 @@ IBL, seen by the proof's camera, no rig):
   from the exported file, in a scene :func:`blender_scene` builds from the same numbers:
   camera origin, target and horizontal field of view, the IBL's pixels resampled to
   Blender's lat-long convention (:func:`blender_environment`), the same cup mesh and
-  ground, Standard view, scene-linear EXR out.
+  ground, Standard view, scene-linear EXR out. A textured preset's maps are not yet
+  laid out on the ball as on Mitsuba's sphere, and the cup arrives from PLY without UVs:
+  only constant presets compare pixel for pixel.
 
 Compared on the ball (pixels whose camera ray meets it at under 70° from its normal,
 :func:`ball_mask`): the mean colour's luminance and the per-pixel relative RMS
