@@ -229,7 +229,12 @@ def _dcc_loss(layer, spec: MaterialSpec, path, types: dict[str, Any]) -> None:
     for net in spec.networks:
         if net.context == "universal":
             notes = "; ".join(n.custom["loss"] for n in net.nodes if n.custom.get("loss"))
-            attr = _attribute(layer, path.AppendProperty(DCC_LOSS), types["string"])
+            where = path.AppendProperty(DCC_LOSS)
+            # Custom (not a schema property): Blender imports only custom attributes.
+            Sdf.JustCreatePrimAttributeInLayer(
+                layer, where, types["string"], Sdf.VariabilityVarying, True
+            )
+            attr = layer.GetAttributeAtPath(where)
             attr.default = notes or "UsdPreviewSurface expresses this material fully"
 
 

@@ -98,3 +98,11 @@ def test_a_textured_asset_arrives_with_its_maps_and_colour_spaces(tmp_path):
         "ShaderNodeNormalMap",
         "ShaderNodeTexImage",
     ]
+
+
+def test_blender_shows_each_materials_universal_loss_as_a_custom_property(library_file):
+    _, answer = library_file
+    notes = {n: m["custom"].get("lookdev:loss", "") for n, m in answer["materials"].items()}
+    assert notes["gold"] == "UsdPreviewSurface expresses this material fully"
+    assert "sheen" in notes["velvet"] and "anisotropic" in notes["brushed_steel"]
+    assert all(notes[n] for n in Library(use_env=False).names())
