@@ -56,3 +56,21 @@ if [ ! -f "$docs_stamp" ] || [ pyproject.toml -nt "$docs_stamp" ]; then
   fi
   touch "$docs_stamp"
 fi
+
+# Blender as a test consumer (tests marked dcc): the bpy wheel pins its own Python
+# (3.11 for bpy 4.5), so it gets a venv of its own, .venv-blender. Set
+# LOOKDEV_BLENDER_PYTHON to use another interpreter that imports bpy.
+if [ -z "${LOOKDEV_BLENDER_PYTHON:-}" ] && [ ! -f .venv-blender/.lookdev-installed ]; then
+  BLENDER_PYTHON=${BLENDER_PYTHON:-python3.11}
+  if command -v "$BLENDER_PYTHON" >/dev/null 2>&1; then
+    echo "setup: installing Blender (bpy 4.5) into .venv-blender (log: .venv-blender/pip.log)"
+    "$BLENDER_PYTHON" -m venv .venv-blender
+    if .venv-blender/bin/python -m pip install -q 'bpy==4.5.*' >.venv-blender/pip.log 2>&1; then
+      touch .venv-blender/.lookdev-installed
+    else
+      echo "setup: warning: bpy did not install (see .venv-blender/pip.log); the dcc tests will be skipped" >&2
+    fi
+  else
+    echo "setup: warning: no $BLENDER_PYTHON for Blender's bpy; the dcc tests will be skipped" >&2
+  fi
+fi

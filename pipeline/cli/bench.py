@@ -23,6 +23,9 @@ COMMANDS = {
         ".bench_blend:blend_", "Blend 4 texture-masked Disney layers into all maps vs a numpy copy."
     ),
     "cli": Lazy(".bench_cli:cli_", "CPU time of the quick commands vs `import typer`."),
+    "dcc": Lazy(
+        ".bench_dcc:dcc_", "Blender Cycles renders of the exported USD beside lookdev's proofs."
+    ),
     "depth": Lazy(
         ".bench_depth:depth_", "The proof scene at each material's path depth vs a deep reference."
     ),

@@ -4,7 +4,9 @@ Maps are ``UsdUVTexture`` nodes reading ``st`` through one ``UsdPrimvarReader_fl
 affine conversions (the clearcoat scale, ``opacity = 1 - spec_trans`` when asked) ride on the
 texture's ``scale``/``bias`` so the baked image is shared with the other contexts.
 What the surface cannot express is named in the surface shader's ``customData``
-(``lookdev:loss``), and an importer reads only what is there.
+(``lookdev:loss``), and an importer reads only what is there. The surface's constants
+sit on its own inputs, not on connections to the Material's interface: Blender's
+importer (and others that rebuild the surface as their own shader) reads only those.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from .network import (
     Node,
     Source,
     loss_note,
+    plain_value,
     surface_inputs,
 )
 from .textures import (
@@ -93,6 +96,12 @@ def build(source: Source, preview_opacity: str = "keep") -> Network:
     nodes: list[Node] = []
     table = table_for("universal", source.model, preview_opacity)
     inputs = surface_inputs(source, table, preview_defaults(), nodes, _texture)
+    # The surface holds its constants itself, unconnected: DCC importers that build
+    # their own shader from a UsdPreviewSurface (Blender's among them) read an input's
+    # value only when it has no connection, and follow a connection only to a shader
+    # output, so an input connected to the Material's interface arrives as their
+    # default. The interface stays, read by the MaterialX and RenderMan networks.
+    inputs = {name: (kind, plain_value(value)) for name, (kind, value) in inputs.items()}
     if source.normal_map is not None:
         inputs["normal"] = _normal(nodes, source.normal_map)
     refit = _fractional_metal(source, inputs) if source.model == "disney" else ""

@@ -10,7 +10,7 @@
   (:func:`collect`); a package always collects.
 - The root prim carries ``kind = "component"`` and ``assetInfo``, the layer a ``doc``
   naming lookdev and its version (:func:`asset_metadata`), and ``--preview-geometry``
-  adds a sphere per material bound with ``MaterialBindingAPI``, in a grid, so a DCC's
+  adds a sphere mesh per material bound with ``MaterialBindingAPI``, in a grid, so a DCC's
   default import shows the library (:func:`add_preview_geometry`).
 """
 
@@ -308,24 +308,44 @@ def asset_metadata(layer, root: str, name: str, count: int) -> None:
 
 
 def add_preview_geometry(layer, root: str, material_paths: list[str]) -> None:
-    """A unit sphere per material under ``/ROOT/Geometry``, bound to it with
-    ``MaterialBindingAPI``, in a square grid (2.5 units apart, y up, on the ground)."""
-    from pxr import Sdf
+    """A unit sphere mesh per material under ``/ROOT/Geometry``, bound to it with
+    ``MaterialBindingAPI``, in a square grid (2.5 units apart, y up, on the ground).
 
+    Each sphere references one mesh (:func:`.geometry.uv_sphere`, a ``class`` prim
+    under ``Geometry``), so the file holds its arrays once."""
+    from pxr import Sdf, Vt
+
+    from .geometry import uv_sphere
+
+    types = Sdf.ValueTypeNames
     geometry = Sdf.CreatePrimInLayer(layer, f"/{root}/Geometry")
     geometry.specifier, geometry.typeName = Sdf.SpecifierDef, "Xform"
+    mesh = uv_sphere()
+    proto = Sdf.PrimSpec(geometry, "preview_sphere", Sdf.SpecifierClass, "Mesh")
+    for name, kind, value in (
+        ("points", types.Point3fArray, Vt.Vec3fArray.FromNumpy(mesh.points.astype(np.float32))),
+        ("normals", types.Normal3fArray, Vt.Vec3fArray.FromNumpy(mesh.normals.astype(np.float32))),
+        ("faceVertexCounts", types.IntArray, Vt.IntArray.FromNumpy(mesh.counts)),
+        ("faceVertexIndices", types.IntArray, Vt.IntArray.FromNumpy(mesh.indices)),
+        ("primvars:st", types.TexCoord2fArray, Vt.Vec2fArray.FromNumpy(mesh.st.astype(np.float32))),
+        ("extent", types.Float3Array, Vt.Vec3fArray([(-1.0, -1.0, -1.0), (1.0, 1.0, 1.0)])),
+    ):
+        Sdf.AttributeSpec(proto, name, kind).default = value
+    proto.attributes["normals"].SetInfo("interpolation", "vertex")
+    proto.attributes["primvars:st"].SetInfo("interpolation", "vertex")
+    # Vertex normals, not a subdivision surface: shaded smooth as the proof's sphere.
+    scheme = Sdf.AttributeSpec(proto, "subdivisionScheme", types.Token, Sdf.VariabilityUniform)
+    scheme.default = "none"
     columns = max(1, int(np.ceil(np.sqrt(len(material_paths)))))
     for i, material in enumerate(material_paths):
         name = Sdf.Path(material).name
-        sphere = Sdf.PrimSpec(geometry, f"{name}_sphere", Sdf.SpecifierDef, "Sphere")
+        sphere = Sdf.PrimSpec(geometry, f"{name}_sphere", Sdf.SpecifierDef, "Mesh")
+        sphere.referenceList.prependedItems = [Sdf.Reference(primPath=proto.path)]
         sphere.SetInfo("apiSchemas", Sdf.TokenListOp.Create(prependedItems=["MaterialBindingAPI"]))
-        translate = Sdf.AttributeSpec(sphere, "xformOp:translate", Sdf.ValueTypeNames.Double3)
+        translate = Sdf.AttributeSpec(sphere, "xformOp:translate", types.Double3)
         translate.default = (2.5 * (i % columns), 1.0, -2.5 * (i // columns))
         order = Sdf.AttributeSpec(
-            sphere,
-            "xformOpOrder",
-            Sdf.ValueTypeNames.TokenArray,
-            variability=Sdf.VariabilityUniform,
+            sphere, "xformOpOrder", types.TokenArray, variability=Sdf.VariabilityUniform
         )
         order.default = ["xformOp:translate"]
         binding = Sdf.RelationshipSpec(sphere, "material:binding", custom=False)

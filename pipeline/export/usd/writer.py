@@ -169,6 +169,7 @@ def _author_material(layer, scope, spec: MaterialSpec, base: Path, types: dict[s
     prim.customData = {"lookdev": dict(spec.custom)}
     prim.documentation = loss_doc(spec)
     path = prim.path
+    _dcc_loss(layer, spec, path, types)
     # Every colour value and map of the material is in the working space: UsdColorSpaceAPI
     # names it by USD's canonical name (lin_rec709_scene, lin_ap1_scene) for the material
     # and everything under it; textures that differ say so on their own inputs.
@@ -221,6 +222,25 @@ def _author_material(layer, scope, spec: MaterialSpec, base: Path, types: dict[s
             for name, kind in node.outputs.items():
                 Sdf.JustCreatePrimAttributeInLayer(layer, at(f"outputs:{name}"), types[kind])
     return path
+
+
+DCC_LOSS = "userProperties:lookdev:loss"
+"""The universal network's loss note, where Blender shows it: its USD importer makes every
+``userProperties:`` attribute of a Material a custom property of the material (Blender
+4.5 and 5.3, observed); it shows neither ``doc`` nor ``displayName``."""
+
+
+def _dcc_loss(layer, spec: MaterialSpec, path, types: dict[str, Any]) -> None:
+    for net in spec.networks:
+        if net.context == "universal":
+            notes = "; ".join(n.custom["loss"] for n in net.nodes if n.custom.get("loss"))
+            where = path.AppendProperty(DCC_LOSS)
+            # Custom (not a schema property): Blender imports only custom attributes.
+            Sdf.JustCreatePrimAttributeInLayer(
+                layer, where, types["string"], Sdf.VariabilityVarying, True
+            )
+            attr = layer.GetAttributeAtPath(where)
+            attr.default = notes or "UsdPreviewSurface expresses this material fully"
 
 
 def _attribute(layer, path, type_name, variability=Sdf.VariabilityVarying):

@@ -129,8 +129,9 @@ def test_plain_diffuse_has_no_clearcoat_sheen_or_transmission(tmp_path):
         "outputs:mtlx:surface",
         "outputs:ri:surface",
         "outputs:surface",
+        "userProperties:lookdev:loss",
     ]
-    assert sum(len(v) for v in attrs.values()) == 4 + 4 + 5 + 8
+    assert sum(len(v) for v in attrs.values()) == 4 + 4 + 5 + 9
 
 
 @pytest.mark.parametrize("specular", [0.0, 0.3, 0.5, 2.0])

@@ -283,16 +283,26 @@ def test_name_clashes_are_refused_unless_renamed(cli, tmp_path, monkeypatch):
     assert import_names([found, found], rename=True) == ["gold", "gold_imported"]
 
 
-def test_a_file_edited_after_export_is_read_from_its_networks(tmp_path):
+@pytest.mark.parametrize(
+    ("contexts", "edited"),
+    [
+        # Only a UsdPreviewSurface: the user edits the surface's own input (it holds
+        # its constants, so that Blender reads them; there is no interface to edit).
+        (("universal",), "/Materials/gold/preview_surface.inputs:roughness"),
+        # All contexts: the Material's interface input, which MaterialX and RenderMan
+        # read (the override a Houdini or Katana user makes).
+        (("universal", "mtlx", "ri"), "/Materials/gold.inputs:roughness"),
+    ],
+)
+def test_a_file_edited_after_export_is_read_from_its_networks(tmp_path, contexts, edited):
     out = tmp_path / "g.usda"
-    api.export_usd(["gold"], out, ("universal",))
+    api.export_usd(["gold"], out, contexts)
     (found,) = import_usd(out)
     assert found.contexts == ["record"] and found.params["roughness"] == 0.2
     layer = Sdf.Layer.FindOrOpen(str(out))
-    # The override a DCC user makes: the Material's interface input every context reads.
-    layer.GetAttributeAtPath("/Materials/gold.inputs:roughness").default = 0.35
+    layer.GetAttributeAtPath(edited).default = 0.35
     layer.Save()
     (found,) = import_usd(out)
-    assert found.contexts == ["universal"]
+    assert "record" not in found.contexts and "universal" in found.contexts
     assert found.params["roughness"] == pytest.approx(0.35)  # the edit, not the stale record
     assert any("edited after lookdev exported" in line for line in found.loss)

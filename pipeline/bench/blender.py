@@ -1,0 +1,70 @@
+"""Blender as a consumer: its ``bpy`` wheel, run in its own interpreter.
+
+Blender's Python module (PyPI ``bpy``) pins its own Python and numpy, so it lives in a
+virtual environment of its own (``scripts/setup.sh`` makes ``.venv-blender``) and lookdev
+talks to it through a subprocess: :func:`run` starts :mod:`.blender_side` there with a
+JSON request and reads a JSON answer. Nothing of lookdev is imported on Blender's side.
+
+The interpreter is ``$LOOKDEV_BLENDER_PYTHON`` if set, else ``.venv-blender/bin/python``
+beside the checkout (:func:`interpreter`).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import tempfile
+from pathlib import Path
+from typing import Any
+
+from lookdev.materials.errors import LookdevError
+
+__all__ = ["BlenderError", "interpreter", "run", "version"]
+
+ENV = "LOOKDEV_BLENDER_PYTHON"
+SIDE = Path(__file__).with_name("blender_side.py")
+
+
+class BlenderError(LookdevError):
+    """Blender is not installed, or a Blender run failed."""
+
+
+def interpreter() -> Path | None:
+    """The Python that imports ``bpy``, or None when none is installed."""
+    given = os.environ.get(ENV)
+    if given:
+        return Path(given)
+    here = Path(__file__).resolve().parents[2] / ".venv-blender" / "bin" / "python"
+    return here if here.exists() else None
+
+
+def run(request: dict[str, Any], timeout: float = 1800.0) -> dict[str, Any]:
+    """Run one request (``{"op": …}``, see :mod:`.blender_side`) in Blender; its answer."""
+    python = interpreter()
+    if python is None:
+        raise BlenderError(
+            f"no Blender Python: run scripts/setup.sh (it makes .venv-blender) or set {ENV}"
+        )
+    with tempfile.TemporaryDirectory(prefix="lookdev-blender-") as tmp:
+        ask, answer = Path(tmp) / "request.json", Path(tmp) / "answer.json"
+        ask.write_text(json.dumps(request))
+        try:
+            done = subprocess.run(
+                [str(python), str(SIDE), str(ask), str(answer)],
+                capture_output=True,
+                text=True,
+                timeout=timeout,
+                check=False,
+            )
+        except (OSError, subprocess.TimeoutExpired) as exc:
+            raise BlenderError(f"Blender did not run ({exc})") from None
+        if done.returncode != 0 or not answer.exists():
+            tail = (done.stderr or done.stdout).strip().splitlines()[-1:] or ["no output"]
+            raise BlenderError(f"Blender failed (exit {done.returncode}): {tail[0]}")
+        return json.loads(answer.read_text())
+
+
+def version() -> str:
+    """The Blender version the interpreter's ``bpy`` is, e.g. ``"4.5.15"``."""
+    return str(run({"op": "version"})["version"])
