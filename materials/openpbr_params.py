@@ -65,42 +65,56 @@ class OpenPBRParams(Params):
     """OpenPBR Surface v1.1 inputs (the specification's names, defaults and ranges)."""
 
     base_weight: float = _u(1.0, "multiplier of the base albedo")
-    base_color: Color = Field((0.8, 0.8, 0.8))
+    base_color: Color = Field((0.8, 0.8, 0.8), description="albedo of the base (diffuse and metal)")
     base_metalness: float = _u(0.0, "mix towards the F82-tint conductor")
     base_diffuse_roughness: float = _u(0.0, "Oren–Nayar σ of the diffuse")
     specular_weight: float = _u(1.0, "dielectric F0 multiplier (via the IOR); metal scale", 1e3)
-    specular_color: Color = Field((1.0, 1.0, 1.0))
+    specular_color: Color = Field(
+        (1.0, 1.0, 1.0), description="tint of the specular (metal: F82 edge tint)"
+    )
     specular_roughness: float = _u(0.3, "GGX roughness r, α = r²")
     specular_roughness_anisotropy: float = _u(0.0, "anisotropy of the specular lobe")
-    specular_ior: float = Field(1.5, gt=0.0, le=1e3)
+    specular_ior: float = Field(1.5, gt=0.0, le=1e3, description="IOR of the dielectric base")
     transmission_weight: float = _u(0.0, "mix towards the translucent base")
-    transmission_color: Color = Field((1.0, 1.0, 1.0))
+    transmission_color: Color = Field(
+        (1.0, 1.0, 1.0), description="colour of the glass, reached at transmission_depth"
+    )
     transmission_depth: float = _u(0.0, "distance at which transmission_color is reached", 1e9)
-    transmission_scatter: Color = Field((0.0, 0.0, 0.0))
-    transmission_scatter_anisotropy: float = Field(0.0, ge=-1.0, le=1.0)
+    transmission_scatter: Color = Field(
+        (0.0, 0.0, 0.0), description="scattering coefficient of the interior"
+    )
+    transmission_scatter_anisotropy: float = Field(
+        0.0, ge=-1.0, le=1.0, description="phase function g of the interior"
+    )
     transmission_dispersion_scale: float = _u(0.0, "dispersion amount")
-    transmission_dispersion_abbe_number: float = Field(20.0, gt=0.0, le=1e6)
+    transmission_dispersion_abbe_number: float = Field(
+        20.0, gt=0.0, le=1e6, description="Abbe number of the dispersion"
+    )
     subsurface_weight: float = _u(0.0, "mix towards the subsurface slab")
-    subsurface_color: Color = Field((0.8, 0.8, 0.8))
+    subsurface_color: Color = Field((0.8, 0.8, 0.8), description="albedo of the subsurface")
     subsurface_radius: float = _u(1.0, "mean free path scale", 1e9)
-    subsurface_radius_scale: Color = Field((1.0, 0.5, 0.25))
-    subsurface_scatter_anisotropy: float = Field(0.0, ge=-1.0, le=1.0)
+    subsurface_radius_scale: Color = Field(
+        (1.0, 0.5, 0.25), description="per-channel scale of the mean free path"
+    )
+    subsurface_scatter_anisotropy: float = Field(
+        0.0, ge=-1.0, le=1.0, description="phase function g of the subsurface"
+    )
     coat_weight: float = _u(0.0, "coverage of the coat")
-    coat_color: Color = Field((1.0, 1.0, 1.0))
+    coat_color: Color = Field((1.0, 1.0, 1.0), description="absorption tint of the coat")
     coat_roughness: float = _u(0.0, "GGX roughness of the coat")
     coat_roughness_anisotropy: float = _u(0.0, "anisotropy of the coat")
-    coat_ior: float = Field(1.6, gt=0.0, le=1e3)
+    coat_ior: float = Field(1.6, gt=0.0, le=1e3, description="IOR of the coat")
     coat_darkening: float = _u(1.0, "1: the physical darkening under the coat; 0: none")
     fuzz_weight: float = _u(0.0, "coverage of the fuzz")
-    fuzz_color: Color = Field((1.0, 1.0, 1.0))
+    fuzz_color: Color = Field((1.0, 1.0, 1.0), description="colour of the fuzz")
     fuzz_roughness: float = _u(0.5, "fibre-likeness of the fuzz")
     thin_film_weight: float = _u(0.0, "coverage of the thin film")
     thin_film_thickness: float = _u(0.5, "thickness in µm", 1e3)
-    thin_film_ior: float = Field(1.4, gt=0.0, le=1e3)
+    thin_film_ior: float = Field(1.4, gt=0.0, le=1e3, description="IOR of the thin film")
     emission_luminance: float = _u(0.0, "emitted luminance in nits", 1e12)
-    emission_color: Color = Field((1.0, 1.0, 1.0))
+    emission_color: Color = Field((1.0, 1.0, 1.0), description="colour of the emission")
     geometry_opacity: float = _u(1.0, "coverage of the surface")
-    geometry_thin_walled: bool = False
+    geometry_thin_walled: bool = Field(False, description="a thin shell, not a solid")
 
 
 NOT_MODELLED: dict[str, str] = {

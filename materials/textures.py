@@ -24,7 +24,7 @@ import typing
 from typing import Annotated, Any
 
 import numpy as np
-from annotated_types import Ge, Le
+from annotated_types import Ge, Gt, Le
 from pydantic import Field, model_validator
 
 from . import colour
@@ -135,7 +135,10 @@ def apply_rule(
 
 
 def _float_bounds(metadata: list[Any]) -> tuple[float, float]:
-    lo = next((m.ge for m in metadata if isinstance(m, Ge)), -math.inf)
+    # an exclusive floor (gt) bounds the range as well: the schema refuses the value itself
+    lo = next(
+        (m.ge if isinstance(m, Ge) else m.gt for m in metadata if isinstance(m, Ge | Gt)), -math.inf
+    )
     hi = next((m.le for m in metadata if isinstance(m, Le)), math.inf)
     return float(lo), float(hi)
 
