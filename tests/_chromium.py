@@ -171,8 +171,20 @@ class Page:
             raise AssertionError(f"{expression}: {reply['exceptionDetails']}")
         return reply["result"].get("value")
 
+    def scroll_through(self) -> None:
+        """Scroll the page top to bottom a view at a time, so that what loads when scrolled
+        to (the review page's players) has loaded, then back to the top."""
+        height = self.js("document.documentElement.scrollHeight") or 0
+        step = max(self.js("window.innerHeight") or 600, 100)
+        for y in range(0, int(height) + int(step), int(step)):
+            self.js(f"window.scrollTo(0, {y})")
+            time.sleep(0.05)
+        self.js("window.scrollTo(0, 0)")
+
     def images_loaded(self, timeout: float = 10.0) -> list:
-        """``[src, complete, naturalWidth]`` of every image, once all have settled."""
+        """``[src, complete, naturalWidth]`` of every image, once all have settled (after
+        scrolling through the page: an image not yet scrolled to has nothing to load)."""
+        self.scroll_through()
         deadline = time.monotonic() + timeout
         while True:
             images = self.js(

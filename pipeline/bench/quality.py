@@ -215,7 +215,7 @@ def error_case(
     from lookdev.pipeline.variant import use_mitsuba
 
     use_mitsuba()
-    # whole-frame passes (issue 16's "new" default); per pixel: .adaptive
+    # whole-frame passes (the 480×240, 4-spp-cap default); per pixel: .adaptive
     new = settings.Settings(**({"adaptive": False} | (s.new or {})))
     pose = Frame(0, "element", 0.0)
     hub, env = blended(preset), ibl.load(ibl_name, s.ibl_width).pixels

@@ -55,8 +55,10 @@ from lookdev.pipeline.export.usd.network import (
 from lookdev.pipeline.export.usd.writer import (
     COLOUR_SPACE_API,
     COLOUR_SPACE_ATTR,
+    DCC_LOSS,
     MTLX_CONFIG_API,
     author,
+    dcc_loss_note,
     export_usd,
     loss_doc,
     material_spec,
@@ -190,6 +192,10 @@ def spec_paths(specs: list[MaterialSpec]) -> tuple[list[Any], list[tuple[Any, An
         if any(net.context == "mtlx" for net in spec.networks):
             version = path.AppendProperty("config:mtlx:version")
             attributes.append((version, types["string"], Sdf.VariabilityUniform))
+        if dcc_loss_note(spec) is not None:
+            attributes.append(
+                (path.AppendProperty(DCC_LOSS), types["string"], Sdf.VariabilityVarying)
+            )
         for name, (kind, _) in spec.interface().items():
             attr = path.AppendProperty(f"inputs:{name}")
             attributes.append((attr, types[kind], Sdf.VariabilityVarying))
@@ -254,6 +260,9 @@ def author_naive(specs: list[MaterialSpec], base: Path):
             material.GetPrim().CreateAttribute(
                 "config:mtlx:version", types["string"], True, Sdf.VariabilityUniform
             ).Set(mtlx_version())
+        note = dcc_loss_note(spec)
+        if note is not None:
+            material.GetPrim().CreateAttribute(DCC_LOSS, types["string"], True).Set(note)
         interface = {
             name: material.CreateInput(name, types[kind])
             for name, (kind, _) in spec.interface().items()

@@ -48,6 +48,7 @@ from lookdev.materials import colour
 from lookdev.materials.errors import LookdevError
 
 from . import contact, denoise, ibl, rig, tonemap
+from .contact import file_entry
 from .settings import MAX_SAMPLES, MAX_SIDE, MIN_SIDE, ProofError, Settings
 from .turntable import Frame
 
@@ -101,12 +102,6 @@ class Job:
 
 
 # -- manifests -----------------------------------------------------------------------------
-def file_entry(path: Path) -> dict[str, Any]:
-    """``{"file", "size", "sha256"}`` of a written file."""
-    data = path.read_bytes()
-    return {"file": path.name, "size": len(data), "sha256": hashlib.sha256(data).hexdigest()}
-
-
 def _still_valid(folder: Path, entry: dict[str, Any]) -> bool:
     path = folder / entry["file"]
     try:

@@ -8,7 +8,9 @@ still labels every frame, so a sheet is never unlabelled.
 
 from __future__ import annotations
 
+import hashlib
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -194,3 +196,9 @@ def read_rgb(path: Path) -> np.ndarray:
         raise ProofImageError(f"cannot decode the image ({first})", where=str(path))
     pixels = np.asarray(pixels, dtype=np.float32)
     return pixels[..., :3] if pixels.shape[-1] >= 3 else np.repeat(pixels[..., :1], 3, -1)
+
+
+def file_entry(path: Path) -> dict[str, Any]:
+    """``{"file", "size", "sha256"}`` of a written file: how a manifest records it."""
+    data = path.read_bytes()
+    return {"file": path.name, "size": len(data), "sha256": hashlib.sha256(data).hexdigest()}

@@ -90,8 +90,6 @@ def _write(
     wall: float,
     cpu: float,
 ) -> dict[str, Any]:
-    from .batch import file_entry
-
     w0 = time.perf_counter()
     stem = folder / f"frame_{frame.index:03d}"
     images = {
@@ -115,7 +113,7 @@ def _write(
         "kind": frame.kind,
         "angle": frame.angle,
         "images": {role: path.name for role, path in images.items()},
-        "files": {role: file_entry(path) for role, path in images.items()},
+        "files": {role: contact.file_entry(path) for role, path in images.items()},
         "sampling": "per_pixel",
         "spp": int(round(f.mean_spp)),
         "spp_mean": round(f.mean_spp, 2),

@@ -307,9 +307,11 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
     for context in READABLE[model]:
         net = by_context.get(context)
         foreign = _foreign(net) if model == "disney" else None
-        if foreign is not None and mapped_from_disney(foreign) and result.contexts:
-            # lookdev's own Disney → OpenPBR mapping: the contexts already read hold
-            # Burley's parameters as they are; the mapping's inverse would lose some
+        exact = mapped_from_disney(foreign) if foreign is not None else False
+        if foreign is not None and result.contexts and (exact or "ri" in result.contexts):
+            # lookdev's own Disney → OpenPBR mapping, or any OpenPBR beside a PxrDisneyBsdf
+            # already read (its record stripped, a file is known by that): the contexts
+            # read hold Burley's parameters as they are; the mapping's inverse loses some
             if foreign.custom.get("loss"):
                 result.loss.append(f"{context}: {foreign.custom['loss']}")
             result.contexts.append(context)

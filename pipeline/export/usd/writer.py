@@ -230,17 +230,23 @@ DCC_LOSS = "userProperties:lookdev:loss"
 4.5 and 5.3, observed); it shows neither ``doc`` nor ``displayName``."""
 
 
-def _dcc_loss(layer, spec: MaterialSpec, path, types: dict[str, Any]) -> None:
+def dcc_loss_note(spec: MaterialSpec) -> str | None:
+    """The universal network's loss note as :data:`DCC_LOSS` holds it; None without one."""
     for net in spec.networks:
         if net.context == "universal":
             notes = "; ".join(n.custom["loss"] for n in net.nodes if n.custom.get("loss"))
-            where = path.AppendProperty(DCC_LOSS)
-            # Custom (not a schema property): Blender imports only custom attributes.
-            Sdf.JustCreatePrimAttributeInLayer(
-                layer, where, types["string"], Sdf.VariabilityVarying, True
-            )
-            attr = layer.GetAttributeAtPath(where)
-            attr.default = notes or "UsdPreviewSurface expresses this material fully"
+            return notes or "UsdPreviewSurface expresses this material fully"
+    return None
+
+
+def _dcc_loss(layer, spec: MaterialSpec, path, types: dict[str, Any]) -> None:
+    note = dcc_loss_note(spec)
+    if note is None:
+        return
+    where = path.AppendProperty(DCC_LOSS)
+    # Custom (not a schema property): Blender imports only custom attributes.
+    Sdf.JustCreatePrimAttributeInLayer(layer, where, types["string"], Sdf.VariabilityVarying, True)
+    layer.GetAttributeAtPath(where).default = note
 
 
 def _attribute(layer, path, type_name, variability=Sdf.VariabilityVarying):

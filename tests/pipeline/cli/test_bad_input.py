@@ -536,6 +536,7 @@ def stubbed(monkeypatch, tmp_path):
     class Exported:
         output, materials, contexts, textures, files = Path("x.usda"), [], ["universal"], [], []
         fidelity: dict = {}
+        contexts_fidelity: dict = {}
 
         def to_json(self):
             return {}

@@ -167,13 +167,13 @@ def _with(text: str, old: str, new: str) -> str:
             "color3f inputs:base_color = (1, 0.782, 0.344)",
             "color3f inputs:base_color = (1, inf, 0.344)",
             "NonFiniteShaderInput",
-            "input 'diffuseColor'",
+            "input 'baseColor'",  # the interface drives RenderMan's (and MaterialX's) surface
         ),
         (
             "float inputs:metallic = 1\n",
             "float inputs:metallic = -0.5\n",
             "ShaderInputOutOfRange",
-            "input 'metallic'",
+            "input 'base_metalness'",  # OpenPBR's, which the interface's metallic drives
         ),
     ],
 )
@@ -189,12 +189,19 @@ def test_validate_usd_names_prim_and_input_of_a_bad_value(
     assert hits and all(e.split(": ")[1].startswith("/Materials/") for e in hits), errors
 
 
-def test_validate_usd_passes_our_own_exports_and_only_warns_above_a_ui_maximum(cli, exported):
+def test_validate_usd_passes_our_own_exports_and_only_warns_above_a_ui_maximum(
+    cli, exported, tmp_path
+):
     r = cli("validate", "usd", str(exported), "--json")
     assert r.code == 0, r.out
+    assert json.loads(r.out)["errors"] == []
+    # the diamond's specular > 1 (Burley allows it) is beyond ND_disney_principled's
+    # slider: a warning (OpenPBR, the default mtlx surface, takes it as an IOR in range)
+    disney = tmp_path / "diamond.usda"
+    lookdev.export_usd(["diamond"], disney, mtlx_surface="disney")
+    r = cli("validate", "usd", str(disney), "--json")
     doc = json.loads(r.out)
-    assert doc["errors"] == []
-    # the diamond's specular > 1 (Burley allows it) is beyond MaterialX's slider: a warning
+    assert r.code == 0 and doc["errors"] == [], r.out
     assert any(w.startswith("ShaderInputAboveUiMax") and "diamond" in w for w in doc["warnings"])
 
 

@@ -33,8 +33,12 @@ def test_surface_constants_are_unconnected_and_the_interface_drives_the_others(t
     )
     # A DCC's override of the interface reaches MaterialX and RenderMan.
     UsdShade.Material(stage.GetPrimAtPath("/Materials/gold")).GetInput("roughness").Set(0.35)
-    for shader in ("/Materials/gold/mtlx_surface", "/Materials/gold/ri_surface"):
-        attr = _producer(stage, shader, "roughness")
+    # (OpenPBR, the default mtlx surface, names it specular_roughness)
+    for shader, name in (
+        ("/Materials/gold/mtlx_surface", "specular_roughness"),
+        ("/Materials/gold/ri_surface", "roughness"),
+    ):
+        attr = _producer(stage, shader, name)
         assert attr.GetPath() == Sdf.Path("/Materials/gold.inputs:roughness")
         assert attr.Get() == pytest.approx(0.35)
 

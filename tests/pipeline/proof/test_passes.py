@@ -154,8 +154,8 @@ def test_settings_default_to_a_noise_target_with_a_cap_and_spp_to_a_fixed_count(
     s = settings.Settings()
     assert (s.spp, s.noise, s.max_spp) == (
         None,
-        settings.DEFAULT_NOISE,
-        settings.DEFAULT_PIXEL_MAX_SPP,
+        settings.UNIFORM_NOISE,
+        settings.DEFAULT_MAX_SPP,
     )
     assert s.sampling() == {"noise": s.noise, "max_spp": s.max_spp, "time_budget": None}
     assert s.resolution == settings.DEFAULT_RESOLUTION and s.pixel_filter == "box"

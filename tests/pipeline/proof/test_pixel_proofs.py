@@ -26,18 +26,25 @@ def plastic():
     return blend(load_material("plastic_glossy"), 16)
 
 
-def test_the_defaults_sample_per_pixel_to_a_display_target():
-    s = settings.Settings()
+def test_per_pixel_sampling_to_a_display_target_is_opt_in():
+    s = settings.Settings(adaptive=True)
     assert s.per_pixel() and s.noise == settings.DEFAULT_NOISE
     assert s.max_spp == settings.DEFAULT_PIXEL_MAX_SPP
-    old = settings.Settings(adaptive=False)
-    assert not old.per_pixel() and (old.noise, old.max_spp) == (0.05, settings.DEFAULT_MAX_SPP)
-    assert not settings.Settings(pixel_filter="gaussian").per_pixel()
+    default = settings.Settings()
+    assert not default.per_pixel()
+    assert (default.noise, default.max_spp) == (settings.UNIFORM_NOISE, settings.DEFAULT_MAX_SPP)
+    assert not settings.Settings(adaptive=True, pixel_filter="gaussian").per_pixel()
 
 
 def test_a_per_pixel_proof_records_its_estimates_and_resumes(plastic, tmp_path):
     s = batch.Settings(
-        element_frames=1, light_frames=1, resolution=(24, 12), noise=0.03, max_spp=64, rig="none"
+        element_frames=1,
+        light_frames=1,
+        resolution=(24, 12),
+        noise=0.03,
+        max_spp=64,
+        rig="none",
+        adaptive=True,
     )
     job = batch.make_jobs([plastic], [ibl.load(ibl.REAL_HDR, 64)], tmp_path, s)[0]
     doc = batch.run_job(job)
