@@ -47,7 +47,9 @@ def test_list_filters_by_tag_and_model(cli):
     assert {e["name"] for e in both} == {"brushed_aluminium", "brushed_steel"}
     layered = json.loads(cli("presets", "list", "--model", "layered", "--json").out)
     assert layered and all(e["model"] == "layered" for e in layered)
-    one_line_error(cli("presets", "list", "--model", "phong"), "--model", "disney, pixar, openpbr, layered")
+    one_line_error(
+        cli("presets", "list", "--model", "phong"), "--model", "disney, pixar, openpbr, layered"
+    )
 
 
 def test_list_warns_about_broken_files_and_lists_the_rest(cli, tmp_path):
