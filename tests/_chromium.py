@@ -175,10 +175,17 @@ class Page:
         """Scroll the page top to bottom a view at a time, so that what loads when scrolled
         to (the review page's players) has loaded, then back to the top."""
         height = self.js("document.documentElement.scrollHeight") or 0
-        step = max(self.js("window.innerHeight") or 600, 100)
+        step = max(self.js("window.innerHeight") or 600, 100) // 2
         for y in range(0, int(height) + int(step), int(step)):
             self.js(f"window.scrollTo(0, {y})")
             time.sleep(0.05)
+        # the observer reports on a later frame: bring each image still waiting into view
+        # until none is (or a few seconds pass, and the check then sees it)
+        waiting = "document.querySelectorAll('img[data-lazy=\"wait\"]')"
+        deadline = time.monotonic() + 5.0
+        while self.js(f"{waiting}.length") and time.monotonic() < deadline:
+            self.js(f"{waiting}[0].scrollIntoView()")
+            time.sleep(0.1)
         self.js("window.scrollTo(0, 0)")
 
     def images_loaded(self, timeout: float = 10.0) -> list:
