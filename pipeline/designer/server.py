@@ -36,6 +36,9 @@ __all__ = ["DEFAULT_SIZE", "Designer", "GuardMiddleware", "free_port"]
 HOST = "127.0.0.1"
 DEFAULT_SIZE = (480, 270)
 CLIENT_QUEUE = 2
+"""Frames a page may have waiting; past that a new frame is dropped (the one after it is
+newer still). News (a state version, a task) is never dropped: a tab that missed a state
+message would wait for it forever once the frames stop."""
 
 
 def free_port() -> int:
@@ -192,15 +195,15 @@ class Designer:
             self.loop.call_soon_threadsafe(self._fan_out, message, b"")
 
     def _fan_out(self, message: dict[str, Any], data: bytes) -> None:
+        frame = message["type"] == "frame"
         for queue in list(self.clients):
-            if queue.full():  # a slow page gets the newest frame, not a backlog
-                with contextlib.suppress(asyncio.QueueEmpty):
-                    queue.get_nowait()
+            if frame and queue.qsize() >= CLIENT_QUEUE:
+                continue  # a slow page: no backlog of frames (see CLIENT_QUEUE)
             queue.put_nowait((message, data))
 
     async def _websocket(self, ws: WebSocket) -> None:
         await ws.accept()
-        queue: asyncio.Queue = asyncio.Queue(CLIENT_QUEUE * 2)
+        queue: asyncio.Queue = asyncio.Queue()  # bounded for frames only (_fan_out)
         self.clients.add(queue)
         await asyncio.to_thread(self.ensure_renderer)
         self.renderer.post(rotate_ibl=self.renderer.view.get("rotate_ibl", 0.0))
