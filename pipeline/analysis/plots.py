@@ -217,6 +217,20 @@ def polar_curves(
 POLAR_DECADES = 4
 
 
+def _log_polar_axes(ax: Any, floor: float, *, label_every: int) -> None:
+    """The upper half-plane of a polar view, its radius :data:`POLAR_DECADES` decades of f
+    above 10^``floor``, every ``label_every``-th decade labelled."""
+    ax.set_theta_zero_location("N")
+    ax.set_theta_direction(-1)
+    ax.set_thetamin(-90)
+    ax.set_thetamax(90)
+    ax.set_rmax(POLAR_DECADES * 1.02)
+    ticks = np.arange(1, POLAR_DECADES + 1)
+    ax.set_rticks(ticks)
+    labels = [f"{10.0 ** (floor + t):.1g}" if t % label_every == 0 else "" for t in ticks]
+    ax.set_yticklabels(labels, fontsize="x-small")
+
+
 def draw_polar(
     ax: Any, hub: BlendedMaterial, incidence_deg: Sequence[float] = (0, 30, 60, 80)
 ) -> None:
@@ -231,15 +245,7 @@ def draw_polar(
     for ti, row in zip(incidence_deg, lum, strict=True):
         r = np.log10(np.maximum(row, 10.0**floor)) - floor
         ax.plot(theta_o, r, lw=1.4, label=f"θi = {ti:g}°")
-    ax.set_theta_zero_location("N")
-    ax.set_theta_direction(-1)
-    ax.set_thetamin(-90)
-    ax.set_thetamax(90)
-    ax.set_rmax(POLAR_DECADES * 1.02)
-    ticks = np.arange(1, POLAR_DECADES + 1)
-    ax.set_rticks(ticks)
-    labels = [f"{10.0 ** (floor + t):.1g}" if t % 2 == 0 else "" for t in ticks]
-    ax.set_yticklabels(labels, fontsize="x-small")
+    _log_polar_axes(ax, floor, label_every=2)
     ax.text(
         0.5,
         -0.02,
@@ -287,14 +293,7 @@ def draw_polar_overlay(
         for k, (ti, row) in enumerate(zip(incidence_deg, lum, strict=True)):
             r = np.log10(np.maximum(row, 10.0**floor)) - floor
             ax.plot(theta_o, r, style, color=colours[k], lw=1.3, label=f"{hub.name}, θi = {ti:g}°")
-    ax.set_theta_zero_location("N")
-    ax.set_theta_direction(-1)
-    ax.set_thetamin(-90)
-    ax.set_thetamax(90)
-    ax.set_rmax(POLAR_DECADES * 1.02)
-    ticks = np.arange(1, POLAR_DECADES + 1)
-    ax.set_rticks(ticks)
-    ax.set_yticklabels([f"{10.0 ** (floor + t):.1g}" for t in ticks], fontsize="x-small")
+    _log_polar_axes(ax, floor, label_every=1)
     ax.legend(fontsize="xx-small", loc="upper left", bbox_to_anchor=(-0.25, 1.15))
 
 
