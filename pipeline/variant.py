@@ -12,6 +12,7 @@ import functools
 import os
 import re
 import subprocess
+import threading
 import warnings
 from pathlib import Path
 
@@ -41,9 +42,19 @@ def _has_cuda() -> bool:
     return any(Path(p).exists() for p in ("/dev/nvidia0", "/dev/nvidiactl"))
 
 
-@functools.cache
 def use_mitsuba(preferred: str | None = None) -> str:
     """Set and return the Mitsuba variant: ``preferred`` or the fastest that works here."""
+    # Threads asking at once (the designer's workers) must not race ``mi.set_variant``:
+    # a variant that loses the race looks broken and the slow fallback wins.
+    with _VARIANT_LOCK:
+        return _choose_variant(preferred)
+
+
+_VARIANT_LOCK = threading.Lock()
+
+
+@functools.cache
+def _choose_variant(preferred: str | None) -> str:
     libllvm = find_libllvm()
     if libllvm:
         os.environ.setdefault("DRJIT_LIBLLVM_PATH", libllvm)

@@ -24,6 +24,9 @@ __all__ = ["JPEG_QUALITY", "Renderer", "encode"]
 JPEG_QUALITY = 90
 IDLE_WAIT_S = 0.25
 VIEW_KEYS = ("mode", "ibl", "rotate_ibl", "rotate_element", "exposure", "size")
+# Dr.Jit's recording and replay of frozen passes (dr.freeze) is process state, not a
+# thread's: two designers in one process (two notebook cells) render one pass at a time.
+_PASS_LOCK = threading.Lock()
 
 
 def encode(display: Any, fmt: str = "JPEG") -> bytes:
@@ -138,7 +141,8 @@ class Renderer:
 
     def _step(self, key: str, vp: Any, s: dict[str, Any]) -> None:
         start = time.perf_counter()
-        frame = vp.step()
+        with _PASS_LOCK:
+            frame = vp.step()
         shown = vp.raw() if self.view["raw"] and frame.denoised else frame
         s.update(converged=bool(frame.converged), fresh=False)
         meta = {

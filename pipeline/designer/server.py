@@ -16,6 +16,7 @@ import contextlib
 import json
 import socket
 import tempfile
+import threading
 from pathlib import Path
 from typing import Any
 
@@ -112,6 +113,10 @@ class Designer:
         self.clients: set[asyncio.Queue] = set()
         self.loop: asyncio.AbstractEventLoop | None = None
         self.renderer = None
+        # Two tabs connecting at once both ask for the renderer from worker threads; one
+        # must be made, not two (two render threads replaying Dr.Jit recordings at once
+        # deadlocked: one held the GIL waiting on Dr.Jit, the other the reverse).
+        self._renderer_lock = threading.Lock()
         self.tasks: dict[str, dict[str, Any]] = {}
         self.ab_against = "opened"
         self.proof_settings: dict[str, Any] = {}
@@ -164,13 +169,14 @@ class Designer:
         return factory(material, geometry=self.geometry, **kw)
 
     def ensure_renderer(self) -> None:
-        if self.renderer is None:
-            from .render import Renderer
+        with self._renderer_lock:
+            if self.renderer is None:
+                from .render import Renderer
 
-            self.renderer = Renderer(
-                self._viewport, self._publish, watching=lambda: bool(self.clients)
-            )
-            self.renderer.post(material=self.session.hub(), ibl=self.ibl)
+                self.renderer = Renderer(
+                    self._viewport, self._publish, watching=lambda: bool(self.clients)
+                )
+                self.renderer.post(material=self.session.hub(), ibl=self.ibl)
 
     def material_changed(self) -> None:
         """After an edit: the new blend to the viewport, the news to every tab."""

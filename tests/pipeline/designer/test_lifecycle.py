@@ -131,3 +131,22 @@ def test_the_mode_switch_and_the_raw_toggle(client, designer):
             pass
         assert not m["denoised"]  # raw: the frame before denoising, whatever the engine did
     assert designer.renderer.view["mode"] == "truth" and designer.renderer.view["raw"]
+
+
+def test_two_tabs_connecting_at_once_start_one_renderer(designer):
+    import threading
+
+    before = {t for t in threading.enumerate() if t.name == "designer-render"}
+    start = threading.Barrier(4)
+
+    def connect() -> None:
+        start.wait()
+        designer.ensure_renderer()
+
+    tabs = [threading.Thread(target=connect) for _ in range(4)]
+    for t in tabs:
+        t.start()
+    for t in tabs:
+        t.join()
+    started = {t for t in threading.enumerate() if t.name == "designer-render"} - before
+    assert len(started) == 1
