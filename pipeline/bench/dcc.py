@@ -18,7 +18,8 @@ Compared on the ball (pixels whose camera ray meets it at under 70° from its no
 :func:`ball_mask`): the mean colour's luminance and the per-pixel relative RMS
 difference of luminance. Each side renders twice (Cycles with two seeds, the proofs at
 ``spp`` and ``spp + 2`` samples, an even count apart as the proofs round odd ones, so
-Mitsuba's sampler draws other streams): half their difference is each side's noise (:func:`compare`).
+Mitsuba's sampler draws other streams): half their difference is each side's noise
+(:func:`compare`).
 
 The loss note's stated size (the export's albedo change, :mod:`.fidelity`) is checked
 against the render (:func:`agrees`): Cycles against the proof is within it plus three
@@ -329,11 +330,9 @@ def run(
         size = sizes[preset]
         stated = 0.0 if size.fully else size.albedo_change
         agree, bound = agrees(mean_diff["cycles-proof"], stated, size.fully, noise)
+        note = loss.get(preset, "")
         rows.append(
-            Row(
-                preset, mean, mean_diff, pixel, noise, loss.get(preset, ""), stated,
-                size.fully, bound, agree,
-            )  # fmt: skip
+            Row(preset, mean, mean_diff, pixel, noise, note, stated, size.fully, bound, agree)
         )
     return {
         "blender": version,
