@@ -227,7 +227,7 @@ def _author_material(layer, scope, spec: MaterialSpec, base: Path, types: dict[s
 DCC_LOSS = "userProperties:lookdev:loss"
 """The universal network's loss note, where Blender shows it: its USD importer makes every
 ``userProperties:`` attribute of a Material a custom property of the material (Blender
-4.5 and 5.3, observed); it shows neither ``doc`` nor ``displayName``."""
+4.5.15 and 5.0.1, observed); it shows neither ``doc`` nor ``displayName``."""
 
 
 FULLY = "UsdPreviewSurface expresses this material fully"
