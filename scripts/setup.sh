@@ -58,19 +58,30 @@ if [ ! -f "$docs_stamp" ] || [ pyproject.toml -nt "$docs_stamp" ]; then
 fi
 
 # Blender as a test consumer (tests marked dcc): the bpy wheel pins its own Python
-# (3.11 for bpy 4.5), so it gets a venv of its own, .venv-blender. Set
-# LOOKDEV_BLENDER_PYTHON to use another interpreter that imports bpy.
-if [ -z "${LOOKDEV_BLENDER_PYTHON:-}" ] && [ ! -f .venv-blender/.lookdev-installed ]; then
-  BLENDER_PYTHON=${BLENDER_PYTHON:-python3.11}
-  if command -v "$BLENDER_PYTHON" >/dev/null 2>&1; then
-    echo "setup: installing Blender (bpy 4.5) into .venv-blender (log: .venv-blender/pip.log)"
-    "$BLENDER_PYTHON" -m venv .venv-blender
-    if .venv-blender/bin/python -m pip install -q 'bpy==4.5.*' >.venv-blender/pip.log 2>&1; then
-      touch .venv-blender/.lookdev-installed
-    else
-      echo "setup: warning: bpy did not install (see .venv-blender/pip.log); the dcc tests will be skipped" >&2
-    fi
-  else
-    echo "setup: warning: no $BLENDER_PYTHON for Blender's bpy; the dcc tests will be skipped" >&2
+# (3.11 for bpy 4.5 and for bpy 5.0), so each Blender gets a venv of its own:
+# .venv-blender (bpy 4.5, the LTS) and .venv-blender5 (the newest bpy, 5.x); the dcc
+# tests run against each one installed. Set LOOKDEV_BLENDER_PYTHON to use only another
+# interpreter that imports bpy.
+install_blender() {  # venv, pip requirement
+  local venv=$1 want=$2
+  [ -f "$venv/.lookdev-installed" ] && return 0
+  local python=${BLENDER_PYTHON:-python3.11}
+  if ! command -v "$python" >/dev/null 2>&1; then
+    echo "setup: warning: no $python for Blender's bpy ($want); the dcc tests will skip it" >&2
+    return 0
   fi
+  echo "setup: installing Blender ($want) into $venv (log: $venv/pip.log)"
+  "$python" -m venv "$venv"
+  if "$venv/bin/python" -m pip install -q "$want" >"$venv/pip.log" 2>&1; then
+    touch "$venv/.lookdev-installed"
+  else
+    # No venv without its bpy: the dcc tests run against every venv that exists.
+    mv "$venv/pip.log" "$venv-pip.log"
+    rm -rf "$venv"
+    echo "setup: warning: $want did not install (see $venv-pip.log); the dcc tests will skip it" >&2
+  fi
+}
+if [ -z "${LOOKDEV_BLENDER_PYTHON:-}" ]; then
+  install_blender .venv-blender 'bpy==4.5.*'
+  install_blender .venv-blender5 'bpy==5.*'
 fi

@@ -238,22 +238,33 @@ def render(bpy: Any, request: dict[str, Any]) -> dict[str, Any]:
 
 
 def _mitsuba_sphere_uv(obj: Any, frame: Any) -> None:
-    """UVs from the sphere's local frame (``frame`` takes Blender's object coordinates
-    there): u = atan2(y, x) / 2π, θ from +z, written as st (t = 1 − θ/π). Meant to be
-    Mitsuba's sphere parametrisation; the maps do not yet land where the proof shows
-    them (the bench's measurements page says so)."""
+    """Mitsuba's sphere parametrisation (its ``sphere`` shape: u = atan2(y, x) / 2π,
+    v = θ / π with θ from +z, in the sphere's own frame) as the mesh's st. ``frame`` takes
+    Blender's object coordinates to that frame. Mitsuba's bitmap puts a map's row 0 at
+    v = 0 and lookdev's maps are row 0 at st t = 0 (bottom-up), so t = v (not 1 − v).
+
+    The mesh is first turned so that its poles lie on the frame's z axis: its rings are
+    then Mitsuba's rings, and only the faces at the seam (kept on one side) and at the
+    poles (u of the pole vertex taken from the face's others) need care."""
     mesh = obj.data
+    mesh.transform(frame.inverted().to_4x4())
     layer = mesh.uv_layers["st"]
     for poly in mesh.polygons:
-        uvs = []
-        for loop in poly.loop_indices:
+        uvs, poles = [], []
+        for k, loop in enumerate(poly.loop_indices):
             p = frame @ mesh.vertices[mesh.loops[loop].vertex_index].co
             u = (math.atan2(p.y, p.x) / (2 * math.pi)) % 1.0
             theta = math.acos(max(-1.0, min(1.0, p.z / max(p.length, 1e-12))))
-            uvs.append([u, 1.0 - theta / math.pi])
-        if max(uv[0] for uv in uvs) - min(uv[0] for uv in uvs) > 0.5:
+            if math.hypot(p.x, p.y) < 1e-6:
+                poles.append(k)
+            uvs.append([u, theta / math.pi])
+        others = [uv[0] for k, uv in enumerate(uvs) if k not in poles]
+        if others and max(others) - min(others) > 0.5:
             for uv in uvs:  # a face across the seam: keep it on one side
                 uv[0] += 1.0 if uv[0] < 0.5 else 0.0
+            others = [uv[0] for k, uv in enumerate(uvs) if k not in poles]
+        for k in poles:
+            uvs[k][0] = sum(others) / len(others) if others else 0.0
         for loop, uv in zip(poly.loop_indices, uvs, strict=True):
             layer.data[loop].uv = uv
 

@@ -10,14 +10,20 @@ IBL, seen by the proof's camera, no rig):
   from the exported file, in a scene :func:`blender_scene` builds from the same numbers:
   camera origin, target and horizontal field of view, the IBL's pixels resampled to
   Blender's lat-long convention (:func:`blender_environment`), the same cup mesh and
-  ground, Standard view, scene-linear EXR out. A textured preset's maps are not yet
-  laid out on the ball as on Mitsuba's sphere, and the cup arrives from PLY without UVs:
-  only constant presets compare pixel for pixel.
+  ground, Standard view, scene-linear EXR out. The ball's st is Mitsuba's sphere
+  parametrisation (``blender_side``), so a textured preset's maps land where the proof
+  shows them.
 
 Compared on the ball (pixels whose camera ray meets it at under 70° from its normal,
 :func:`ball_mask`): the mean colour's luminance and the per-pixel relative RMS
-difference of luminance. Cycles renders twice with two seeds: their difference is its
-noise (:func:`compare`), which the figures are read against.
+difference of luminance. Each side renders twice (Cycles with two seeds, the proofs at
+``spp`` and ``spp + 2`` samples, an even count apart as the proofs round odd ones, so
+Mitsuba's sampler draws other streams): half their difference is each side's noise
+(:func:`compare`).
+
+The loss note's stated size (the export's albedo change, :mod:`.fidelity`) is checked
+against the render (:func:`agrees`): Cycles against the proof is within it plus three
+standard errors of the two means, or the row is flagged.
 """
 
 from __future__ import annotations
@@ -30,8 +36,10 @@ from typing import Any
 import numpy as np
 
 __all__ = [
+    "NOISE_SIGMAS",
     "PRESETS",
     "Y_UP_TO_Z_UP",
+    "agrees",
     "ball_mask",
     "blender_environment",
     "blender_scene",
@@ -56,6 +64,8 @@ Y_UP_TO_Z_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
 """lookdev's world (y up, camera on +z) → Blender's (z up, the same scene seen from −y)."""
 
 GRAZING_COS = math.cos(math.radians(70.0))
+NOISE_SIGMAS = 3.0
+"""A difference within this many standard errors of the two means is noise."""
 
 
 def _matrix4(linear: np.ndarray, translate=(0.0, 0.0, 0.0)) -> list[list[float]]:
@@ -172,11 +182,32 @@ class Row:
     mean: dict[str, list[float]]  # render → mean RGB on the ball
     mean_diff: dict[str, float]  # "cycles-universal", "cycles-proof": relative luminance
     pixel_rms: dict[str, float]  # the same pairs: per-pixel relative RMS of luminance
-    noise: dict[str, float]  # Cycles: mean and per-pixel, from its two seeds
+    noise: dict[str, float]  # per side (cycles, proof): the mean's standard error, per pixel
     loss: str  # the universal loss note, as Blender shows it
+    stated: float  # the note's albedo change (0 where it says "fully")
+    fully: bool  # the note says the universal context expresses the preset fully
+    bound: float  # what |mean_diff["cycles-proof"]| may be: |stated| + noise
+    agree: bool
 
     def to_json(self) -> dict[str, Any]:
         return self.__dict__.copy()
+
+
+def agrees(diff: float, stated: float, fully: bool, noise: dict[str, float]) -> tuple[bool, float]:
+    """Whether a render's relative mean difference agrees with a loss note: within the
+    note's stated albedo change (none where the note says "fully") plus
+    :data:`NOISE_SIGMAS` standard errors of the difference of the two means; and that
+    bound.
+
+    >>> ok, bound = agrees(0.008, -0.039, True, {"cycles_mean": 0.001, "proof_mean": 0.003})
+    >>> ok, round(bound, 4)
+    (True, 0.0095)
+    >>> agrees(-0.70, -0.75, False, {"cycles_mean": 0.001, "proof_mean": 0.003})[0]
+    True
+    """
+    sigma = math.hypot(noise["cycles_mean"], noise["proof_mean"])
+    bound = (0.0 if fully else abs(stated)) + NOISE_SIGMAS * sigma
+    return abs(diff) <= bound, bound
 
 
 def _lum(rgb: np.ndarray) -> np.ndarray:
@@ -185,19 +216,29 @@ def _lum(rgb: np.ndarray) -> np.ndarray:
     return np.asarray(luminance(rgb))
 
 
+def _noise(a: np.ndarray, b: np.ndarray, ref: float) -> tuple[float, float]:
+    """Two renders' average: its per-pixel noise (half their difference, RMS) and the
+    standard error of its mean over the pixels, both relative to ``ref``."""
+    half = 0.5 * (_lum(a) - _lum(b))
+    pixel = float(np.sqrt(np.mean(half**2)))
+    return pixel / math.sqrt(half.size) / ref, pixel / ref
+
+
 def compare(
     renders: dict[str, np.ndarray], mask: np.ndarray
 ) -> tuple[dict[str, Any], dict[str, Any], dict[str, Any], dict[str, Any]]:
-    """Means, relative mean differences, per-pixel relative RMS and Cycles' noise.
+    """Means, relative mean differences, per-pixel relative RMS and each side's noise.
 
-    ``renders``: ``proof``, ``universal``, ``cycles_a`` and ``cycles_b`` (two seeds),
-    (H, W, 3) scene-linear. Cycles is their average; its noise is half their
-    difference (per pixel, and of the mean), relative to its mean luminance.
+    ``renders``: ``universal``, two renders of the proof (``proof_a``, ``proof_b``) and
+    of Cycles (``cycles_a``, ``cycles_b``), (H, W, 3) scene-linear. Each pair is used as
+    its average.
     """
-    a, b = renders["cycles_a"][mask], renders["cycles_b"][mask]
-    cycles = 0.5 * (a + b)
-    ball = {"cycles": cycles, "proof": renders["proof"][mask]}
-    ball["universal"] = renders["universal"][mask]
+    ball = {"universal": renders["universal"][mask]}
+    pairs = {}
+    for side in ("cycles", "proof"):
+        a, b = renders[f"{side}_a"][mask], renders[f"{side}_b"][mask]
+        ball[side] = 0.5 * (a + b)
+        pairs[side] = (a, b)
     mean = {k: v.mean(axis=0).tolist() for k, v in ball.items()}
     lum = {k: _lum(v) for k, v in ball.items()}
     ref = {k: float(lum[k].mean()) for k in lum}
@@ -206,11 +247,9 @@ def compare(
         key = f"cycles-{other}"
         mean_diff[key] = (ref["cycles"] - ref[other]) / ref[other]
         pixel[key] = float(np.sqrt(np.mean((lum["cycles"] - lum[other]) ** 2)) / ref[other])
-    half = 0.5 * (_lum(a) - _lum(b))
-    noise = {
-        "mean": float(abs(half.mean()) / ref["cycles"]),
-        "pixel": float(np.sqrt(np.mean(half**2)) / ref["cycles"]),
-    }
+    noise = {}
+    for side, (a, b) in pairs.items():
+        noise[f"{side}_mean"], noise[f"{side}_pixel"] = _noise(a, b, ref[side])
     return mean, mean_diff, pixel, noise
 
 
@@ -221,8 +260,10 @@ def run(
     resolution: tuple[int, int] = (200, 100),
     spp: int = 128,
     progress: Any = None,
+    python: Path | None = None,
 ) -> dict[str, Any]:
-    """Render ``presets`` in Cycles and in lookdev's proofs; the figures (module doc)."""
+    """Render ``presets`` in Cycles and in lookdev's proofs; the figures (module doc).
+    ``python``: the Blender to use (:func:`.blender.interpreter` by default)."""
     from lookdev.pipeline import api
     from lookdev.pipeline.proof import ibl as ibl_module
     from lookdev.pipeline.proof.contact import read_rgb, write_exr
@@ -234,20 +275,21 @@ def run(
     usd.parent.mkdir(parents=True, exist_ok=True)
     step = progress or (lambda _text: None)
     step("export usd")
-    api.export_usd(list(presets), usd, collect=True)
-    step("lookdev proofs (Mitsuba)")
-    api.proof(
-        list(presets),
-        [ibl],
-        out / "proofs",
-        frames=1,
-        light_frames=0,
-        spp=spp,
-        resolution=resolution,
-        rig="none",
-        context="universal",
-        denoise=False,
-    )
+    sizes = api.export_usd(list(presets), usd, collect=True, report=True).fidelity
+    for folder, samples in (("proofs", spp), ("proofs_b", spp + 2)):
+        step(f"lookdev proofs (Mitsuba, {samples} spp)")
+        api.proof(
+            list(presets),
+            [ibl],
+            out / folder,
+            frames=1,
+            light_frames=0,
+            spp=samples,
+            resolution=resolution,
+            rig="none",
+            context="universal",
+            denoise=False,
+        )
     env = ibl_module.load(ibl, ibl_module.DEFAULT_WIDTH)
     env_path = write_exr(blender_environment(env.pixels), out / "blender_environment.exr")
     scene = blender_scene(env_path, resolution)
@@ -269,7 +311,8 @@ def run(
                     "seed": seed,
                     "threads": 2,
                     **scene,
-                }
+                },
+                python=python,
             )
             frames[preset][key] = Path(answer["frames"][preset])
             version = answer["version"]
@@ -278,12 +321,19 @@ def run(
     rows = []
     for preset in presets:
         renders = {k: read_rgb(p) for k, p in frames[preset].items()}
-        renders["proof"] = read_rgb(out / "proofs" / preset / ibl / "frame_000.exr")
+        renders["proof_a"] = read_rgb(out / "proofs" / preset / ibl / "frame_000.exr")
+        renders["proof_b"] = read_rgb(out / "proofs_b" / preset / ibl / "frame_000.exr")
         renders["universal"] = read_rgb(
             out / "proofs" / f"{preset}-universal" / ibl / "frame_000.exr"
         )
         mean, mean_diff, pixel, noise = compare(renders, mask)
-        rows.append(Row(preset, mean, mean_diff, pixel, noise, loss.get(preset, "")))
+        size = sizes[preset]
+        stated = 0.0 if size.fully else size.albedo_change
+        agree, bound = agrees(mean_diff["cycles-proof"], stated, size.fully, noise)
+        note = loss.get(preset, "")
+        rows.append(
+            Row(preset, mean, mean_diff, pixel, noise, note, stated, size.fully, bound, agree)
+        )
     return {
         "blender": version,
         "ibl": ibl,

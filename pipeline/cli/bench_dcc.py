@@ -36,10 +36,12 @@ def dcc_(
     and `--context universal` proof, same camera, IBL and scene; compare on the ball.
 
     Reports per preset the mean colour's relative luminance difference and the per-pixel
-    relative RMS difference, Cycles against the universal proof (what the loss note
-    describes) and against the preset's own proof, beside Cycles' noise (two seeds) and
-    the loss note Blender shows (the material's custom property lookdev:loss). Needs
-    Blender's bpy (scripts/setup.sh installs it into .venv-blender).
+    relative RMS difference, Cycles against the universal proof and against the preset's
+    own proof, beside each side's noise (two renders each) and the loss note Blender shows
+    (the material's custom property lookdev:loss), and whether they agree: Cycles
+    against the proof within the note's stated albedo change (none where it says
+    "fully") plus three standard errors. Needs Blender's bpy (scripts/setup.sh installs
+    it into .venv-blender).
 
     Example: lookdev bench dcc --spp 256 --json > dcc.json
     """
@@ -67,11 +69,12 @@ def dcc_(
         [
             r["preset"],
             f"{100 * r['mean_diff']['cycles-universal']:+.1f} %",
-            f"{100 * r['pixel_rms']['cycles-universal']:.1f} %",
             f"{100 * r['mean_diff']['cycles-proof']:+.1f} %",
             f"{100 * r['pixel_rms']['cycles-proof']:.1f} %",
-            f"{100 * r['noise']['mean']:.2f} % / {100 * r['noise']['pixel']:.1f} %",
-            r["loss"],
+            f"{100 * r['noise']['cycles_pixel']:.1f} % / {100 * r['noise']['proof_pixel']:.1f} %",
+            "fully" if r["fully"] else f"{100 * r['stated']:+.1f} %",
+            f"{100 * r['bound']:.1f} %",
+            "yes" if r["agree"] else "NO",
         ]
         for r in result["rows"]
     ]
@@ -83,12 +86,15 @@ def dcc_(
             [
                 "preset",
                 "mean vs universal",
-                "pixel vs universal",
                 "mean vs proof",
                 "pixel vs proof",
-                "Cycles noise mean / pixel",
-                "loss note (lookdev:loss)",
+                "noise Cycles / proof (pixel)",
+                "note says",
+                "may be",
+                "agree",
             ],
             rows,
         )
     )
+    for r in result["rows"]:
+        console.print(f"{r['preset']}: {r['loss']}", markup=False, highlight=False)

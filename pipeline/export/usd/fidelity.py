@@ -8,8 +8,11 @@ view angles :data:`ANGLES`, by Monte Carlo over each model's own sampler (fixed 
 report is reproducible), per channel; and the highlight, f·cos θi at the mirror direction
 of a 30° view: the light reflected within 10° of it (what a person sees first on a
 sphere; an energy, so mirrors compare too). The report gives, per material,
-the RMS and the worst albedo difference (with angle and channel) and the ratio of the
-highlights' luminance, preview over source.
+the RMS and the worst albedo difference (with angle and channel), the ratio of the
+highlights' luminance, preview over source, and the relative change of the
+bihemispherical albedo's luminance (:func:`sphere_albedo`: what a ball shows under even
+light, so it predicts a render's mean colour). :meth:`Fidelity.size` says those figures
+in words for the loss note a DCC shows (:func:`.writer.dcc_loss_note`).
 
 Layered materials are measured at their centre texel; a layered Pixar material
 (composited lobe weights) is measured from the preview values at its centre against the
@@ -48,6 +51,7 @@ __all__ = [
     "measure",
     "preview_hub",
     "preview_params",
+    "sphere_albedo",
 ]
 
 SHORT = {
@@ -61,6 +65,27 @@ ANGLES = (0.0, 30.0, 45.0, 60.0, 75.0, 85.0)
 """View angles (degrees from the normal) at which albedo is compared."""
 SAMPLES = 4096
 CHANNELS = "RGB"
+FULLY_ALBEDO = 0.01
+"""Below this relative albedo change (and :data:`FULLY_HIGHLIGHT`) a context expresses a
+material fully: the Monte Carlo figures at :data:`SAMPLES` resolve about that much."""
+FULLY_HIGHLIGHT = 0.05
+"""… and the highlight's energy within this relative change."""
+
+
+def sphere_albedo(albedo: Any) -> float:
+    """The bihemispherical albedo's luminance, 2∫E(μ)μ dμ over μ = cos θ, from E(θ) at
+    :data:`ANGLES` (per angle, RGB): trapezoids in μ, E held at its 85° value down to the
+    horizon. It is the mean a sphere shows under even white light (each view angle
+    weighted by the area it covers on the sphere's silhouette).
+
+    >>> round(sphere_albedo([[0.5, 0.5, 0.5]] * len(ANGLES)), 6)
+    0.5
+    """
+    lum = np.asarray(luminance(np.asarray(albedo, np.float64)))
+    mu = np.concatenate([[0.0], np.cos(np.radians(ANGLES))[::-1]])
+    e = np.concatenate([[lum[-1]], lum[::-1]])
+    f = 2.0 * mu * e
+    return float(np.sum(0.5 * (f[1:] + f[:-1]) * np.diff(mu)))
 
 
 @dataclass(frozen=True)
@@ -82,10 +107,31 @@ class Fidelity:
     loss: str = ""  # what the network could not express (its surface's note)
     notes: tuple[str, ...] = ()  # renderer behaviours that change the look
     unavailable: str = ""  # why there is no figure (the context's model is not known)
+    albedo_change: float = 0.0  # relative change of sphere_albedo, context over source
+
+    @property
+    def fully(self) -> bool:
+        """The context shows the material within what the measurement resolves."""
+        return (
+            not self.unavailable
+            and abs(self.albedo_change) <= FULLY_ALBEDO
+            and abs(self.highlight_ratio - 1.0) <= FULLY_HIGHLIGHT
+        )
+
+    def size(self) -> str:
+        """The figures in words, e.g. ``albedo −3.9 %, highlight −2 %, albedo RMS 0.13``."""
+        if self.unavailable:
+            return ""
+        return (
+            f"albedo {_signed(100 * self.albedo_change, 1)} %, highlight "
+            f"{_signed(100 * (self.highlight_ratio - 1.0), 0)} %, albedo RMS {self.rms:.2f}"
+        )
 
     def to_json(self) -> dict[str, Any]:
         if self.unavailable:  # no figures: null, not NaN (which JSON does not have)
-            blank = {k: None for k in ("albedo_preview", "rms", "worst", "highlight_ratio")}
+            blank = dict.fromkeys(
+                ("albedo_preview", "rms", "worst", "highlight_ratio", "albedo_change")
+            )
             return {**self._json(), **blank, "highlight_width_deg": None}
         return self._json()
 
@@ -103,6 +149,9 @@ class Fidelity:
             "highlight_ratio": self.highlight_ratio,
             "highlight_width_source_deg": self.highlight_width_source,
             "highlight_width_deg": self.highlight_width,
+            "albedo_change": self.albedo_change,
+            "size": self.size(),
+            "fully": self.fully,
             "loss": self.loss,
             "notes": list(self.notes),
             "unavailable": self.unavailable,
@@ -176,6 +225,14 @@ def measure(model, params, maps: dict[str, Any], samples: int = SAMPLES) -> Meas
     return Measured(np.asarray(up), np.asarray(down), np.asarray(highlight), np.asarray(width))
 
 
+def _signed(x: float, digits: int) -> str:
+    """``+3.1`` / ``−3.1`` (a minus sign, not a hyphen); zero unsigned."""
+    text = f"{abs(x):.{digits}f}"
+    if float(text) == 0.0:
+        return text
+    return ("+" if x > 0 else "\u2212") + text
+
+
 def _ratio(a: float, b: float) -> float:
     return a / b if b > 0.0 else math.inf if a > 0.0 else 1.0
 
@@ -198,6 +255,7 @@ def compared(name: str, src: Measured, got: Measured, **about: Any) -> Fidelity:
         _ratio(float(luminance(got.highlight[at])), float(luminance(src.highlight[at]))),
         highlight_width_source=round(float(src.width[at]), 3),
         highlight_width=round(float(got.width[at]), 3),
+        albedo_change=_ratio(sphere_albedo(a_got), sphere_albedo(a_src)) - 1.0,
         **about,
     )
 

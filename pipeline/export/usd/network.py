@@ -109,6 +109,9 @@ class MaterialSpec:
     name: str
     networks: list[Network]
     custom: dict[str, Any]
+    size: Any = None
+    """The universal context measured against the material (a :class:`.fidelity.Fidelity`),
+    when the export measured it: its figures go into the loss note a DCC shows."""
 
     def interface(self) -> dict[str, tuple[str, Any]]:
         """The Material's interface inputs the networks read: name → (type, value)."""
@@ -191,6 +194,8 @@ class Source:
     custom: dict[str, Any] = field(default_factory=dict)
     """Values no target expresses, kept in the Material's ``customData`` (``lookdev``) for
     the import (the GTR ``specular_gamma`` and the roughness it was authored with)."""
+    size: Any = None
+    """The universal context measured against the material (:attr:`MaterialSpec.size`)."""
 
     @cached_property
     def lobes(self) -> dict[str, bool]:

@@ -23,7 +23,10 @@ from lookdev.materials.preview_surface import MODEL, PreviewParams  # noqa: E402
 from lookdev.pipeline import api  # noqa: E402
 from lookdev.pipeline.analysis.albedo import albedo_monte_carlo  # noqa: E402
 from lookdev.pipeline.blend import BlendedMaterial  # noqa: E402
+from lookdev.pipeline.export.usd.fidelity import Fidelity  # noqa: E402
+from lookdev.pipeline.export.usd.network import Connection, MaterialSpec, Network  # noqa: E402
 from lookdev.pipeline.export.usd.pixar import metallic_workflow  # noqa: E402
+from lookdev.pipeline.export.usd.writer import DCC_LOSS, FULLY, dcc_loss_note  # noqa: E402
 
 
 def _prepare(xp, params):
@@ -86,6 +89,42 @@ def test_export_report_prints_and_carries_the_fidelity(cli, tmp_path):
     # opaque in the preview, is far (its transmission is the named loss).
     assert abs(rows["gold"]["albedo_preview"][0][0] - rows["gold"]["albedo_source"][0][0]) < 0.05
     assert rows["glass_clear"]["rms"] > 3 * rows["gold"]["rms"]
+    # The size the loss note in the file states is the report's own.
+    stage = Usd.Stage.Open(str(out))
+    note = stage.GetPrimAtPath("/Materials/glass_clear").GetAttribute(DCC_LOSS).Get()
+    assert note.endswith(f"measured against the material: {rows['glass_clear']['size']}")
+    assert rows["glass_clear"]["albedo_change"] > 0.5 and not rows["glass_clear"]["fully"]
+
+
+def _fidelity(albedo_change: float, highlight_ratio: float) -> Fidelity:
+    flat = [[0.5] * 3] * 6
+    return Fidelity("m", flat, flat, 0.0, 0.0, "0° R", highlight_ratio, albedo_change=albedo_change)
+
+
+@pytest.mark.parametrize(
+    ("change", "ratio", "fully"),
+    [(0.0, 1.0, True), (-0.009, 1.049, True), (0.011, 1.0, False), (0.0, 0.94, False)],
+)
+def test_fully_means_within_what_the_measurement_resolves(change, ratio, fully):
+    assert _fidelity(change, ratio).fully is fully
+
+
+def test_the_size_in_words_signs_each_change_with_a_minus_sign():
+    assert _fidelity(-0.746, 1.09).size() == "albedo \u221274.6 %, highlight +9 %, albedo RMS 0.00"
+    assert _fidelity(0.0, 1.0).size() == "albedo 0.0 %, highlight 0 %, albedo RMS 0.00"
+
+
+def test_a_note_says_fully_only_when_nothing_is_named_and_the_figures_are_small():
+    def note(size):
+        return dcc_loss_note(
+            MaterialSpec("m", [Network("universal", Connection("s", "surface"), [])], {}, size)
+        )
+
+    assert note(None) == FULLY
+    assert note(_fidelity(0.002, 1.01)).startswith(f"{FULLY} (measured against the material:")
+    assert note(_fidelity(-0.05, 0.98)).startswith(
+        "UsdPreviewSurface's BRDF is not the material's;"
+    )
 
 
 def test_openpbr_takes_the_energy_weighted_highlight_roughness(tmp_path):
