@@ -9,17 +9,8 @@ import typer
 
 from lookdev.pipeline.bench import glass
 
-from .common import (
-    Ibl,
-    JsonOut,
-    Resolution,
-    Spp,
-    check_resolution,
-    console,
-    print_json,
-    rendered,
-    table,
-)
+from .common import JsonOut, console, print_json, table
+from .render_options import Ibl, Resolution, Spp, check_resolution, rendered
 
 __all__ = ["glass_"]
 
