@@ -33,6 +33,7 @@ from lookdev.materials.pixar import PixarParams
 from lookdev.materials.textures import UDIM_TOKEN, TextureInput, is_texture_input
 
 from .errors import PresetError, PresetNotFoundError, TextureError
+from .index import held_warnings
 from .preset import MODELS, PresetFile, split_params
 
 Lookup = Callable[[str], tuple[PresetFile, Path]]
@@ -108,8 +109,13 @@ Material.model_rebuild()
 
 
 def resolve(name: str, lookup: Lookup) -> Material:
-    """The material ``name`` with its ``extends`` chain and layer references resolved."""
-    return _resolve(name, lookup, ())
+    """The material ``name`` with its ``extends`` chain and layer references resolved.
+
+    Warnings about its maps are printed once it has resolved: a material that fails
+    prints its error alone (:func:`.index.held_warnings`).
+    """
+    with held_warnings():
+        return _resolve(name, lookup, ())
 
 
 def _resolve(name: str, lookup: Lookup, seen: tuple[str, ...]) -> Material:
