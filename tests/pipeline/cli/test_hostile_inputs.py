@@ -246,3 +246,13 @@ def test_a_maps_warning_is_not_printed_before_the_error_of_the_same_material(cli
     one_line_error(cli("presets", "show", "bad", "-L", str(lib), "-r"), "does not exist")
     r = cli("presets", "show", "warned", "-L", str(lib), "-r")
     assert r.code == 0 and r.err.count("lookdev: warning:") == 1 and "no colorspace" in r.err
+
+
+def test_a_batch_prints_the_error_of_its_bad_preset_alone(cli, tmp_path):
+    lib = tmp_path / "lib"
+    lib.mkdir()
+    _image(lib / "c.png", 3)
+    _preset(lib, "warned", '[params]\nbase_color = { texture = "c.png" }\n')
+    _preset(lib, "bad", '[params]\nmetallic = { texture = "missing.png" }\n')
+    out = str(tmp_path / "x.usda")
+    one_line_error(cli("export", "usd", "warned", "bad", "-L", str(lib), "-o", out), "missing.png")
