@@ -265,16 +265,38 @@ def _link_stat(path: str, is_preset: bool) -> os.stat_result | None:
 
 
 _warned: set[str] = set()
+_held: list[list[str]] = []
 
 
 def warn(message: str) -> None:
-    """One line on stderr, ``lookdev: warning: …``, once per message and process."""
+    """One line on stderr, ``lookdev: warning: …``, once per message and process (inside
+    :func:`held_warnings`, when it ends)."""
     if message in _warned:
+        return
+    if _held:
+        if message not in _held[-1]:
+            _held[-1].append(message)
         return
     _warned.add(message)
     with contextlib.suppress(OSError, ValueError):
         sys.stderr.write(f"lookdev: warning: {message}\n")
         sys.stderr.flush()
+
+
+@contextlib.contextmanager
+def held_warnings() -> Iterator[None]:
+    """Hold the warnings given inside until it ends: printed when it ends normally,
+    dropped when it ends in an error, whose one line is then all that is printed (bad
+    input is one line; a warning about a map comes back on the run after the error is
+    fixed). Nested holds pass theirs to the outer one."""
+    _held.append([])
+    try:
+        yield
+    except BaseException:
+        _held.pop()
+        raise
+    for message in _held.pop():
+        warn(message)
 
 
 @contextlib.contextmanager

@@ -33,8 +33,8 @@ from lookdev.materials.pixar import PixarParams
 from lookdev.materials.textures import UDIM_TOKEN, TextureInput, is_texture_input
 
 from .errors import PresetError, PresetNotFoundError, TextureError
+from .index import held_warnings
 from .preset import MODELS, PresetFile, split_params
-from .textures import ParamTexture
 
 Lookup = Callable[[str], tuple[PresetFile, Path]]
 """Finds a preset by name: its parsed file and where it lives."""
@@ -109,8 +109,13 @@ Material.model_rebuild()
 
 
 def resolve(name: str, lookup: Lookup) -> Material:
-    """The material ``name`` with its ``extends`` chain and layer references resolved."""
-    return _resolve(name, lookup, ())
+    """The material ``name`` with its ``extends`` chain and layer references resolved.
+
+    Warnings about its maps are printed once it has resolved: a material that fails
+    prints its error alone (:func:`.index.held_warnings`).
+    """
+    with held_warnings():
+        return _resolve(name, lookup, ())
 
 
 def _resolve(name: str, lookup: Lookup, seen: tuple[str, ...]) -> Material:
@@ -138,6 +143,9 @@ def _checked(model: str, params: dict[str, Any], *, where: str, prefix: str = "p
     (:mod:`.textures`: files, tiles, channels, colour space, range)."""
     constants, textures = split_params(model, params, where=where, prefix=prefix)
     for key, tex in textures.items():
+        # the image reader (OpenImageIO) is imported only for a preset that has textures
+        from .textures import ParamTexture
+
         label = f"{prefix}.{key}"
         ParamTexture(tex, key, MODELS[model], where=where, label=label).check()
     return constants, textures
@@ -153,6 +161,8 @@ def _tiles_agree(material: Material) -> Material:
     ]:
         for key, tex in mat.textures.items():
             if tex.udim:
+                from .textures import ParamTexture
+
                 field = f"{label}: {key}" if label else key
                 tiles = set(ParamTexture(tex, key, MODELS[mat.model], where=None).tiles)
                 sets.append((field, tex, tiles))

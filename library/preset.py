@@ -21,15 +21,16 @@ from __future__ import annotations
 
 import re
 import tomllib
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Literal
 
 import tomli_w
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
-from lookdev.materials import registry
 from lookdev.materials.errors import ParameterError, one_line, register_schema, short_repr
 from lookdev.materials.layers import ConstantMask, LayerSpec
+from lookdev.materials.model_names import PARAMS, Imported
 from lookdev.materials.params import Params
 from lookdev.materials.textures import TextureInput, is_texture_input, texturable
 
@@ -40,10 +41,9 @@ from .toml_file import NAME_RE as NAME_RE
 from .toml_file import check_name as check_name
 from .toml_file import parse_toml as parse_toml
 
-MODELS: dict[str, type[Params]] = {
-    name: registry.MODELS[name].params_type for name in registry.PRESET_MODELS
-}
-"""Parameter schema of each reflectance model a preset may name (from the registry)."""
+MODELS: Mapping[str, type[Params]] = Imported(PARAMS)
+"""Parameter schema of each reflectance model a preset may name, imported when first asked
+for (its model's module is not: validating a preset needs no evaluation)."""
 
 METADATA = ("description", "tags", "source", "extends")
 """Top-level fields that ``--set`` may change (everything else it sets is a parameter)."""

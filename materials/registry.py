@@ -22,16 +22,15 @@ from __future__ import annotations
 
 import types
 import typing
-from collections.abc import Mapping
+from collections.abc import Mapping, MutableMapping
 from typing import Any
 
 import numpy as np
 
-from . import disney, measured, openpbr, pixar, sheen
 from .arrays import NumpyOps
 from .bsdf import Model
 from .errors import LookdevError
-from .model_names import PRESET_MODELS
+from .model_names import HOMES, PRESET_MODELS, Imported
 
 __all__ = [
     "LAYERED",
@@ -46,19 +45,10 @@ __all__ = [
     "parameter_lobes",
 ]
 
-MODELS: dict[str, Model] = {
-    m.name: m
-    for m in (
-        disney.MODEL,
-        sheen.MODEL,
-        pixar.MODEL,
-        pixar.LAYERED_MODEL,
-        measured.MODEL,
-        openpbr.MODEL,
-    )
-}
-"""Every model by name; each renders in Mitsuba as the plugin ``lookdev_<name>``. A new
-model adds itself here (tests add toy models the same way)."""
+MODELS: MutableMapping[str, Model] = Imported(HOMES)
+"""Every model by name, imported on first use; each renders in Mitsuba as the plugin
+``lookdev_<name>``. A new model adds its row to :data:`~.model_names.HOMES` (tests add toy
+models by setting an item)."""
 
 
 LAYERED: Mapping[str, str] = types.MappingProxyType({"pixar": "pixar_layered"})

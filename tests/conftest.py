@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import sys
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -34,6 +35,12 @@ settings.register_profile("explore", max_examples=500)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "deterministic"))
 
 
+DEFAULT_IGNORED = (DeprecationWarning, PendingDeprecationWarning, ImportWarning, ResourceWarning)
+"""What Python's default warning filters hide from a user's terminal."""
+SHOW_WARNING = warnings.showwarning
+"""The interpreter's printer of warnings (to stderr), before pytest records them."""
+
+
 @dataclass
 class CliResult:
     code: int
@@ -42,18 +49,29 @@ class CliResult:
 
 
 @pytest.fixture
-def cli(capsys):
-    """``cli("presets", "list")`` → CliResult(code, out, err), as a user would see it."""
+def cli(capfd):
+    """``cli("presets", "list")`` → CliResult(code, out, err), as a user would see it.
+
+    Captured at the file descriptors, so a C library's own line (libpng, OpenColorIO)
+    counts; Python warnings print as the interpreter's default filters print them (pytest
+    would otherwise record them out of sight): every "one line on stderr" test sees what
+    a terminal shows.
+    """
     from lookdev.pipeline.cli import main
 
     def run(*args: str) -> CliResult:
-        capsys.readouterr()
-        try:
-            main(list(args))
-            code = 0
-        except SystemExit as exc:
-            code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
-        captured = capsys.readouterr()
+        capfd.readouterr()
+        with warnings.catch_warnings():
+            warnings.resetwarnings()
+            for category in DEFAULT_IGNORED:
+                warnings.simplefilter("ignore", category)
+            warnings.showwarning = SHOW_WARNING
+            try:
+                main(list(args))
+                code = 0
+            except SystemExit as exc:
+                code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+        captured = capfd.readouterr()
         return CliResult(code, captured.out, captured.err)
 
     return run

@@ -153,15 +153,22 @@ def measured(path: PathLike) -> BlendedMaterial:
 
 
 def _materials(materials: Any, library: Any) -> list[Any]:
-    """One material or several, each loaded if named; a name given twice counts once."""
+    """One material or several, each loaded if named; a name given twice counts once.
+
+    Warnings about their maps are printed once all have loaded: a batch with a bad
+    preset prints its error alone (:func:`lookdev.library.index.held_warnings`).
+    """
+    from lookdev.library.index import held_warnings
+
     if isinstance(materials, str | os.PathLike) or hasattr(materials, "model"):
         materials = [materials]
     out, seen = [], set()
-    for m in materials:
-        key = os.fspath(m) if isinstance(m, str | os.PathLike) else id(m)
-        if key not in seen:
-            seen.add(key)
-            out.append(_material(m, library))
+    with held_warnings():
+        for m in materials:
+            key = os.fspath(m) if isinstance(m, str | os.PathLike) else id(m)
+            if key not in seen:
+                seen.add(key)
+                out.append(_material(m, library))
     return out
 
 

@@ -6,11 +6,11 @@ from __future__ import annotations
 from typing import Annotated
 
 import typer
-from rich.progress import Progress
 
 from lookdev.pipeline.bench import depth
 
 from .common import JsonOut, console, print_json, table
+from .render_options import Ibl, Resolution, Spp, check_resolution, rendered
 
 __all__ = ["depth_"]
 
@@ -20,13 +20,9 @@ def depth_(
         list[str] | None,
         typer.Argument(help="Presets to measure (default: one per depth class)."),
     ] = None,
-    ibl: Annotated[str, typer.Option("--ibl", help="Built-in IBL name or an .exr/.hdr.")] = (
-        "studio"
-    ),
-    spp: Annotated[int, typer.Option("--spp", min=1, help="Samples per pixel.")] = 64,
-    resolution: Annotated[
-        tuple[int, int], typer.Option("--resolution", help="Width and height in pixels.")
-    ] = (160, 80),
+    ibl: Ibl = "studio",
+    spp: Spp = 64,
+    resolution: Resolution = (160, 80),
     reference_depth: Annotated[
         int, typer.Option("--reference-depth", min=2, help="Depth of the reference renders.")
     ] = 32,
@@ -39,10 +35,7 @@ def depth_(
 
       lookdev bench depth gold glass_clear --spp 32 --json
     """
-    if min(resolution) < 8:
-        raise depth.BenchDepthError(
-            f"{resolution[0]} {resolution[1]}: at least 8", field="--resolution"
-        )
+    check_resolution(resolution, depth.BenchDepthError)
     settings = depth.Settings(
         presets=tuple(presets or depth.DEFAULT_PRESETS),
         ibl=ibl,
@@ -51,9 +44,7 @@ def depth_(
         reference_depth=reference_depth,
         repeat=repeat,
     )
-    with Progress(console=console, transient=True, disable=as_json) as bar:
-        task = bar.add_task("rendering", total=len(settings.presets))
-        result = depth.run(settings, progress=lambda: bar.advance(task))
+    result = rendered(depth.run, settings, as_json)
     if as_json:
         print_json(result)
         return

@@ -6,11 +6,11 @@ from __future__ import annotations
 from typing import Annotated
 
 import typer
-from rich.progress import Progress
 
 from lookdev.pipeline.bench import glass
 
 from .common import JsonOut, console, print_json, table
+from .render_options import Ibl, Resolution, Spp, check_resolution, rendered
 
 __all__ = ["glass_"]
 
@@ -20,17 +20,15 @@ def glass_(
         list[str] | None,
         typer.Argument(help="Glass presets to measure (default: every built-in glass)."),
     ] = None,
-    ibl: Annotated[str, typer.Option("--ibl", help="Built-in IBL name or an .exr/.hdr.")] = "sky",
-    spp: Annotated[int, typer.Option("--spp", min=1, help="Samples per pixel.")] = 16,
+    ibl: Ibl = "sky",
+    spp: Spp = 16,
     reference_spp: Annotated[
         int,
         typer.Option(
             "--reference-spp", min=4, help="Samples of each reference (relMSE denominator)."
         ),
     ] = 256,
-    resolution: Annotated[
-        tuple[int, int], typer.Option("--resolution", help="Width and height in pixels.")
-    ] = (128, 64),
+    resolution: Resolution = (128, 64),
     repeat: Annotated[
         int, typer.Option("--repeat", min=1, help="Seeds (interleaved rounds).")
     ] = 24,
@@ -47,10 +45,7 @@ def glass_(
 
       lookdev bench glass glass_clear glass_frosted --spp 16 --json
     """
-    if min(resolution) < 8:
-        raise glass.BenchGlassError(
-            f"{resolution[0]} {resolution[1]}: at least 8", field="--resolution"
-        )
+    check_resolution(resolution, glass.BenchGlassError)
     settings = glass.Settings(
         presets=tuple(presets or glass.DEFAULT_PRESETS),
         ibl=ibl,
@@ -59,9 +54,7 @@ def glass_(
         resolution=resolution,
         repeat=repeat,
     )
-    with Progress(console=console, transient=True, disable=as_json) as bar:
-        task = bar.add_task("rendering", total=len(settings.presets))
-        result = glass.run(settings, progress=lambda: bar.advance(task))
+    result = rendered(glass.run, settings, as_json)
     if as_json:
         print_json(result)
         return

@@ -8,6 +8,11 @@ imports ``presets.py`` and nothing of the benchmarks, Mitsuba or USD. A command 
 imported when the group resolves that command's name: to run it, or to show its own
 ``--help``.
 
+Typer (0.29) coerces option values with pydantic, building a ``TypeAdapter`` for each
+parameter before looking at its value; an option left unset needs none, so every command
+here builds its adapters on the first value given (:func:`defer_coercion`): ``lookdev
+presets list`` imports no pydantic.
+
 An entry's attribute is either a :class:`typer.Typer` (a sub-group, e.g. ``presets``) or
 a plain function (a command, e.g. ``proof``), exactly what ``app.add_typer`` or
 ``app.command`` would have been given.
@@ -23,7 +28,7 @@ from typing import Any
 import typer
 from typer.core import TyperCommand, TyperGroup
 
-__all__ = ["Lazy", "LazyGroup", "lazy_group"]
+__all__ = ["Lazy", "LazyGroup", "defer_coercion", "lazy_group"]
 
 PACKAGE = __name__.rpartition(".")[0]
 """Relative module names of the tables resolve against the CLI package."""
@@ -56,6 +61,7 @@ class Lazy:
             command = typer.main.get_command_from_info(
                 info, pretty_exceptions_short=True, rich_markup_mode=markup
             )
+        defer_coercion(command)
         command.short_help = self.help
         if self.panel is not None:
             command.rich_help_panel = self.panel
@@ -80,6 +86,7 @@ class LazyGroup(TyperGroup):
 
     def __init__(self, **attrs: Any) -> None:
         super().__init__(**attrs)
+        defer_coercion(self)
         for name, entry in self.table.items():
             self.commands.setdefault(name, _Placeholder(name, entry))
 
@@ -97,6 +104,36 @@ class _Placeholder(TyperCommand):
         super().__init__(name=name, help=entry.help, short_help=entry.help)
         if entry.panel is not None:
             self.rich_help_panel = entry.panel
+
+
+def defer_coercion(command: Any) -> None:
+    """Let each parameter of ``command`` (and of its sub-commands) build Typer's coercion
+    when it first gets a value: one left unset (``None``) is returned as Typer returns it,
+    without a pydantic ``TypeAdapter``. A Typer without that machinery is left as it is."""
+    try:
+        from typer._coercion import RuntimeParam, build_runtime_param
+    except ImportError:  # pragma: no cover - another Typer
+        return
+
+    @dataclass(frozen=True)
+    class OnFirstValue(RuntimeParam):
+        def _coerce_value(self, value: Any, param: Any, ctx: Any) -> Any:
+            param._runtime_param = build_runtime_param(param.type_descriptor)
+            return param._runtime_param._coerce_value(value, param=param, ctx=ctx)
+
+    def defer(param: Any) -> Any:
+        if getattr(param, "_runtime_param", False) is None and hasattr(param, "type_descriptor"):
+            d = param.type_descriptor
+            param._runtime_param = OnFirstValue(d.parameter_info, d.annotation)
+        return param
+
+    for param in getattr(command, "params", ()):
+        defer(param)
+    help_option = command.get_help_option  # made on first use: `--help` is a parameter too
+    command.get_help_option = lambda ctx: defer(help_option(ctx))
+    for sub in getattr(command, "commands", {}).values():
+        if not isinstance(sub, _Placeholder):
+            defer_coercion(sub)
 
 
 def lazy_group(table: Mapping[str, Lazy]) -> type[LazyGroup]:

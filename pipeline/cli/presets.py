@@ -12,6 +12,7 @@ import typer
 from lookdev.library import PresetError
 from lookdev.library.library import Library, apply_changes, read_preset
 from lookdev.library.toml_file import check_name
+from lookdev.materials.model_names import PRESET_MODELS
 
 from .common import console, err_console, print_json
 
@@ -72,9 +73,10 @@ def list_(
 
       lookdev presets list -L ~/looks --model layered --json
     """
-    if model is not None and model not in ("disney", "pixar", "openpbr", "layered"):
+    allowed = (*PRESET_MODELS, "layered")
+    if model is not None and model not in allowed:
         raise PresetError(
-            f"unknown model {model!r}; allowed: disney, pixar, openpbr, layered", field="--model"
+            f"unknown model {model!r}; allowed: {', '.join(allowed)}", field="--model"
         )
     from lookdev.library import listing
 

@@ -344,24 +344,19 @@ def _image(
         nodes.append(extract)
         out = Connection(extract.name, "out")
     suffix = "color3FA" if colour else "float"
-    if scale != 1.0:
-        node = Node(
-            f"{name}_scale",
-            f"ND_multiply_{suffix}",
-            {"in1": (slot_type, out), "in2": ("float", float(scale))},
-            {"out": slot_type},
-        )
-        nodes.append(node)
-        out = Connection(node.name, "out")
-    if bias != 0.0:
-        node = Node(
-            f"{name}_bias",
-            f"ND_add_{suffix}",
-            {"in1": (slot_type, out), "in2": ("float", float(bias))},
-            {"out": slot_type},
-        )
-        nodes.append(node)
-        out = Connection(node.name, "out")
+    for step, node_def, value, identity in (
+        ("scale", "multiply", scale, 1.0),
+        ("bias", "add", bias, 0.0),
+    ):
+        if value != identity:  # texel · scale + bias, each node only where it changes the value
+            node = Node(
+                f"{name}_{step}",
+                f"ND_{node_def}_{suffix}",
+                {"in1": (slot_type, out), "in2": ("float", float(value))},
+                {"out": slot_type},
+            )
+            nodes.append(node)
+            out = Connection(node.name, "out")
     return slot_type, out
 
 

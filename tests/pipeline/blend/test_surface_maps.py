@@ -2,31 +2,21 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import OpenImageIO as oiio
 import pytest
+from _blend_helpers import write_image
 
 import lookdev
 from lookdev.pipeline.blend.errors import TextureError
 from lookdev.pipeline.blend.surface_maps import udim_tiles
 
 
-def _png(path: Path, pixels: np.ndarray, fmt=oiio.UINT16) -> None:
-    px = np.ascontiguousarray(pixels, dtype=np.float32)
-    px = px[..., None] if px.ndim == 2 else px
-    out = oiio.ImageOutput.create(str(path))
-    out.open(str(path), oiio.ImageSpec(px.shape[1], px.shape[0], px.shape[2], fmt))
-    out.write_image(px)
-    out.close()
-
-
 def test_height_is_scaled_to_scene_units_over_the_udim_box(tmp_path):
     # tile 1002 (u = 1) is white, 1011 (v = 1) grey; 1012 is missing: the set's mean
-    _png(tmp_path / "h.1001.png", np.zeros((4, 4)))
-    _png(tmp_path / "h.1002.png", np.ones((4, 4)))
-    _png(tmp_path / "h.1011.png", np.full((4, 4), 0.5))
+    write_image(tmp_path / "h.1001.png", np.zeros((4, 4)), oiio.UINT16)
+    write_image(tmp_path / "h.1002.png", np.ones((4, 4)), oiio.UINT16)
+    write_image(tmp_path / "h.1011.png", np.full((4, 4), 0.5), oiio.UINT16)
     (tmp_path / "p.toml").write_text(
         'name = "p"\nmodel = "disney"\n'
         'height = { texture = "h.<UDIM>.png", scale = 0.02, offset = 0.001 }\n'
@@ -45,7 +35,7 @@ def test_height_is_scaled_to_scene_units_over_the_udim_box(tmp_path):
 
 def test_a_directx_normal_map_is_flipped_to_opengl(tmp_path):
     encoded = np.broadcast_to(np.array([0.5, 0.75, 0.9]), (4, 4, 3))
-    _png(tmp_path / "a_Normal_DirectX.png", encoded, oiio.UINT8)
+    write_image(tmp_path / "a_Normal_DirectX.png", encoded, oiio.UINT8)
     (tmp_path / "p.toml").write_text('name = "p"\nmodel = "disney"\ntextures = "a_<channel>.png"\n')
     hub = lookdev.blend(str(tmp_path / "p.toml"), 4)
     assert hub.normal_map.shape == (4, 4, 3)

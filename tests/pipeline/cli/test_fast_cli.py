@@ -47,18 +47,30 @@ def heavy(modules: set[str], names: tuple[str, ...]) -> list[str]:
 @pytest.mark.parametrize("args", [("--help",), ("--version",), ("bench", "--help")])
 def test_help_and_version_import_no_command_and_no_heavy_package(args):
     modules = loaded(*args)
-    # Typer 0.29 coerces option values through pydantic: a group's options, once parsed,
-    # bring it (`bench --help` parses the root's); eager --help and --version do not.
-    typer_own = () if args[0] == "bench" else ("pydantic",)
-    assert heavy(modules, HEAVY + OURS_HEAVY + typer_own) == []
+    # Typer 0.29 coerces option values through pydantic; options left unset need none
+    # (lazy.defer_coercion), so no quick command imports it for Typer's sake
+    assert heavy(modules, HEAVY + OURS_HEAVY + ("pydantic",)) == []
     commands = {m for m in modules if m.startswith("lookdev.pipeline.cli.")}
     assert commands <= {"lookdev.pipeline.cli.lazy", "lookdev.pipeline.cli.bench"}
 
 
-def test_presets_list_reads_headers_without_the_models():
+MODEL_MODULES = tuple(
+    f"lookdev.materials.{m}" for m in ("disney", "disney_prepare", "sheen", "openpbr", "measured")
+)
+"""Evaluation modules of the models: validating a Disney preset needs none of them."""
+
+
+def test_presets_list_reads_headers_without_the_models_or_pydantic():
     modules = loaded("presets", "list")
-    assert heavy(modules, HEAVY + OURS_HEAVY) == []
+    assert heavy(modules, HEAVY + OURS_HEAVY + MODEL_MODULES + ("pydantic",)) == []
     assert "lookdev.pipeline.cli.presets" in modules
+
+
+def test_presets_show_validates_without_the_models_the_image_reader_or_a_renderer():
+    modules = loaded("presets", "show", "gold")
+    unwanted = ("mitsuba", "drjit", "pxr", "matplotlib", "OpenImageIO", "lookdev.pipeline.bench")
+    assert heavy(modules, unwanted + MODEL_MODULES + ("lookdev.materials.registry",)) == []
+    assert "lookdev.materials.params" in modules  # it was validated
 
 
 def test_presets_show_loads_no_renderer_no_usd_and_no_benchmark():
@@ -94,6 +106,13 @@ def test_each_entry_is_listed_by_its_line_and_runs_its_own_help(cli):
 def test_a_typo_still_gets_a_suggestion(cli):
     r = cli("presest", "list")
     assert r.code == 2 and "Did you mean 'presets'" in r.err
+
+
+def test_an_option_given_is_still_coerced_and_range_checked(cli):
+    r = cli("bench", "cli", "--rounds", "0")
+    assert r.code == 2 and r.err.count("\n") == 1 and "--rounds: 0 is out of range" in r.err
+    r = cli("presets", "list", "--json", "--model", "disney")
+    assert r.code == 0 and all(p["model"] == "disney" for p in json.loads(r.out))
 
 
 def test_lazy_group_is_a_typer_group():

@@ -230,3 +230,29 @@ def test_a_truncated_png_texture_prints_one_line_and_no_libpng_line(tmp_path):
     lines = r.stderr.strip().splitlines()
     assert r.returncode == 2 and len(lines) == 1, r.stderr
     assert lines[0].startswith("lookdev: error: ") and "cannot decode" in lines[0]
+
+
+def test_a_maps_warning_is_not_printed_before_the_error_of_the_same_material(cli, tmp_path):
+    lib = tmp_path / "lib"
+    lib.mkdir()
+    _image(lib / "c.png", 3)  # 8-bit colour without a colour space: a warning when it loads
+    _preset(lib, "warned", '[params]\nbase_color = { texture = "c.png" }\n')
+    _preset(
+        lib,
+        "bad",
+        '[params]\nbase_color = { texture = "c.png" }\nroughness = 0.5\n'
+        'metallic = { texture = "missing.png" }\n',
+    )
+    one_line_error(cli("presets", "show", "bad", "-L", str(lib), "-r"), "does not exist")
+    r = cli("presets", "show", "warned", "-L", str(lib), "-r")
+    assert r.code == 0 and r.err.count("lookdev: warning:") == 1 and "no colorspace" in r.err
+
+
+def test_a_batch_prints_the_error_of_its_bad_preset_alone(cli, tmp_path):
+    lib = tmp_path / "lib"
+    lib.mkdir()
+    _image(lib / "c.png", 3)
+    _preset(lib, "warned", '[params]\nbase_color = { texture = "c.png" }\n')
+    _preset(lib, "bad", '[params]\nmetallic = { texture = "missing.png" }\n')
+    out = str(tmp_path / "x.usda")
+    one_line_error(cli("export", "usd", "warned", "bad", "-L", str(lib), "-o", out), "missing.png")

@@ -15,22 +15,6 @@ from MaterialX import PyMaterialXGenGlsl as glsl  # noqa: E402
 from MaterialX import PyMaterialXGenOsl as osl  # noqa: E402
 from MaterialX import PyMaterialXGenShader as gen  # noqa: E402
 
-from lookdev.pipeline import api  # noqa: E402
-
-
-@pytest.fixture(scope="module")
-def exported(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("mtlx")
-    result = api.export_usd(
-        None, folder / "all.usda", mtlx=folder / "all.mtlx", all_presets=True, map_resolution=16
-    )
-    doc = mx.createDocument()
-    mx.readFromXmlFile(doc, str(folder / "all.mtlx"))
-    libraries = mx.createDocument()
-    mx.loadLibraries(mx.getDefaultDataLibraryFolders(), mx.getDefaultDataSearchPath(), libraries)
-    doc.importLibrary(libraries)
-    return result, doc
-
 
 @pytest.mark.slow
 @pytest.mark.parametrize("generator", [glsl.GlslShaderGenerator, osl.OslShaderGenerator])

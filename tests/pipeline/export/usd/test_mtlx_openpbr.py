@@ -46,20 +46,6 @@ def _generators():
 GENERATORS = _generators()
 
 
-@pytest.fixture(scope="module")
-def exported(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("mtlx_openpbr")
-    result = api.export_usd(
-        None, folder / "all.usda", mtlx=folder / "all.mtlx", all_presets=True, map_resolution=16
-    )
-    doc = mx.createDocument()
-    mx.readFromXmlFile(doc, str(folder / "all.mtlx"))
-    libraries = mx.createDocument()
-    mx.loadLibraries(mx.getDefaultDataLibraryFolders(), mx.getDefaultDataSearchPath(), libraries)
-    doc.importLibrary(libraries)
-    return result, doc
-
-
 def test_every_disney_preset_is_openpbr_and_validates(exported):
     result, doc = exported
     valid, message = doc.validate()

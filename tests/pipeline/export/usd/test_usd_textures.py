@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import OpenImageIO as oiio
 import pytest
+from _blend_helpers import write_image
 from pxr import Usd, UsdShade
 
 from lookdev.materials.textures import TextureInput
@@ -21,16 +22,6 @@ from lookdev.pipeline.export.usd.validate import validate_usd
 RES = 8
 
 
-def _png(path: Path, pixels: np.ndarray, fmt=oiio.UINT8) -> Path:
-    px = np.ascontiguousarray(pixels, dtype=np.float32)
-    px = px[..., None] if px.ndim == 2 else px
-    out = oiio.ImageOutput.create(str(path))
-    out.open(str(path), oiio.ImageSpec(px.shape[1], px.shape[0], px.shape[2], fmt))
-    out.write_image(px)
-    out.close()
-    return path
-
-
 @pytest.fixture
 def maps(tmp_path):
     """A texture set: a UDIM base colour (2 tiles, sRGB 8-bit), a roughness and a height."""
@@ -38,9 +29,9 @@ def maps(tmp_path):
     src.mkdir()
     rng = np.random.default_rng(0)
     for tile in (1001, 1002):
-        _png(src / f"hero_BaseColor.{tile}.png", rng.random((RES, RES, 3)))
-    _png(src / "hero_Roughness.png", rng.random((RES, RES)))
-    _png(src / "hero_Height.png", rng.random((RES, RES)), oiio.UINT16)
+        write_image(src / f"hero_BaseColor.{tile}.png", rng.random((RES, RES, 3)), oiio.UINT8)
+    write_image(src / "hero_Roughness.png", rng.random((RES, RES)), oiio.UINT8)
+    write_image(src / "hero_Height.png", rng.random((RES, RES)), oiio.UINT16)
     return src
 
 
@@ -204,7 +195,7 @@ def test_missing_texture_with_collect_is_one_error_and_nothing_written(tmp_path,
 
 
 def test_missing_texture_at_the_cli_is_one_line_exit_2(cli, tmp_path):
-    _png(tmp_path / "h.png", np.full((4, 4), 0.5))
+    write_image(tmp_path / "h.png", np.full((4, 4), 0.5), oiio.UINT8)
     (tmp_path / "bumpy.toml").write_text(
         'name = "bumpy"\nmodel = "disney"\nheight = { texture = "h.png", scale = 0.01 }\n'
     )
