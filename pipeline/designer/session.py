@@ -30,7 +30,7 @@ from lookdev.library.preset import MODELS, build_preset, preset_document
 from lookdev.materials.errors import LookdevError
 
 from . import saving
-from .edits import EditRefused, apply
+from .edits import EditRefused, apply, check_new_files
 
 __all__ = ["BLEND_RESOLUTION", "EditRefused", "Session"]
 
@@ -193,14 +193,21 @@ class Session:
                 }
             except Exception:  # a stored document always validates; keep the raw values
                 pass
+        values = _jsonable(values)
         return {
             "index": index,
             "label": label,
             "model": model,
-            "values": _jsonable(values),
+            "values": values,
+            "hex": _hexes(model, values),
             "base": _jsonable(base),
             "overridden": sorted(overrides),
         }
+
+    def target_values(self, index: int | None) -> dict[str, Any]:
+        """The values ``index`` (None: the preset's own parameters) shows, maps included."""
+        with self.lock:
+            return self._target(index, None)["values"]
 
     # -- editing ---------------------------------------------------------------------------
     def edit(self, op: dict[str, Any]) -> None:
@@ -208,6 +215,7 @@ class Session:
         with self.lock:
             candidate = apply(copy.deepcopy(self.doc), op, self)
             self._check(candidate)
+            check_new_files(self.doc, candidate, self)
             self._push(candidate, self.path, self.parent_name)
 
     def set_hidden(self, index: int, hidden: bool) -> None:
@@ -288,6 +296,18 @@ def _defaults(model: str | None) -> dict[str, Any]:
     if model not in MODELS:
         return {}
     return MODELS[model]().model_dump(mode="json")
+
+
+def _hexes(model: str | None, values: dict[str, Any]) -> dict[str, str]:
+    """``"#rrggbb"`` (sRGB) of each constant colour, for the page's colour picker."""
+    from lookdev.materials import colour
+
+    from .controls import controls_for
+
+    if model not in MODELS:
+        return {}
+    colours = [c["name"] for c in controls_for(model) if c["kind"] == "colour"]
+    return {k: colour.encode_hex(values[k]) for k in colours if isinstance(values.get(k), list)}
 
 
 def _plain(values: dict[str, Any]) -> dict[str, Any]:
