@@ -125,11 +125,16 @@ def file_refs(value: Any, session: Any, base: Path) -> Any:
 def check_new_files(old: dict[str, Any], new: dict[str, Any], session: Any) -> None:
     """Refuse a file ``new`` names as a plain path that ``old`` did not name and that lies
     outside the session's folders: a path typed by hand reaches no further than one picked
-    by ``{"root", "path"}`` (both documents have passed the schema already)."""
+    by ``{"root", "path"}``. Checked before the schema's check opens any file; a document
+    the schema refuses is left to it."""
     if session.roots is None:
         return
+    try:
+        given = list(texture_references(build_preset(new, where="designer")))
+    except LookdevError:
+        return  # refused by the schema next, before a file is read
     known = {w for _, w in texture_references(build_preset(old, where="designer"))}
     base = session.base_folder()
-    for field, written in texture_references(build_preset(new, where="designer")):
+    for field, written in given:
         if written not in known and session.roots.locate(base / written) is None:
             raise PathRefused(f"{field}: {written!r} lies outside the library folders")

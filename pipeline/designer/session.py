@@ -214,8 +214,8 @@ class Session:
         """Apply one edit (see :func:`.edits.apply`); refused edits raise :class:`EditRefused`."""
         with self.lock:
             candidate = apply(copy.deepcopy(self.doc), op, self)
+            check_new_files(self.doc, candidate, self)  # before any file is opened
             self._check(candidate)
-            check_new_files(self.doc, candidate, self)
             self._push(candidate, self.path, self.parent_name)
 
     def set_hidden(self, index: int, hidden: bool) -> None:
