@@ -269,6 +269,7 @@ def test_a_layer_mask_from_a_texture(user_library):
 def test_a_mask_preview_is_the_blends_own_evaluation(user_library):
     import io
 
+    import numpy as np
     from PIL import Image
 
     from lookdev.pipeline.designer.guard import Roots
