@@ -184,7 +184,11 @@ class Session:
         for key, value in overrides.items():
             values[key] = value
         if model in MODELS:
-            constants = {k: v for k, v in values.items() if not isinstance(v, dict)}
+            # unset optionals out: a dump holds ``ior = None`` beside ``specular``, and the
+            # model refuses the pair (then overrides such as a hex colour stayed raw)
+            constants = {
+                k: v for k, v in values.items() if not isinstance(v, dict) and v is not None
+            }
             constants = {k: list(v) if isinstance(v, tuple) else v for k, v in constants.items()}
             try:
                 canon = MODELS[model].model_validate(_plain(constants)).model_dump(mode="json")

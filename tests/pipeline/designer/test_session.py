@@ -282,7 +282,8 @@ def test_a_mask_preview_is_the_blends_own_evaluation(user_library):
     s.save_new("base")
     s.replace({"name": "untitled", "model": "layered", "layers": [{"preset": "gold"}]})
     ref = {"root": "library0", "path": "mask.png"}
-    s.edit({"op": "layer_add", "preset": "rust", "mask": {"kind": "texture", "path": ref}})
+    mask = {"kind": "texture", "path": ref, "wrap": "clamp"}
+    s.edit({"op": "layer_add", "preset": "rust", "mask": mask})
     grey = np.asarray(Image.open(io.BytesIO(preview_png(mask_of(s, 1, "mask")))))
     assert grey.shape == (PREVIEW_PX, PREVIEW_PX)
     assert grey[:, 0].max() < 40 and grey[:, -1].min() > 215  # dark at u = 0, light at u = 1
