@@ -187,8 +187,8 @@ def test_the_designer_in_chromium(page_on_gold, user_library, cli):
     )
     assert d.session.doc["layers"][1]["mask"] == {"kind": "texture", "path": "mask.png"}
     page.check(f'{top} .frow[data-name="invert"] input')
-    page.wait_for_function(
-        f"() => document.querySelector('{top} .frow[data-name=\"invert\"] input')?.checked",
+    page.wait_for_function(  # the server's answer, drawn: the summary says so
+        f"() => document.querySelector('{top} summary').textContent.includes('inverted')",
         timeout=WAIT_MS,
     )
     assert d.session.doc["layers"][1]["mask"]["invert"] is True
