@@ -162,7 +162,7 @@ function control(c, t) {
     const hexBox = el("input", { value: hex, name: "hex", size: 7, title: "sRGB hex (#rrggbb)", className: "hex" });
     hexBox.onchange = () => send(hexBox.value.trim(), "hex");
     const inputs = rgb.map((x, i) => el("input", {
-      type: "number", step: "any", value: Number(x).toFixed(4), name: `c${i}`, title: `linear ${"rgb"[i]}`,
+      type: "number", step: "any", value: x, name: `c${i}`, title: `linear ${"rgb"[i]}`,
     }));
     for (const inp of inputs) {
       inp.onchange = () => send(inputs.map((i) => Number(i.value)), inp.name);
@@ -279,7 +279,7 @@ function field(f, cur, set) {
   if (f.kind === "file") {
     const span = el("span", { className: "file" });
     const name = typeof cur === "string" ? cur : (cur ? `${cur.root}/${cur.path}` : "no file");
-    span.append(el("code", { textContent: name, title: name }),
+    span.append(el("code", { textContent: name.split("/").pop(), title: name }),
       el("button", { textContent: "choose…", name: `${f.name}-choose`,
         title: "Pick an image from the library folders", onclick: () => pickFile((ref) => set(ref)) }));
     return span;
@@ -306,6 +306,7 @@ function pickFile(onPick, where = {}) {
   if (old) old.remove();
   const dialog = el("div", { id: "picker", role: "dialog" });
   const close = el("button", { textContent: "close", onclick: () => dialog.remove() });
+  dialog.append(el("p", { textContent: "reading the library folders…" }), close);
   document.body.append(dialog);
   const show = async (root, path) => {
     let listing;
