@@ -2,7 +2,9 @@
 
 Usage: ``python scripts/designer_screenshots.py OUT_DIR [PRESET]`` writes ``page.png``
 (the whole page) and crops of the viewport, the parameters, the layer stack (its top
-layer's mask editor unfolded) and the library into OUT_DIR; ``docs/gallery/designer.png`` is ``page.png`` of ``rusty_iron``.
+layer's mask editor unfolded) and the library into OUT_DIR;
+``docs/gallery/designer.png`` is ``page.png`` of ``rusty_iron`` and
+``docs/gallery/designer_layers.png`` its ``layers.png``.
 """
 
 from __future__ import annotations
