@@ -74,6 +74,7 @@ __all__ = [
     "convert_codes",
     "to_working",
     "decode_hex",
+    "encode_hex",
     "luminance",
     "luminance_weights",
     "is_data",
@@ -364,6 +365,17 @@ def decode_hex(value: str, space: str = SRGB_TEXTURE) -> tuple[float, float, flo
     h = value.strip().lstrip("#")
     rgb = [int(h[i : i + 2], 16) / 255.0 for i in (0, 2, 4)]
     return tuple(float(x) for x in convert(rgb, space))
+
+
+def encode_hex(rgb: Any, space: str = SRGB_TEXTURE) -> str:
+    """Working-space linear RGB → ``"#rrggbb"`` encoded in ``space``: :func:`decode_hex`'s
+    inverse to 8 bits (a colour outside the encoding's 0..1 is clipped to its edge).
+
+    >>> encode_hex(decode_hex("#808080"))
+    '#808080'
+    """
+    encoded = np.clip(convert(np.asarray(rgb, np.float32), working_space(), space), 0.0, 1.0)
+    return "#" + "".join(f"{round(float(v) * 255.0):02x}" for v in encoded)
 
 
 @functools.cache

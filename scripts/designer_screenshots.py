@@ -1,8 +1,10 @@
 """Screenshots of the Material Designer in headless Chromium (Debian's, via playwright).
 
 Usage: ``python scripts/designer_screenshots.py OUT_DIR [PRESET]`` writes ``page.png``
-(the whole page) and crops of the viewport, the parameters, the layer stack and the
-library into OUT_DIR; ``docs/gallery/designer.png`` is ``page.png`` of ``rusty_iron``.
+(the whole page) and crops of the viewport, the parameters, the layer stack (its top
+layer's mask editor unfolded) and the library into OUT_DIR;
+``docs/gallery/designer.png`` is ``page.png`` of ``rusty_iron`` and
+``docs/gallery/designer_layers.png`` its ``layers.png``.
 """
 
 from __future__ import annotations
@@ -45,7 +47,9 @@ def main(out: Path, preset: str = "rusty_iron") -> None:
                     arg=SPP,
                     timeout=600_000,
                 )
-                time.sleep(20)  # the plot and the thumbnails
+                # the top layer's mask editor unfolded, as an artist edits it
+                page.click("#layers li:first-child details.mask summary")
+                time.sleep(20)  # the plot, the thumbnails and the mask preview
                 page.screenshot(path=str(out / "page.png"))
                 for name, selector in PARTS.items():
                     if page.locator(selector).is_visible():

@@ -30,7 +30,7 @@ from lookdev.library.preset import MODELS
 from lookdev.materials.params import Params, parse_color
 from lookdev.materials.textures import TextureInput, texturable
 
-__all__ = ["controls_for", "mask_kinds", "texture_fields"]
+__all__ = ["FILE_FIELDS", "controls_for", "form_field", "mask_kinds", "texture_fields"]
 
 PLAUSIBLE_MAX = 1.0
 """Slider end of a parameter whose schema allows more (Burley's "may be pushed beyond")."""
@@ -93,31 +93,87 @@ def _slider_max(low: float, high: float, default: Any) -> float:
     return min(high, top) if math.isfinite(high) else top
 
 
+FILE_FIELDS = ("texture", "path")
+"""Fields naming an image: drawn as the server's file picker (library folders only)."""
+
+
 @cache
 def texture_fields() -> list[dict[str, Any]]:
-    """Descriptors of a texture input's own fields (file, channel, colour space, …)."""
+    """Form descriptors of a texture input's own fields (file, channel, colour space, …)."""
     schema = TextureInput.model_json_schema()
+    required = set(schema.get("required", ()))
     return [
-        {"name": n, "doc": f.description or "", "default": _default(f)}
-        for n, f in TextureInput.model_fields.items()
+        form_field(n, schema["properties"][n], n in required)
+        for n in TextureInput.model_fields
         if n in schema["properties"]
     ]
 
 
 @cache
 def mask_kinds() -> dict[str, dict[str, Any]]:
-    """Every mask kind with its fields' schema (the masks' existing options)."""
+    """Every mask kind with form descriptors of its fields (the masks' existing options)."""
     from lookdev.materials.layers import mask_adapter
 
-    schema = mask_adapter().json_schema()
-    defs = schema.get("$defs", {})
     out = {}
-    for cls_schema in defs.values():
-        kind = cls_schema.get("properties", {}).get("kind", {})
-        name = kind.get("const") or (kind.get("enum") or [None])[0] or kind.get("default")
-        if name:
-            out[name] = {
-                "doc": cls_schema.get("description", ""),
-                "fields": {k: v for k, v in cls_schema["properties"].items() if k != "kind"},
-            }
+    for cls_schema in mask_adapter().json_schema().get("$defs", {}).values():
+        props = cls_schema.get("properties", {})
+        kind = props.get("kind", {})
+        names = kind.get("enum") or [kind.get("const") or kind.get("default")]
+        required = set(cls_schema.get("required", ())) - {"kind"}
+        fields = [form_field(k, v, k in required) for k, v in props.items() if k != "kind"]
+        for name in filter(None, names):
+            out[name] = {"doc": cls_schema.get("description", ""), "fields": fields}
     return out
+
+
+def form_field(name: str, prop: dict[str, Any], required: bool) -> dict[str, Any]:
+    """A control descriptor of one JSON-schema property: ``kind`` is one of ``number``,
+    ``switch``, ``choice``, ``text``, ``channel`` (an index or a name), ``pair`` (two
+    numbers), ``file``, ``space`` (an OCIO colour space), ``mask`` or ``masks`` (nested).
+
+    >>> form_field("wrap", {"enum": ["periodic", "clamp"], "default": "periodic"}, False)["kind"]
+    'choice'
+    >>> form_field("low", {"type": "number", "minimum": 0, "maximum": 1}, False)["max"]
+    1
+    """
+    out: dict[str, Any] = {
+        "name": name,
+        "title": name.replace("_", " "),
+        "doc": prop.get("description", ""),
+        "default": prop.get("default"),
+        "required": required,
+    }
+    options = prop.get("anyOf", [prop])
+    core = [p for p in options if p.get("type") != "null"]
+    out["optional"] = len(core) < len(options)
+    types = {p.get("type") for p in core}
+    first = core[0] if core else prop
+    if "oneOf" in prop or "$ref" in prop:
+        return out | {"kind": "mask"}
+    if first.get("type") == "array" and "oneOf" in first.get("items", {}):
+        return out | {"kind": "masks", "min_items": first.get("minItems", 0)}
+    if name in FILE_FIELDS:
+        return out | {"kind": "file"}
+    if name == "colorspace":
+        from lookdev.materials import colour
+
+        return out | {"kind": "space", "choices": colour.spaces()}
+    if types == {"integer", "string"}:
+        return out | {"kind": "channel"}
+    if first.get("type") == "boolean":
+        return out | {"kind": "switch"}
+    if "enum" in first or "const" in first:
+        return out | {"kind": "choice", "choices": list(first.get("enum", [first.get("const")]))}
+    if first.get("type") == "array" and "prefixItems" in first:
+        items = first["prefixItems"]
+        return out | {"kind": "pair", **_bounds(items[0]), "count": len(items)}
+    if first.get("type") in ("number", "integer"):
+        return out | {"kind": "number", "integer": first["type"] == "integer", **_bounds(first)}
+    return out | {"kind": "text"}
+
+
+def _bounds(prop: dict[str, Any]) -> dict[str, Any]:
+    return {
+        "min": prop.get("minimum", prop.get("exclusiveMinimum")),
+        "max": prop.get("maximum", prop.get("exclusiveMaximum")),
+    }

@@ -14,10 +14,13 @@ import os
 from pathlib import Path
 from typing import Any
 
-from lookdev.library.preset import check_name
+from lookdev.library.containment import texture_references
+from lookdev.library.preset import build_preset, check_name
 from lookdev.materials.errors import LookdevError
 
-__all__ = ["OPS", "EditRefused", "apply", "file_refs"]
+from .guard import PathRefused
+
+__all__ = ["OPS", "EditRefused", "apply", "check_new_files", "file_refs"]
 
 OPS = (
     "set",
@@ -117,3 +120,21 @@ def file_refs(value: Any, session: Any, base: Path) -> Any:
         real = session.roots.resolve(value["root"], value["path"])
         return Path(os.path.relpath(real, base)).as_posix()
     return {k: file_refs(v, session, base) for k, v in value.items()}
+
+
+def check_new_files(old: dict[str, Any], new: dict[str, Any], session: Any) -> None:
+    """Refuse a file ``new`` names as a plain path that ``old`` did not name and that lies
+    outside the session's folders: a path typed by hand reaches no further than one picked
+    by ``{"root", "path"}``. Checked before the schema's check opens any file; a document
+    the schema refuses is left to it."""
+    if session.roots is None:
+        return
+    try:
+        given = list(texture_references(build_preset(new, where="designer")))
+    except LookdevError:
+        return  # refused by the schema next, before a file is read
+    known = {w for _, w in texture_references(build_preset(old, where="designer"))}
+    base = session.base_folder()
+    for field, written in given:
+        if written not in known and session.roots.locate(base / written) is None:
+            raise PathRefused(f"{field}: {written!r} lies outside the library folders")

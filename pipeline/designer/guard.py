@@ -22,6 +22,7 @@ import os
 import secrets
 from collections.abc import Iterable
 from pathlib import Path
+from typing import Any
 
 from lookdev.materials.errors import LookdevError
 
@@ -105,17 +106,35 @@ class Roots:
                 return name, real.relative_to(base).as_posix()
         return None
 
-    def files(self, suffixes: Iterable[str]) -> list[tuple[str, str]]:
-        """Every file under the roots with one of ``suffixes`` (hidden ones skipped)."""
+    def listing(self, root: str, relative: str, suffixes: Iterable[str]) -> dict[str, Any]:
+        """One folder of the file picker: its sub-folders and files with ``suffixes``
+        (``relative`` empty for the root itself). Entries whose links lead out of the
+        root, and hidden ones, are left out: the picker never shows what it may not open."""
+        base = self.roots.get(root)
+        folder = self.resolve(root, relative) if relative else base
+        if folder is None:
+            raise PathRefused(f"unknown folder {root!r}; allowed: {', '.join(self.roots)}")
+        if not folder.is_dir():
+            raise PathRefused(f"{relative!r} is not a folder of {root}")
         wanted = tuple(s.lower() for s in suffixes)
-        out = []
-        for name, base in self.roots.items():
-            for folder, dirs, names in os.walk(base):
-                dirs[:] = sorted(d for d in dirs if not d.startswith("."))
-                for n in sorted(names):
-                    if n.lower().endswith(wanted) and not n.startswith("."):
-                        out.append((name, (Path(folder) / n).relative_to(base).as_posix()))
-        return out
+        dirs, files = [], []
+        for entry in sorted(folder.iterdir()):
+            real = Path(os.path.realpath(entry))
+            if entry.name.startswith(".") or not real.is_relative_to(base):
+                continue
+            name = entry.relative_to(base).as_posix()
+            if real.is_dir():
+                dirs.append(name)
+            elif entry.name.lower().endswith(wanted):
+                files.append(name)
+        up = folder.relative_to(base).parent.as_posix() if folder != base else None
+        return {
+            "root": root,
+            "path": relative,
+            "up": "" if up == "." else up,
+            "dirs": dirs,
+            "files": files,
+        }
 
 
 def _plain_parts(relative: str) -> list[str]:

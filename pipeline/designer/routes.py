@@ -20,7 +20,7 @@ from starlette.routing import Route
 
 from lookdev.materials.errors import LookdevError
 
-from . import library_panel, tasks
+from . import library_panel, previews, tasks
 from .controls import mask_kinds, texture_fields
 from .session import EditRefused
 
@@ -68,9 +68,18 @@ def routes(d: Any) -> list[Route]:
         )
         return FileResponse(path, media_type="image/png")
 
-    async def images(request: Request) -> Response:
-        found = await asyncio.to_thread(d.roots.files, IMAGE_SUFFIXES)
-        return JSONResponse([{"root": r, "path": p} for r, p in found])
+    async def browse(request: Request) -> Response:
+        q = request.query_params
+        root = q.get("root") or d.roots.names()[0]
+        listing = await asyncio.to_thread(d.roots.listing, root, q.get("path", ""), IMAGE_SUFFIXES)
+        return JSONResponse(listing | {"roots": d.roots.names()})
+
+    async def preview(request: Request) -> Response:
+        q = request.query_params
+        target = None if q.get("target", "") in ("", "null") else int(q["target"])
+        mask = await asyncio.to_thread(previews.mask_of, d.session, target, q.get("field", ""))
+        data = await asyncio.to_thread(previews.preview_png, mask)
+        return Response(data, media_type="image/png", headers={"Cache-Control": "no-store"})
 
     async def files(request: Request) -> Response:
         path = d.roots.resolve(request.path_params["root"], request.path_params["path"])
@@ -140,7 +149,8 @@ def routes(d: Any) -> list[Route]:
         ("/api/meta", meta, ["GET"]),
         ("/api/library", library, ["GET"]),
         ("/api/thumbnail/{name}.png", thumbnail, ["GET"]),
-        ("/api/images", images, ["GET"]),
+        ("/api/browse", browse, ["GET"]),
+        ("/api/preview.png", preview, ["GET"]),
         ("/files/{root}/{path:path}", files, ["GET"]),
         ("/api/edit", edit, ["POST"]),
         ("/api/undo", undo, ["POST"]),

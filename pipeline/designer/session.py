@@ -30,7 +30,7 @@ from lookdev.library.preset import MODELS, build_preset, preset_document
 from lookdev.materials.errors import LookdevError
 
 from . import saving
-from .edits import EditRefused, apply
+from .edits import EditRefused, apply, check_new_files
 
 __all__ = ["BLEND_RESOLUTION", "EditRefused", "Session"]
 
@@ -184,7 +184,11 @@ class Session:
         for key, value in overrides.items():
             values[key] = value
         if model in MODELS:
-            constants = {k: v for k, v in values.items() if not isinstance(v, dict)}
+            # unset optionals out: a dump holds ``ior = None`` beside ``specular``, and the
+            # model refuses the pair (then overrides such as a hex colour stayed raw)
+            constants = {
+                k: v for k, v in values.items() if not isinstance(v, dict) and v is not None
+            }
             constants = {k: list(v) if isinstance(v, tuple) else v for k, v in constants.items()}
             try:
                 canon = MODELS[model].model_validate(_plain(constants)).model_dump(mode="json")
@@ -193,20 +197,28 @@ class Session:
                 }
             except Exception:  # a stored document always validates; keep the raw values
                 pass
+        values = _jsonable(values)
         return {
             "index": index,
             "label": label,
             "model": model,
-            "values": _jsonable(values),
+            "values": values,
+            "hex": _hexes(model, values),
             "base": _jsonable(base),
             "overridden": sorted(overrides),
         }
+
+    def target_values(self, index: int | None) -> dict[str, Any]:
+        """The values ``index`` (None: the preset's own parameters) shows, maps included."""
+        with self.lock:
+            return self._target(index, None)["values"]
 
     # -- editing ---------------------------------------------------------------------------
     def edit(self, op: dict[str, Any]) -> None:
         """Apply one edit (see :func:`.edits.apply`); refused edits raise :class:`EditRefused`."""
         with self.lock:
             candidate = apply(copy.deepcopy(self.doc), op, self)
+            check_new_files(self.doc, candidate, self)  # before any file is opened
             self._check(candidate)
             self._push(candidate, self.path, self.parent_name)
 
@@ -288,6 +300,18 @@ def _defaults(model: str | None) -> dict[str, Any]:
     if model not in MODELS:
         return {}
     return MODELS[model]().model_dump(mode="json")
+
+
+def _hexes(model: str | None, values: dict[str, Any]) -> dict[str, str]:
+    """``"#rrggbb"`` (sRGB) of each constant colour, for the page's colour picker."""
+    from lookdev.materials import colour
+
+    from .controls import controls_for
+
+    if model not in MODELS:
+        return {}
+    colours = [c["name"] for c in controls_for(model) if c["kind"] == "colour"]
+    return {k: colour.encode_hex(values[k]) for k in colours if isinstance(values.get(k), list)}
 
 
 def _plain(values: dict[str, Any]) -> dict[str, Any]:

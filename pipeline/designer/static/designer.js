@@ -14,7 +14,7 @@ const el = (tag, props = {}, ...children) => {
 let state = null;
 let meta = null;
 let library = [];
-let images = [];
+let openMasks = new Set(); // layers whose mask editor is unfolded
 let target = null; // null: the preset's own parameters; an index: a layer
 let plotView = "slice";
 let frames = { A: null, B: null };
@@ -153,14 +153,21 @@ function control(c, t) {
     };
     row.append(range, num);
   } else if (c.kind === "colour") {
+    // linear working-space values (what the model takes) and their sRGB hex (what a
+    // picker shows); the server converts both ways, so the page holds no colour formula
     const rgb = Array.isArray(value) ? value : c.default;
-    const inputs = rgb.map((x, i) => el("input", { type: "number", step: "any", value: x, name: `c${i}` }));
+    const hex = (t.hex || {})[c.name] || "#000000";
+    const picker = el("input", { type: "color", value: hex, title: "pick an sRGB colour", name: "picker" });
+    picker.onchange = () => send(picker.value, "picker");
+    const hexBox = el("input", { value: hex, name: "hex", size: 7, title: "sRGB hex (#rrggbb)", className: "hex" });
+    hexBox.onchange = () => send(hexBox.value.trim(), "hex");
+    const inputs = rgb.map((x, i) => el("input", {
+      type: "number", step: "any", value: x, name: `c${i}`, title: `linear ${"rgb"[i]}`,
+    }));
     for (const inp of inputs) {
       inp.onchange = () => send(inputs.map((i) => Number(i.value)), inp.name);
     }
-    const picker = el("input", { type: "color", title: "pick an sRGB colour (#rrggbb)", name: "picker" });
-    picker.onchange = () => send(picker.value, "picker");
-    row.append(...inputs, picker);
+    row.append(picker, hexBox, el("span", { className: "unit", textContent: "linear" }), ...inputs);
   } else if (c.kind === "switch") {
     const box = el("input", { type: "checkbox", checked: !!value, name: "switch" });
     box.onchange = () => send(box.checked, "switch");
@@ -174,7 +181,8 @@ function control(c, t) {
   if (c.texturable && !(value && typeof value === "object" && !Array.isArray(value))) {
     row.append(el("button", {
       textContent: "map…", title: "Drive this parameter by a texture",
-      onclick: () => pickTexture(c, t, null),
+      onclick: () => pickFile((ref) => edit({ op: "set", target: t.index, field: c.name, value: { texture: ref } })
+        .then((m) => m && say(m, true))),
     }));
   }
   wrap.append(row, error);
@@ -182,39 +190,190 @@ function control(c, t) {
 }
 
 function textureRow(c, t, tex) {
-  const row = el("div", { className: "row" });
-  row.append(el("span", {
-    className: "map",
-    textContent: `map ${tex.texture} · channel ${tex.channel ?? "auto"} · ${tex.colorspace ?? "by file rules"}`,
-  }));
-  row.append(el("button", { textContent: "swap…", onclick: () => pickTexture(c, t, tex) }));
+  // the map driving a parameter: its file, channel, colour space and the rest of the
+  // texture input's schema, a preview of the channel read, and "constant" to drop it
+  const box = el("div", { className: "map-editor" });
+  const error = el("div", { className: "error" });
+  const commit = async (v, input) => {
+    const message = await edit({ op: "set", target: t.index, field: c.name, value: v });
+    if (message) { error.textContent = message; if (input) input.classList.add("invalid"); }
+  };
   const constant = Array.isArray(c.default) || typeof c.default === "number" ? c.default : 0.5;
-  row.append(el("button", {
-    textContent: "constant", title: "Replace the map by a constant",
-    onclick: () => edit({ op: "set", target: t.index, field: c.name, value: constant }),
+  const head = el("div", { className: "row" });
+  if (!String(tex.texture).includes("<UDIM>")) head.append(preview(t.index, c.name));
+  head.append(el("button", {
+    textContent: "constant", title: "Replace the map by a constant (the default)",
+    onclick: () => commit(constant),
   }));
-  return row;
+  box.append(head, form(meta.texture_fields, tex, commit), error);
+  return box;
 }
 
-function pickTexture(c, t, tex) {
-  const sel = el("select");
-  sel.append(el("option", { textContent: "choose an image…", value: "" }));
-  images.forEach((im, i) => sel.append(el("option", { value: i, textContent: `${im.root}/${im.path}` })));
-  const box = document.querySelector(`.control[data-field="${c.name}"] .row`);
-  box.append(sel);
-  sel.onchange = async () => {
-    if (sel.value === "") return;
-    const value = Object.assign({}, tex || {}, { texture: images[Number(sel.value)] });
-    const message = await edit({ op: "set", target: t.index, field: c.name, value });
-    if (message) say(message, true);
+function preview(target, field) {
+  const q = `target=${target === null ? "" : target}&field=${encodeURIComponent(field)}&v=${state.version}`;
+  return el("img", { className: "preview", src: `api/preview.png?${q}`, alt: `${field} preview`,
+    title: "as the blend reads it: 0 black, 1 white" });
+}
+
+// -- forms from the server's field descriptors (controls.form_field) ---------------------
+// `value` is the object edited; `commit(next, input)` sends the whole new object and
+// shows a refusal beside the form (nothing is applied then).
+function form(fields, value, commit) {
+  const box = el("div", { className: "form" });
+  for (const f of fields) {
+    const row = el("div", { className: "frow", title: f.doc });
+    row.dataset.name = f.name;
+    const set = (v, input) => {
+      const next = Object.assign({}, value);
+      if (v === undefined) delete next[f.name]; else next[f.name] = v;
+      commit(next, input);
+    };
+    row.append(el("label", { textContent: f.title }), field(f, value[f.name], set));
+    box.append(row);
+  }
+  return box;
+}
+
+function numberOrText(text) {
+  const x = text.trim();
+  return x === "" ? undefined : (Number.isNaN(Number(x)) ? x : Number(x));
+}
+
+function field(f, cur, set) {
+  const shown = cur ?? f.default;
+  if (f.kind === "number" || f.kind === "channel" || f.kind === "text") {
+    const inp = el("input", { value: shown ?? "", name: f.name, size: 8,
+      placeholder: f.kind === "channel" ? "index or name" : "" });
+    if (f.kind === "number") Object.assign(inp, { type: "number", step: f.integer ? 1 : "any" });
+    if (f.min !== null && f.min !== undefined) inp.min = f.min;
+    if (f.max !== null && f.max !== undefined) inp.max = f.max;
+    inp.onchange = () => set(f.kind === "text" ? inp.value : numberOrText(inp.value), inp);
+    return inp;
+  }
+  if (f.kind === "switch") {
+    const inp = el("input", { type: "checkbox", checked: !!shown, name: f.name });
+    inp.onchange = () => set(inp.checked, inp);
+    return inp;
+  }
+  if (f.kind === "choice" || f.kind === "space") {
+    const sel = el("select", { name: f.name });
+    if (f.optional) sel.append(el("option", { value: "", textContent: f.kind === "space" ? "by file rule" : "—" }));
+    for (const ch of f.choices) sel.append(el("option", { value: ch, textContent: ch, selected: ch === shown }));
+    sel.onchange = () => set(sel.value === "" ? undefined : sel.value, sel);
+    return sel;
+  }
+  if (f.kind === "pair") {
+    const span = el("span", { className: "pair" });
+    const vals = Array.isArray(shown) ? shown : [];
+    const inputs = [0, 1].map((i) => el("input", { type: "number", step: "any", value: vals[i] ?? "",
+      name: `${f.name}${i}`, size: 5 }));
+    for (const inp of inputs) {
+      inp.onchange = () => {
+        const v = inputs.map((x) => numberOrText(x.value));
+        set(v.every((x) => x === undefined) ? undefined : v, inp);
+      };
+    }
+    span.append(...inputs);
+    return span;
+  }
+  if (f.kind === "file") {
+    const span = el("span", { className: "file" });
+    const name = typeof cur === "string" ? cur : (cur ? `${cur.root}/${cur.path}` : "no file");
+    span.append(el("code", { textContent: name.split("/").pop(), title: name }),
+      el("button", { textContent: "choose…", name: `${f.name}-choose`,
+        title: "Pick an image from the library folders", onclick: () => pickFile((ref) => set(ref)) }));
+    return span;
+  }
+  if (f.kind === "mask") return maskEditor(cur, (m) => set(m));
+  if (f.kind === "masks") {
+    const list = el("div", { className: "masks" });
+    const items = Array.isArray(cur) ? cur : [];
+    items.forEach((m, i) => {
+      const drop = el("button", { textContent: "✕", title: "remove this input", disabled: items.length <= (f.min_items || 0),
+        onclick: () => set(items.filter((_, k) => k !== i)) });
+      list.append(el("div", { className: "mask-item" },
+        maskEditor(m, (v) => set(items.map((x, k) => (k === i ? v : x)))), drop));
+    });
+    list.append(el("button", { textContent: "+ input", onclick: () => set([...items, { kind: "constant", value: 1 }]) }));
+    return list;
+  }
+  return el("span", { textContent: JSON.stringify(cur) });
+}
+
+// -- the file picker: folders of the library path and the session, through the server ----
+function pickFile(onPick, where = {}) {
+  const old = document.getElementById("picker");
+  if (old) old.remove();
+  const dialog = el("div", { id: "picker", role: "dialog" });
+  const close = el("button", { textContent: "close", onclick: () => dialog.remove() });
+  dialog.append(el("p", { textContent: "reading the library folders…" }), close);
+  document.body.append(dialog);
+  const show = async (root, path) => {
+    let listing;
+    try {
+      listing = await api(`api/browse?root=${encodeURIComponent(root || "")}&path=${encodeURIComponent(path || "")}`);
+    } catch (e) { dialog.replaceChildren(el("p", { className: "error", textContent: e.message }), close); return; }
+    const roots = el("select", { name: "root" });
+    for (const r of listing.roots) roots.append(el("option", { value: r, textContent: r, selected: r === listing.root }));
+    roots.onchange = () => show(roots.value, "");
+    const entries = el("ul");
+    if (listing.up !== null) {
+      entries.append(el("li", { className: "dir" }, el("button", { textContent: "⬑ ..", onclick: () => show(listing.root, listing.up) })));
+    }
+    for (const d of listing.dirs) {
+      entries.append(el("li", { className: "dir" }, el("button", { textContent: `▸ ${d.split("/").pop()}/`,
+        onclick: () => show(listing.root, d) })));
+    }
+    for (const f of listing.files) {
+      const b = el("button", { textContent: f.split("/").pop(), className: "pick", title: `${listing.root}/${f}`,
+        onclick: () => { dialog.remove(); onPick({ root: listing.root, path: f }); } });
+      b.dataset.path = f;
+      entries.append(el("li", {}, b));
+    }
+    if (!listing.dirs.length && !listing.files.length) entries.append(el("li", { textContent: "no images here" }));
+    dialog.replaceChildren(el("div", { className: "row" }, el("strong", { textContent: "Choose an image" }), roots,
+      el("code", { textContent: `/${listing.path}` }), close), entries);
   };
+  show(where.root, where.path);
 }
 
 // -- layers ------------------------------------------------------------------------------
-function maskText(m) {
-  if (m === undefined || m === null) return "mask: full";
-  if (typeof m === "number") return `mask: ${m}`;
-  return "mask: " + JSON.stringify(m);
+function asMask(m) {
+  if (m === undefined || m === null) return { kind: "constant", value: 1 };
+  return typeof m === "number" ? { kind: "constant", value: m } : m;
+}
+
+function maskSummary(m) {
+  m = asMask(m);
+  if (m.kind === "constant") return `constant ${m.value ?? 1}`;
+  if (m.kind === "texture") return `texture ${m.path}${m.invert ? " (inverted)" : ""}`;
+  const inner = m.input ? ` of ${maskSummary(m.input)}` : (m.inputs ? ` of ${m.inputs.length}` : "");
+  return m.kind + inner;
+}
+
+// A mask of any kind with its schema's fields; a kind that wraps others (invert, levels,
+// multiply, …) keeps the mask it replaces as its input, so masks are built up in place.
+function maskEditor(mask, commit) {
+  mask = asMask(mask);
+  const box = el("div", { className: "mask-editor" });
+  const kind = el("select", { name: "mask-kind", title: meta.masks[mask.kind]?.doc || "" });
+  for (const k of Object.keys(meta.masks)) kind.append(el("option", { value: k, textContent: k, selected: k === mask.kind }));
+  kind.onchange = () => {
+    const k = kind.value;
+    const fields = meta.masks[k].fields;
+    const next = { kind: k };
+    if (fields.some((f) => f.kind === "mask")) next.input = mask;
+    if (fields.some((f) => f.kind === "masks")) next.inputs = [mask];
+    if (fields.some((f) => f.kind === "file" && f.required)) {
+      pickFile((ref) => commit(Object.assign(next, { path: ref })));
+      kind.value = mask.kind; // unchanged until an image is chosen
+      return;
+    }
+    commit(next);
+  };
+  box.append(el("div", { className: "row" }, el("label", { textContent: "kind" }), kind),
+    form(meta.masks[mask.kind].fields, mask, commit));
+  return box;
 }
 
 function drawLayers() {
@@ -232,7 +391,7 @@ function drawLayers() {
     const eye = el("input", { type: "checkbox", checked: !hidden, title: "show this layer" });
     eye.onchange = async () => refresh(await api("api/hide", { index: i, hidden: !eye.checked }));
     const label = el("span", {
-      textContent: ` ${i}: ${la.name || la.preset || la.model}`, style: "cursor:pointer",
+      className: "layer-name", textContent: ` ${i}: ${la.name || la.preset || la.model}`,
       onclick: () => { target = i; refresh(state); },
     });
     const up = el("button", { textContent: "↑", disabled: i === layers.length - 1, title: "move up",
@@ -241,14 +400,7 @@ function drawLayers() {
       onclick: () => edit({ op: "layer_move", index: i, to: i - 1 }) });
     const del = el("button", { textContent: "✕", title: "delete the layer",
       onclick: () => edit({ op: "layer_remove", index: i }) });
-    const mask = el("textarea", { className: "mask-json", value: JSON.stringify(la.mask ?? 1.0) });
     const error = el("div", { className: "error" });
-    mask.onchange = async () => {
-      let parsed;
-      try { parsed = JSON.parse(mask.value); } catch (e) { error.textContent = `not JSON: ${e.message}`; return; }
-      const message = await edit({ op: "layer_mask", index: i, mask: parsed });
-      if (message) { error.textContent = message; mask.classList.add("invalid"); }
-    };
     const presence = el("input", { type: "number", step: "any", value: la.presence ?? 1, title:
       "presence (Pixar layers: opacity, 0..1)", style: "width:56px" });
     presence.onchange = async () => {
@@ -256,26 +408,30 @@ function drawLayers() {
       if (message) { error.textContent = message; presence.classList.add("invalid"); }
     };
     const pixar = (state.targets[i] || {}).model === "pixar";
-    li.append(eye, label, " ", up, down, del, ...(pixar ? [" presence ", presence] : []),
-      el("span", { className: "mask", textContent: maskText(la.mask) }), mask, error);
+    const mask = el("details", { className: "mask", open: openMasks.has(i) });
+    mask.ontoggle = () => (mask.open ? openMasks.add(i) : openMasks.delete(i));
+    const commit = async (m, input) => {
+      const message = await edit({ op: "layer_mask", index: i, mask: m });
+      if (message) {
+        const shown = list.querySelector(`li[data-index="${i}"] .error`) || error;
+        shown.textContent = message;
+        if (input) input.classList.add("invalid");
+      }
+    };
+    mask.append(el("summary", {}, preview(i, "mask"), el("span", { textContent: ` mask: ${maskSummary(la.mask)}` })),
+      maskEditor(la.mask, commit));
+    li.append(el("div", { className: "row" }, eye, label, up, down, del, ...(pixar ? [" presence ", presence] : [])),
+      mask, error);
     list.append(li);
   }
 }
 
-function maskTemplate(kind) {
-  if (kind === "none") return null;
-  if (kind === "texture") {
-    const im = images.find((x) => !/\.(exr|hdr)$/i.test(x.path)) || images[0];
-    return { kind: "texture", path: im, channel: 0 };
-  }
-  return { kind };
-}
-
 async function addLayer() {
   const preset = $("add-preset").value;
-  const mask = maskTemplate($("add-mask-kind").value);
-  const message = await edit({ op: "layer_add", preset, mask });
-  if (message) say(message, true);
+  const message = await edit({ op: "layer_add", preset });
+  if (message) { say(message, true); return; }
+  openMasks.add(state.doc.layers.length - 1); // the new layer's mask editor, ready to use
+  drawLayers();
 }
 
 // -- library -----------------------------------------------------------------------------
@@ -465,9 +621,6 @@ function setup() {
     b.classList.toggle("on", v === plotView);
     $("plot-tabs").append(b);
   }
-  for (const k of ["none", ...Object.keys(meta.masks)]) {
-    $("add-mask-kind").append(el("option", { value: k, textContent: k === "none" ? "no mask" : `${k} mask` }));
-  }
   document.addEventListener("keydown", (e) => {
     if ((e.ctrlKey || e.metaKey) && e.key.toLowerCase() === "z") {
       e.preventDefault();
@@ -482,7 +635,6 @@ function setup() {
 
 (async () => {
   meta = await api("api/meta");
-  images = await api("api/images");
   setup();
   await refresh();
   connect();

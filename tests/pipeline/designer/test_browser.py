@@ -1,6 +1,7 @@
 """The designer in headless Chromium (Debian's, driven by playwright): a slider changes the
 viewport's pixels, an out-of-range value is refused in place, dragging rotates the IBL, a
-layer with a mask goes into a new layered preset, both presets are saved and read back
+layer with a texture mask (picked, inverted, previewed through the mask controls) goes
+into a new layered preset, both presets are saved and read back
 with ``lookdev presets show --resolved``; no console errors on the way.
 
 ``LOOKDEV_DESIGNER_SCREENSHOTS=DIR`` also saves the page at each step into DIR.
@@ -111,6 +112,8 @@ def _differ(a: np.ndarray, b: np.ndarray) -> float:
 
 def test_the_designer_in_chromium(page_on_gold, user_library, cli):
     d, page, problems, frames = page_on_gold
+    ramp = np.tile(np.linspace(0, 255, 16, dtype=np.uint8), (16, 1))
+    Image.fromarray(ramp).save(user_library / "mask.png")  # the layer's mask, picked below
     first = frames.first_pass(page)
     _shot(page, "opened")
 
@@ -170,10 +173,27 @@ def test_the_designer_in_chromium(page_on_gold, user_library, cli):
     page.click("#new-layered")
     page.wait_for_selector("#layers li", timeout=WAIT_MS)
     page.select_option("#add-preset", "rust")
-    page.select_option("#add-mask-kind", "noise")
     page.click("#add-layer-btn")
     page.wait_for_function(
         "() => document.querySelectorAll('#layers li').length === 2", timeout=WAIT_MS
+    )
+    # its mask through the mask controls: a texture picked in the library, inverted
+    top = '#layers li[data-index="1"]'
+    page.select_option(f'{top} select[name="mask-kind"]', "texture")
+    page.click('#picker button.pick[data-path="mask.png"]')
+    page.wait_for_function(
+        f"() => document.querySelector('{top} .frow[data-name=\"invert\"] input')",
+        timeout=WAIT_MS,
+    )
+    assert d.session.doc["layers"][1]["mask"] == {"kind": "texture", "path": "mask.png"}
+    page.check(f'{top} .frow[data-name="invert"] input')
+    page.wait_for_function(  # the server's answer, drawn: the summary says so
+        f"() => document.querySelector('{top} summary').textContent.includes('inverted')",
+        timeout=WAIT_MS,
+    )
+    assert d.session.doc["layers"][1]["mask"]["invert"] is True
+    page.wait_for_function(  # the preview of the mask, as the blend reads it
+        f"() => document.querySelector('{top} img.preview').naturalWidth > 0", timeout=WAIT_MS
     )
     page.wait_for_timeout(3000)
     _shot(page, "layers")
@@ -193,7 +213,7 @@ def test_the_designer_in_chromium(page_on_gold, user_library, cli):
     layered = tomllib.loads((user_library / "my_layers.toml").read_text())
     assert layered["model"] == "layered"
     assert [la["preset"] for la in layered["layers"]] == ["my_gold", "rust"]
-    assert layered["layers"][1]["mask"]["kind"] == "noise"
+    assert layered["layers"][1]["mask"] == {"kind": "texture", "path": "mask.png", "invert": True}
     shown = cli("presets", "show", "my_layers", "--resolved", "-L", str(user_library))
     assert shown.code == 0, shown.err
     assert "my_gold" in shown.out and "rust" in shown.out

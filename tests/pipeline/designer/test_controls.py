@@ -46,6 +46,29 @@ def test_ranges_are_the_schemas(model):
 
 def test_masks_and_textures_are_described():
     kinds = mask_kinds()
-    assert {"constant", "texture", "noise", "ramp", "levels", "invert"} <= set(kinds)
-    assert "scale" in kinds["noise"]["fields"]
-    assert {f["name"] for f in texture_fields()} >= {"texture", "channel", "colorspace"}
+    assert {"constant", "texture", "noise", "ramp", "levels", "invert", "multiply"} <= set(kinds)
+    fields = {k: {f["name"]: f for f in v["fields"]} for k, v in kinds.items()}
+    assert fields["noise"]["scale"]["kind"] == "number" and fields["noise"]["scale"]["max"] == 4096
+    assert fields["noise"]["octaves"]["integer"] and fields["noise"]["octaves"]["min"] == 1
+    tex = fields["texture"]
+    assert (tex["path"]["kind"], tex["path"]["required"]) == ("file", True)
+    assert tex["channel"]["kind"] == "channel" and tex["invert"]["kind"] == "switch"
+    assert tex["wrap"]["choices"] == ["periodic", "clamp", "black", "mirror"]
+    assert tex["uv_scale"]["kind"] == "pair" and tex["uv_scale"]["default"] == [1.0, 1.0]
+    assert fields["invert"]["input"]["kind"] == "mask"
+    assert fields["multiply"]["inputs"]["kind"] == "masks"
+    assert fields["multiply"] == fields["screen"]  # one schema, four kinds
+    for kind, spec in kinds.items():
+        assert spec["doc"], kind
+        assert all(f["doc"] or f["kind"] == "mask" for f in spec["fields"]), kind
+
+
+def test_a_texture_input_is_described():
+    from lookdev.materials import colour
+
+    fields = {f["name"]: f for f in texture_fields()}
+    assert fields["texture"]["kind"] == "file" and fields["texture"]["required"]
+    assert fields["colorspace"]["kind"] == "space" and fields["colorspace"]["optional"]
+    assert fields["colorspace"]["choices"] == colour.spaces()
+    assert fields["range"]["kind"] == "pair" and fields["range"]["optional"]
+    assert fields["scale"]["default"] == 1.0

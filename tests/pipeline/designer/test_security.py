@@ -149,3 +149,56 @@ def test_guard_compares_the_whole_token():
     g = Guard("abcdef", port=1)
     assert not g.token_ok("abcde") and not g.token_ok("abcdefg") and not g.token_ok(None)
     assert g.check({"host": "127.0.0.1:1"}, "abcdef") is None
+
+
+@pytest.mark.parametrize("path", TRAVERSALS)
+def test_the_file_picker_stays_inside_its_folders(client, designer, path):
+    os.symlink("/etc", designer.folder / "out")
+    r = client.get(f"/{designer.token}/api/browse", params={"root": "session", "path": path})
+    assert r.status_code == 422 and set(r.json()) == {"error"}  # no listing of anything
+
+
+def test_the_file_picker_lists_only_what_it_may_open(client, designer):
+    os.symlink("/etc", designer.folder / "out")
+    os.symlink("/etc/hosts", designer.folder / "hosts.png")
+    (designer.folder / "exports" / "mask.png").write_bytes(b"")
+    r = client.get(f"/{designer.token}/api/browse", params={"root": "session"})
+    assert r.status_code == 200
+    listing = r.json()
+    assert "out" not in listing["dirs"] and "hosts.png" not in listing["files"]
+    assert "exports" in listing["dirs"] and listing["up"] is None
+    where = {"root": "session", "path": "exports"}
+    inner = client.get(f"/{designer.token}/api/browse", params=where)
+    assert inner.json()["files"] == ["exports/mask.png"] and inner.json()["up"] == ""
+    other = client.get(f"/{designer.token}/api/browse", params={"root": "nowhere"})
+    assert other.status_code == 422 and "unknown folder" in other.json()["error"]
+
+
+@pytest.mark.parametrize("path", ["/etc/passwd", "../../../../etc/passwd", "out/hosts"])
+def test_a_typed_path_cannot_point_outside(client, designer, user_library, path):
+    """A mask or map path sent as plain text reaches no further than a picked one (a new
+    preset's relative paths start from the library it will be saved in)."""
+    os.symlink("/etc", user_library / "out")
+    t = designer.token
+    assert client.post(f"/{t}/api/new_layered", json={"name": "typed"}).status_code == 200
+    op = {"op": "layer_add", "preset": "rust", "mask": {"kind": "texture", "path": path}}
+    r = client.post(f"/{t}/api/edit", json=op)
+    assert r.status_code == 422, r.text
+    assert len(designer.session.doc["layers"]) == 1
+    op = {"op": "set", "target": 0, "field": "roughness", "value": {"texture": path}}
+    r = client.post(f"/{t}/api/edit", json=op)
+    assert r.status_code == 422 and "outside" in r.json()["error"], r.text  # no file opened
+    assert "roughness" not in designer.session.doc["layers"][0].get("params", {})
+
+
+def test_a_preview_reads_only_the_document(client, designer):
+    t = designer.token
+    r = client.get(f"/{t}/api/preview.png", params={"target": "", "field": "roughness"})
+    assert r.status_code == 422 and "not driven by a map" in r.json()["error"]
+    assert client.post(f"/{t}/api/new_layered", json={"name": "p"}).status_code == 200
+    op = {"op": "layer_add", "preset": "rust", "mask": {"kind": "ramp", "axis": "v"}}
+    assert client.post(f"/{t}/api/edit", json=op).status_code == 200
+    r = client.get(f"/{t}/api/preview.png", params={"target": 1, "field": "mask"})
+    assert r.status_code == 200 and r.headers["content-type"] == "image/png"
+    r = client.get(f"/{t}/api/preview.png", params={"target": 7, "field": "mask"})
+    assert r.status_code == 422

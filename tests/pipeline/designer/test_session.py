@@ -264,3 +264,41 @@ def test_a_layer_mask_from_a_texture(user_library):
     doc = tomllib.loads(path.read_text())
     assert doc["layers"][1]["mask"] == {"kind": "texture", "path": "mask.png"}
     assert Library([user_library], use_env=False).load("masked").layers[1].material.name == "rust"
+
+
+def test_a_mask_preview_is_the_blends_own_evaluation(user_library):
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    from lookdev.pipeline.designer.guard import Roots
+    from lookdev.pipeline.designer.previews import PREVIEW_PX, mask_of, preview_png
+
+    _grey_png(user_library / "mask.png", None)  # a ramp along u, 0 .. 255
+    s = Session(
+        Library([user_library], use_env=False), "gold", roots=Roots({"library0": user_library})
+    )
+    s.save_new("base")
+    s.replace({"name": "untitled", "model": "layered", "layers": [{"preset": "gold"}]})
+    ref = {"root": "library0", "path": "mask.png"}
+    mask = {"kind": "texture", "path": ref, "wrap": "clamp"}
+    s.edit({"op": "layer_add", "preset": "rust", "mask": mask})
+    grey = np.asarray(Image.open(io.BytesIO(preview_png(mask_of(s, 1, "mask")))))
+    assert grey.shape == (PREVIEW_PX, PREVIEW_PX)
+    assert grey[:, 0].max() < 40 and grey[:, -1].min() > 215  # dark at u = 0, light at u = 1
+    s.edit({"op": "layer_mask", "index": 1, "mask": {**s.doc["layers"][1]["mask"], "invert": True}})
+    inverted = np.asarray(Image.open(io.BytesIO(preview_png(mask_of(s, 1, "mask")))))
+    assert np.abs(inverted.astype(int) + grey - 255).max() <= 1
+    ramp = {"kind": "ramp", "axis": "v"}  # v runs up the image: the top row is v ≈ 1
+    s.edit({"op": "layer_mask", "index": 1, "mask": ramp})
+    up = np.asarray(Image.open(io.BytesIO(preview_png(mask_of(s, 1, "mask")))))
+    assert up[0].mean() > 215 and up[-1].mean() < 40
+
+
+def test_a_colour_shows_its_hex(user_library):
+    s = Session(Library([user_library], use_env=False), "gold")
+    _set(s, "base_color", "#808080")
+    shown = s.state()["targets"][0]
+    assert shown["hex"]["base_color"] == "#808080"
+    assert shown["values"]["base_color"][0] == pytest.approx(0.2158605, abs=1e-5)
