@@ -12,7 +12,8 @@ At 480×270 unless stated, on the proof scene under ``studio``:
 ``designer_converge``
     designer mode, after an edit: seconds of refinement until the material's pixels
     reach relative MSE ≤ 0.01 against the same material refined to 1024 samples per pixel
-    (its own reference), and the samples that took. Target ≤ 2 s.
+    (its own reference), the samples that took, and the relMSE after each pass
+    (``trajectory``: wall s, CPU s, spp, relMSE). Target ≤ 2 s.
 ``truth_edit``
     truth mode, an edit → the first frame (JPEG included): median over random edits. Target ≤ 0.4 s.
 ``truth_compiles``
@@ -181,18 +182,20 @@ def designer_converge(start: Any, size: tuple[int, int], target: float) -> dict[
     view.step()
     view.update_material(_hub(start))
     elapsed = cpu = 0.0
-    error, frame = np.inf, engine_frame
+    error, frame, trajectory = np.inf, engine_frame, []
     while error > target and not frame.converged:
         frame, w, c = _timed(view.step)
         elapsed += w
         cpu += c
         error = relative_mse(frame.rgb, reference, mask)
+        trajectory.append([round(elapsed, 4), round(cpu, 4), frame.spp, float(error)])
     view.close()
     return {
         "seconds": elapsed,
         "cpu_s": cpu,
         "spp": frame.spp,
         "rel_mse": error,
+        "trajectory": trajectory,
         "target_rel_mse": target,
         "reference_spp": 1024,
         "target_s": 2.0,
