@@ -4,8 +4,9 @@ At 480×270 unless stated, on the proof scene under ``studio``:
 
 ``designer_edit``
     designer mode, a parameter edit → the first updated frame as the page receives it
-    (its display through the OCIO view and its JPEG included): median and 90th percentile over random edits of one to three
-    continuous parameters (lobe switches among them), wall and CPU seconds. Target ≤ 0.15 s.
+    (its display through the OCIO view and its JPEG included): median and 90th
+    percentile over random edits of one to three continuous parameters (lobe switches
+    among them), wall and CPU seconds. Target ≤ 0.15 s.
 ``ibl_rotation``
     designer mode at 240×135: IBL rotations (each followed by the frame it makes, as a
     JPEG) per second. Target ≥ 10.

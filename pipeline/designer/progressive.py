@@ -51,9 +51,7 @@ class Part:
         self.passes = 0
         self._noise: tuple[int, float | None] = (-self.layers, None)
 
-    def add(
-        self, rgb: np.ndarray, layer: int, spp: int, pixels: np.ndarray | None = None
-    ) -> None:
+    def add(self, rgb: np.ndarray, layer: int, spp: int, pixels: np.ndarray | None = None) -> None:
         """Add a pass of ``spp`` samples per pixel at sub-pixel position ``layer``:
         ``rgb`` (N, 3), the mean of its samples at ``pixels`` (N distinct flat indices;
         None: every pixel in order, added in place without an index)."""
