@@ -144,7 +144,9 @@ def _samples(seed: Any, base: Any, n: int, spp: int, dims: int) -> list[Any]:
 
     i = dr.arange(mi.UInt32, n * spp)
     index = base + i % spp
-    rng = mi.PCG32(n * spp, mi.UInt64(seed) * 0x9E3779B97F4A7C15, mi.UInt64(i // spp))
+    # ``seed`` and not the constructor: it would add each lane's index to the state.
+    rng = mi.PCG32()
+    rng.seed(mi.UInt64(seed) * 0x9E3779B97F4A7C15, mi.UInt64(i // spp))
     out = []
     for alpha in kronecker(dims):
         bits = rng.next_uint32() + index * alpha  # wraps modulo 2^32: frac(shift + k·α)
