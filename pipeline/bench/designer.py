@@ -3,18 +3,20 @@
 At 480×270 unless stated, on the proof scene under ``studio``:
 
 ``designer_edit``
-    designer mode, a parameter edit → the first updated frame (its display through the
-    OCIO view included): median and 90th percentile over random edits of one to three
-    continuous parameters (lobe switches among them), wall and CPU seconds. Target ≤ 0.15 s.
+    designer mode, a parameter edit → the first updated frame as the page receives it
+    (its display through the OCIO view and its JPEG included): median and 90th
+    percentile over random edits of one to three continuous parameters (lobe switches
+    among them), wall and CPU seconds. Target ≤ 0.15 s.
 ``ibl_rotation``
-    designer mode at 240×135: IBL rotations (each followed by the frame it makes) per
-    second. Target ≥ 10.
+    designer mode at 240×135: IBL rotations (each followed by the frame it makes, as a
+    JPEG) per second. Target ≥ 10.
 ``designer_converge``
     designer mode, after an edit: seconds of refinement until the material's pixels
     reach relative MSE ≤ 0.01 against the same material refined to 1024 samples per pixel
-    (its own reference), and the samples that took. Target ≤ 2 s.
+    (its own reference), the samples that took, and the relMSE after each pass
+    (``trajectory``: wall s, CPU s, spp, relMSE). Target ≤ 2 s.
 ``truth_edit``
-    truth mode, an edit → the first frame: median over random edits. Target ≤ 0.4 s.
+    truth mode, an edit → the first frame (JPEG included): median over random edits. Target ≤ 0.4 s.
 ``truth_compiles``
     truth mode: kernels compiled (Dr.Jit's kernel history: launches that missed its
     cache) and scenes rebuilt over 100 random edits after the first frame. Target 0.
@@ -107,6 +109,8 @@ def _hub(params: Any) -> Any:
 
 
 def _edits(view: Any, start: Any, count: int, seed: int) -> tuple[list[float], list[float]]:
+    from lookdev.pipeline.designer.render import encode
+
     rng = np.random.default_rng(seed)
     wall, cpu, params = [], [], start
     for _ in range(count):
@@ -115,7 +119,7 @@ def _edits(view: Any, start: Any, count: int, seed: int) -> tuple[list[float], l
 
         def edit(hub: Any = hub) -> Any:
             view.update_material(hub)
-            return view.step()
+            return encode(view.step().display)
 
         _, w, c = _timed(edit)
         wall.append(w)
@@ -137,6 +141,7 @@ def designer_edit(start: Any, size: tuple[int, int], edits: int) -> dict[str, An
 
 
 def ibl_rotation(start: Any, size: tuple[int, int], seconds: float) -> dict[str, Any]:
+    from lookdev.pipeline.designer.render import encode
     from lookdev.pipeline.designer.viewport import Viewport
 
     load = _load()
@@ -149,7 +154,7 @@ def ibl_rotation(start: Any, size: tuple[int, int], seconds: float) -> dict[str,
     while time.perf_counter() - t0 < seconds:
         angle += 5.0
         view.rotate_ibl(angle)
-        view.step()
+        encode(view.step().display)
         count += 1
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     view.close()
@@ -178,18 +183,20 @@ def designer_converge(start: Any, size: tuple[int, int], target: float) -> dict[
     view.step()
     view.update_material(_hub(start))
     elapsed = cpu = 0.0
-    error, frame = np.inf, engine_frame
+    error, frame, trajectory = np.inf, engine_frame, []
     while error > target and not frame.converged:
         frame, w, c = _timed(view.step)
         elapsed += w
         cpu += c
         error = relative_mse(frame.rgb, reference, mask)
+        trajectory.append([round(elapsed, 4), round(cpu, 4), frame.spp, float(error)])
     view.close()
     return {
         "seconds": elapsed,
         "cpu_s": cpu,
         "spp": frame.spp,
         "rel_mse": error,
+        "trajectory": trajectory,
         "target_rel_mse": target,
         "reference_spp": 1024,
         "target_s": 2.0,

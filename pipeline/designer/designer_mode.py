@@ -140,11 +140,14 @@ class DesignerMode:
         part, n = self.parts[name], self.passes[name]
         layers = len(self.gbuffer.material)
         spp = FIRST_SPP if n == 0 else max(1, min(LATER_SPP, part.max_spp - part.spp))
-        seed = (self.seed << 24) ^ (n << 1) ^ (name == "other")
-        shaded = self.relighter.shade(self.gbuffer, name, n % layers, seed, spp)
+        layer = n % layers
+        # One sequence per part and position (relight._samples), continued pass by pass.
+        seed = (self.seed << 24) ^ (layer << 1) ^ (name == "other")
+        base = int(part.counts[layer].sum())
+        shaded = self.relighter.shade(self.gbuffer, name, layer, seed, spp, base)
         if shaded is not None:
             pixels, rgb = shaded
-            part.add(rgb, n % layers, spp, pixels)
+            part.add(rgb, layer, spp, pixels)
         else:
             part.spp += spp  # nothing of this part at that position
         self.passes[name] = n + 1

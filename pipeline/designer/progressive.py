@@ -51,13 +51,16 @@ class Part:
         self.passes = 0
         self._noise: tuple[int, float | None] = (-self.layers, None)
 
-    def add(self, rgb: np.ndarray, layer: int, spp: int, pixels: np.ndarray) -> None:
+    def add(self, rgb: np.ndarray, layer: int, spp: int, pixels: np.ndarray | None = None) -> None:
         """Add a pass of ``spp`` samples per pixel at sub-pixel position ``layer``:
-        ``rgb`` (N, 3), the mean of its samples at ``pixels`` (N distinct flat indices)."""
+        ``rgb`` (N, 3), the mean of its samples at ``pixels`` (N distinct flat indices;
+        None: every pixel in order, added in place without an index)."""
         half = int(self.counts[layer, 0] > self.counts[layer, 1])
-        self.sums[layer, half, pixels] += np.asarray(rgb, np.float32) * np.float32(spp)
+        # A slice adds in place; an index array gathers, adds and scatters (≈ 5× slower).
+        where = slice(None) if pixels is None else pixels
+        self.sums[layer, half, where] += np.asarray(rgb, np.float32) * np.float32(spp)
         self.counts[layer, half] += spp
-        self.mask[pixels] = True
+        self.mask[where] = True
         self.spp += spp
         self.passes += 1
 

@@ -46,7 +46,7 @@ from lookdev.materials.tables import device_tables
 
 from .gbuffer import GBuffer, Hits
 
-__all__ = ["Relighter", "material_values", "structure_key"]
+__all__ = ["Relighter", "kronecker", "material_values", "structure_key"]
 
 INV_PI = 1.0 / math.pi
 
@@ -116,11 +116,42 @@ def _gathered(arrays: dict[str, Any], index: Any, width: int) -> dict[str, Any]:
     return out
 
 
-def _rng(seed: Any, count: int) -> Any:
+def kronecker(dims: int) -> tuple[int, ...]:
+    """The additive recurrence of :cite:`Roberts2018` in ``dims`` dimensions: frac(1/φᵏ),
+    k = 1..dims, with φ the positive root of x^(dims+1) = x + 1, as 32-bit fractions.
+
+    >>> [round(a / 2**32, 6) for a in kronecker(1)]  # the golden ratio's sequence
+    [0.618034]
+    """
+    phi = 2.0
+    for _ in range(64):  # Newton's method converges from 2 in a few steps
+        phi -= (phi ** (dims + 1) - phi - 1.0) / ((dims + 1) * phi**dims - 1.0)
+    return tuple(int((phi**-k % 1.0) * 2**32) for k in range(1, dims + 1))
+
+
+def _samples(seed: Any, base: Any, n: int, spp: int, dims: int) -> list[Any]:
+    """``dims`` uniform numbers for each of the ``spp`` samples of ``n`` pixels.
+
+    Sample ``base + s`` of a pixel is that point of the Kronecker sequence
+    (:func:`kronecker`), shifted modulo 1 by an offset random per pixel and fixed for the
+    accumulation (:cite:`Cranley1976`): each pixel's samples over the passes are one
+    low-discrepancy set, so its error falls faster than independent samples' while the
+    estimate stays unbiased (the shift is uniform). Integer arithmetic modulo 2³² keeps
+    every index exact.
+    """
     import drjit as dr
     import mitsuba as mi
 
-    return mi.PCG32(count, mi.UInt64(seed) * 0x9E3779B97F4A7C15, dr.arange(mi.UInt64, count))
+    i = dr.arange(mi.UInt32, n * spp)
+    index = base + i % spp
+    # ``seed`` and not the constructor: it would add each lane's index to the state.
+    rng = mi.PCG32()
+    rng.seed(mi.UInt64(seed) * 0x9E3779B97F4A7C15, mi.UInt64(i // spp))
+    out = []
+    for alpha in kronecker(dims):
+        bits = rng.next_uint32() + index * alpha  # wraps modulo 2^32: frac(shift + k·α)
+        out.append(mi.Float(bits >> 8) * (1.0 / (1 << 24)))
+    return out
 
 
 def _env(emitter: Any, d: Any) -> Any:
@@ -161,30 +192,27 @@ def _material_pass(model: Any, params: Any, shadows: bool) -> Any:
     """The material's pass for one structure (see the module docstring), to be frozen."""
     xp = DrJitOps.for_mitsuba()
 
-    def shade(scene, emitter, g: dict, values: dict, seed, spp: int, n: int, tables: list):
+    def shade(scene, emitter, g: dict, values: dict, seed, base, spp: int, n: int, tables):
         import drjit as dr
         import mitsuba as mi
 
         index = dr.arange(mi.UInt32, n * spp) // spp
         g = _gathered(g, index, n)
         values = _gathered(values, index, n)
-        rng = _rng(seed, n * spp)
+        u = _samples(seed, base, n, spp, 5)
         frame = mi.Frame3f(g["s"], dr.cross(g["n"], g["s"]), g["n"])
         wo = frame.to_local(g["wo"])
         it = dr.zeros(mi.Interaction3f, n * spp)
         it.p, it.n = g["p"], g["n"]
         pr = model.prepare(xp, params, **values)
         # The environment's strategy.
-        ds, radiance = emitter.sample_direction(
-            it, mi.Point2f(rng.next_float32(), rng.next_float32())
-        )
+        ds, radiance = emitter.sample_direction(it, mi.Point2f(u[0], u[1]))
         wi = frame.to_local(ds.d)
         f = mi.Vector3f(model.eval(xp, pr, wi, wo))
         p_bsdf = mi.Float(model.pdf(xp, pr, wi, wo))
         light = f * dr.abs(wi.z) * _power(ds.pdf, p_bsdf) * mi.Vector3f(radiance)
         # The model's strategy.
-        u = mi.Vector3f(rng.next_float32(), rng.next_float32(), rng.next_float32())
-        wi2, value, pdf2, delta = model.sample(xp, pr, wo, u)
+        wi2, value, pdf2, delta = model.sample(xp, pr, wo, mi.Vector3f(u[2], u[3], u[4]))
         wi2 = mi.Vector3f(wi2)
         d2 = frame.to_world(wi2)
         mis = dr.select(mi.Bool(delta), 1.0, _power(mi.Float(pdf2), _env_pdf(emitter, it, d2)))
@@ -206,13 +234,13 @@ def _material_pass(model: Any, params: Any, shadows: bool) -> Any:
 def _other_pass(shadows: bool) -> Any:
     """The pass of everything but the material: diffuse objects, mirrors, background."""
 
-    def shade(scene, emitter, g: dict, seed, spp: int, n: int, tables: list) -> Any:
+    def shade(scene, emitter, g: dict, seed, base, spp: int, n: int, tables) -> Any:
         import drjit as dr
         import mitsuba as mi
 
         index = dr.arange(mi.UInt32, n * spp) // spp
         g = _gathered(g, index, n)
-        rng = _rng(seed, n * spp)
+        u = _samples(seed, base, n, spp, 4)
         hit = g["hit"]
         it = dr.zeros(mi.Interaction3f, n * spp)
         it.p, it.n = g["p"], g["n"]
@@ -220,15 +248,11 @@ def _other_pass(shadows: bool) -> Any:
         albedo = mi.Vector3f(g["albedo"])
         diffuse = hit & (dr.max(albedo) > 0)
         # Lambertian reflection of the environment, as the objects' own BSDFs gave it.
-        ds, radiance = emitter.sample_direction(
-            it, mi.Point2f(rng.next_float32(), rng.next_float32()), diffuse
-        )
+        ds, radiance = emitter.sample_direction(it, mi.Point2f(u[0], u[1]), diffuse)
         cos = dr.dot(ds.d, g["n"])
         ok1 = diffuse & (cos > 0) & (ds.pdf > 0)
         light = albedo * INV_PI * cos * _power(ds.pdf, cos * INV_PI) * mi.Vector3f(radiance)
-        local = mi.warp.square_to_cosine_hemisphere(
-            mi.Point2f(rng.next_float32(), rng.next_float32())
-        )
+        local = mi.warp.square_to_cosine_hemisphere(mi.Point2f(u[2], u[3]))
         d = frame.to_world(local)
         ok2 = diffuse & (local.z > 0)
         reflected = albedo * _power(local.z * INV_PI, _env_pdf(emitter, it, d))
@@ -291,10 +315,14 @@ class Relighter:
                 _material_pass(self.model, self.params, self.shadows)
             )
 
-    def shade(self, gbuffer: GBuffer, part: str, layer: int, seed: int, spp: int = 1):
+    def shade(
+        self, gbuffer: GBuffer, part: str, layer: int, seed: int, spp: int = 1, base: int = 0
+    ):
         """One pass of ``spp`` samples per pixel of ``part`` (``"material"`` or
         ``"other"``) at sub-pixel position ``layer``: (flat pixel indices, (N, 3)
-        radiance float32), or None when the part has no pixel there."""
+        radiance float32), or None when the part has no pixel there. The samples are
+        numbers ``base`` … ``base + spp - 1`` of each pixel's sequence for ``seed``
+        (:func:`_samples`): one seed per accumulation, ``base`` the samples it has."""
         import drjit as dr
         import mitsuba as mi
 
@@ -302,13 +330,14 @@ class Relighter:
         if not hits.count:
             return None
         seed_ = dr.opaque(mi.UInt32, seed & 0xFFFFFFFF)
+        base_ = dr.opaque(mi.UInt32, base & 0xFFFFFFFF)
         # ``hits.width`` (padded) is a Python int: each width is its own recording.
         if part == "material":
             fn = self._material_passes[self.key]
-            args = (hits.arrays, self.values[layer], seed_, spp, hits.width)
+            args = (hits.arrays, self.values[layer], seed_, base_, spp, hits.width)
         else:
             fn = self._other
-            args = (hits.arrays, seed_, spp, hits.width)
+            args = (hits.arrays, seed_, base_, spp, hits.width)
         # The models' look-up tables are inputs too (tables.device_tables).
         try:
             value = fn(self.scene, self.emitter, *args, device_tables())

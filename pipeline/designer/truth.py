@@ -224,8 +224,7 @@ class TruthMode:
             spp = max(1, min(self.pass_spp, self.max_spp - self.part.spp))
             seed = ((self.seed & 0xFFF) << 20) | (self.passes & 0xFFFFF)
             image = self.table.render(spp, seed)
-            pixels = np.arange(self.part.pixels)
-            self.part.add(image.reshape(-1, 3), 0, spp, pixels)
+            self.part.add(image.reshape(-1, 3), 0, spp)
             self.passes += 1
         return self.raw_image()
 

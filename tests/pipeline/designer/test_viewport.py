@@ -101,6 +101,55 @@ def test_frozen_passes_equal_traced_ones():
         np.testing.assert_allclose(v1, v2, rtol=1e-5, atol=1e-6)
 
 
+def test_a_pass_continues_each_pixels_sequence():
+    """A pass of 4 samples from sample 0 is the mean of four 1-sample passes numbered 0 … 3
+    (the same per-pixel shift, the sequence continued), and another seed differs."""
+    import mitsuba as mi
+
+    from lookdev.pipeline.designer import gbuffer
+    from lookdev.pipeline.designer.relight import Relighter
+    from lookdev.pipeline.proof import ibl, shaderball
+    from lookdev.pipeline.variant import use_mitsuba
+
+    use_mitsuba()
+    env = ibl.load("studio", 64).pixels
+    scene = mi.load_dict(shaderball.scene_dict({"type": "diffuse"}, env, (W, H), 2, rig="none"))
+    g = gbuffer.render(scene, W, H)
+    r = Relighter(scene, freeze=False)
+    r.set_material(hub(base_color=(0.5, 0.5, 0.2), roughness=0.3), g)
+    for part in ("material", "other"):
+        pixels, four = r.shade(g, part, 0, 5, spp=4, base=0)
+        ones = [r.shade(g, part, 0, 5, spp=1, base=k)[1] for k in range(4)]
+        np.testing.assert_allclose(four, np.mean(ones, axis=0), rtol=1e-4, atol=1e-6)
+        assert not np.allclose(r.shade(g, part, 0, 6, spp=4, base=0)[1], four)
+
+
+@pytest.mark.parametrize("dims", [1, 2, 5])
+def test_the_kronecker_steps_are_distinct_fractions(dims):
+    from lookdev.pipeline.designer.relight import kronecker
+
+    alphas = kronecker(dims)
+    assert len(set(alphas)) == dims and all(0 < a < 2**32 for a in alphas)
+
+
+def test_the_display_cache_transforms_only_what_changed_and_matches_a_full_view():
+    from lookdev.pipeline.designer.viewport import DisplayCache, _display
+
+    rng = np.random.default_rng(4)
+    first = rng.random((H, W, 3)).astype(np.float32) * 4.0
+    cache = DisplayCache()
+    shown = cache(first, 0.0)
+    second = first.copy()
+    second[: H // 2, : W // 3] *= 0.25
+    again = cache(second, 0.0)
+    assert again is not shown  # a frame already sent is never written to
+    full = _display(second, 0.0)
+    assert np.abs(again.astype(int) - full.astype(int)).max() <= 1
+    np.testing.assert_array_equal(again[H // 2 :], shown[H // 2 :])
+    darker = cache(second, -2.0)  # a new exposure transforms everything
+    assert darker.mean() < again.mean()
+
+
 def test_truth_mode_edits_in_place_with_no_kernel_compiles(viewport):
     """Random edits of every continuous parameter, lobe switches included (clearcoat,
     sheen, spec_trans from 0), after the first frame: no new kernel, no new scene."""
