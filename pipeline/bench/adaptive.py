@@ -34,7 +34,10 @@ import numpy as np
 
 from .measure import relative_mse
 
-__all__ = ["AdaptiveSettings", "CASES", "IBLS", "PRESETS", "bench_case", "classes", "run", "tasks"]
+__all__ = [
+    "AdaptiveSettings", "CASES", "IBLS", "PRESETS", "bench_case", "classes", "environment", "run",
+    "tasks", "uniform_halves",
+]  # fmt: skip
 
 PRESETS = ("plastic_glossy", "gold", "glass_clear", "skin", "rusty_car_paint")
 IBLS = ("sky", "studio", "real")
@@ -61,13 +64,14 @@ class AdaptiveSettings:
         return cls(cases=(("plastic_glossy", "sky"),), resolution=(32, 16), reference_spp=64)
 
 
-def _environment(name: str, width: int) -> np.ndarray:
+def environment(name: str, width: int) -> np.ndarray:
+    """The pixels of a built-in IBL, or of the real HDR for ``real``."""
     from lookdev.pipeline.proof import ibl
 
     return ibl.load(ibl.REAL_HDR if name == "real" else name, width).pixels
 
 
-def _uniform(renderer: Any, spp: int, seed: int) -> tuple[np.ndarray, np.ndarray, float]:
+def uniform_halves(renderer: Any, spp: int, seed: int) -> tuple[np.ndarray, np.ndarray, float]:
     """Halves (H, W, 3) of ``spp`` samples a pixel (in launches of ≤ 64), and CPU seconds."""
     h, w = renderer.height, renderer.width
     sa, sb = np.zeros((h * w, 3)), np.zeros((h * w, 3))
@@ -127,17 +131,17 @@ def bench_case(preset: str, ibl_name: str, s: AdaptiveSettings) -> CaseResult:
     from .quality import blended, proof_table
 
     target = s.target if s.target is not None else settings.DEFAULT_NOISE
-    table = proof_table(blended(preset), _environment(ibl_name, s.ibl_width), s.resolution, "box")
+    table = proof_table(blended(preset), environment(ibl_name, s.ibl_width), s.resolution, "box")
     table.set_frame(Frame(0, "element", 0.0))
     r = adaptive.PixelRenderer(table.scene, table.camera_index, freeze=False)
-    ra, rb, ref_cpu = _uniform(r, s.reference_spp, 7_000_000)
+    ra, rb, ref_cpu = uniform_halves(r, s.reference_spp, 7_000_000)
     ref = 0.5 * (ra + rb)
     dv = view(ra) - view(rb)
     ref_var = np.mean(dv * dv, axis=-1) / 4.0
     ref_view = view(ref)
     masks = classes(ref_view, ref_var)
-    _uniform(r, adaptive.MIN_SPP, 2)  # warm-up: the kernels compile outside the timing
-    ca, cb, cal_cpu = _uniform(r, adaptive.MIN_SPP, 1)  # calibration: CPU per sample
+    uniform_halves(r, adaptive.MIN_SPP, 2)  # warm-up: the kernels compile outside the timing
+    ca, cb, cal_cpu = uniform_halves(r, adaptive.MIN_SPP, 1)  # calibration: CPU per sample
     per_spp = cal_cpu / adaptive.MIN_SPP
     cal_err = adaptive.pixel_error(ca, cb)
     q = float(np.quantile(cal_err, adaptive.CONVERGED_SHARE))
@@ -150,7 +154,7 @@ def bench_case(preset: str, ibl_name: str, s: AdaptiveSettings) -> CaseResult:
     f = adaptive.render_adaptive(r, target=target, max_spp=s.max_spp, seed=seeds(100))
     ad_cpu = time.process_time() - c0
     n_u = max(2, int(round(ad_cpu / per_spp / 2)) * 2)
-    ua, ub, u_cpu = _uniform(r, n_u, 200)
+    ua, ub, u_cpu = uniform_halves(r, n_u, 200)
     uniform = 0.5 * (ua + ub)
 
     guides = denoise.guide_renderer(table).render(seed=0)

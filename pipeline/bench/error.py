@@ -18,6 +18,8 @@ mainjob    the main job's old and new default frame against converged references
            each frame's noise estimate against its measured error (:mod:`.quality`)
 adaptive   uniform, per-pixel adaptive and adaptive + checked denoising at equal CPU
            time, and the estimate per pixel class (:mod:`.adaptive`)
+detail     glass × sky raw, OIDN alone and checked against spp, and the example pebble's
+           high-pass energy against its reference's, as figures (:mod:`.detail`)
 ========== ==============================================================================
 
 Outputs: a Rich table, ``error_bench.json`` (every row, the settings and the machine)
@@ -43,12 +45,13 @@ from lookdev.materials.errors import LookdevError
 
 from . import adaptive as adaptive_bench
 from . import denoise as denoise_bench
+from . import detail as detail_bench
 from . import measure, quality
 from .measure import Row
 
 ITEMS = (
     "render", "albedo", "lambda", "precision", "denoise", "sheen_lambda", "energy", "mainjob",
-    "adaptive",
+    "adaptive", "detail",
 )  # fmt: skip
 
 RENDER_IBL = "studio"
@@ -82,6 +85,7 @@ class Settings:
     adaptive: adaptive_bench.AdaptiveSettings = field(
         default_factory=adaptive_bench.AdaptiveSettings
     )
+    detail: detail_bench.DetailSettings = field(default_factory=detail_bench.DetailSettings)
 
     @classmethod
     def quick(cls) -> Settings:
@@ -100,6 +104,7 @@ class Settings:
             denoise=denoise_bench.DenoiseSettings.quick(),
             mainjob=quality.ErrorSettings.quick(),
             adaptive=adaptive_bench.AdaptiveSettings.quick(),
+            detail=detail_bench.DetailSettings.quick(),
         )
 
 
@@ -110,6 +115,7 @@ class Report:
     denoise: list[denoise_bench.Case] = field(default_factory=list)
     mainjob: list[dict[str, Any]] = field(default_factory=list)  # quality.error_case each
     adaptive: list[dict[str, Any]] = field(default_factory=list)  # adaptive.bench_case each
+    detail: dict[str, Any] = field(default_factory=dict)  # "glass", "pebble": detail's results
 
     def to_json(self, settings: Settings) -> dict[str, Any]:
         return {
@@ -127,6 +133,10 @@ class Report:
             "denoise": [case.as_json() for case in self.denoise],
             "mainjob": self.mainjob,
             "adaptive": self.adaptive,
+            "detail": {
+                k: {key: v for key, v in d.items() if key != "images"}
+                for k, d in self.detail.items()
+            },
         }
 
 
@@ -291,6 +301,8 @@ def run(
         tasks += quality.tasks(settings.mainjob, report)
     if "adaptive" in items:
         tasks += adaptive_bench.tasks(settings.adaptive, report)
+    if "detail" in items:
+        tasks += detail_bench.tasks(settings.detail, report)
     for done, (name, task) in enumerate(tasks):
         progress(name, done, len(tasks))
         try:
@@ -343,6 +355,8 @@ MARKERS = {
     "uniform": "s",
     "adaptive": "o",
     "adaptive + checked": "*",
+    "oidn": "s",
+    "checked": "*",
 }
 
 
@@ -399,7 +413,8 @@ def write_outputs(report: Report, settings: Settings, out_dir: Path) -> dict[str
     files.make_folder(out_dir)
     js = out_dir / "error_bench.json"
     files.atomic_write(js, json.dumps(report.to_json(settings), indent=2) + "\n")
-    return {"json": js, "plot": plot_error_vs_time(report, out_dir / "error_bench.png")}
+    out = {"json": js, "plot": plot_error_vs_time(report, out_dir / "error_bench.png")}
+    return out | detail_bench.plot(report.detail, out_dir)
 
 
 ERROR_NAMES = {
@@ -412,4 +427,5 @@ ERROR_NAMES = {
     "energy": "white furnace max |1 − E|",
     "mainjob": "relative MSE of the frame as shown",
     "adaptive": "relative MSE at equal CPU time",
+    "detail": "relative MSE (glass ladder, pebble)",
 }

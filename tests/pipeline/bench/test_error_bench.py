@@ -26,6 +26,7 @@ TINY = E.Settings(
     precision_pairs=500,
     mainjob=Q.ErrorSettings.quick(),
     adaptive=E.adaptive_bench.AdaptiveSettings.quick(),
+    detail=E.detail_bench.DetailSettings.quick(),
 )
 
 
@@ -204,3 +205,20 @@ def test_sheen_lambda_rows_show_both_modes_against_the_integral():
             table, fit = by[(case, "table", backend)], by[(case, "fit (eq. 3)", backend)]
             assert table.error < 2e-3 < 0.1 < fit.error  # the fit reads r = 0.01 as 0.08
             assert table.seconds > 0 and fit.seconds > 0
+
+
+@pytest.mark.render
+def test_the_detail_item_measures_glass_against_spp_and_the_pebbles_high_pass(tmp_path):
+    from lookdev.pipeline.bench import detail
+
+    s = detail.DetailSettings.quick()
+    report = E.run(E.Settings(detail=s), items=("detail",))
+    assert not report.skipped, report.skipped
+    glass, pebble = report.detail["glass"], report.detail["pebble"]
+    assert [r["spp"] for r in glass["ladder"]] == list(s.ladder)
+    assert all(r[k] > 0 for r in glass["ladder"] for k in ("raw", "oidn", "checked"))
+    assert pebble["reference_high_pass"] > 0
+    assert all(r[k]["ratio"] > 0 for r in pebble["ladder"] for k in ("raw", "oidn", "checked"))
+    paths = E.write_outputs(report, E.Settings(detail=s), tmp_path)
+    assert "images" not in json.loads(paths["json"].read_text())["detail"]["pebble"]
+    assert paths["glass"].read_bytes()[:4] == paths["pebble"].read_bytes()[:4] == b"\x89PNG"

@@ -138,6 +138,27 @@ def test_a_biased_denoiser_is_caught_and_the_raw_pixels_take_over():
     assert np.abs(view(c.image) - view(TRUTH)).mean() < 0.1 * truth_err
 
 
+def test_a_denoiser_whose_halves_err_alike_is_caught_by_the_hold_out():
+    """D_A = D_B (a fixed pattern whatever the input): their difference sees nothing; the
+    raw other half does."""
+    rng = np.random.default_rng(5)
+    a, b = (TRUTH + rng.normal(0, 0.01, TRUTH.shape) for _ in range(2))
+    pattern = TRUTH + rng.normal(0, 0.05, TRUTH.shape)
+    c = checked.check(a, b, adaptive.pixel_error(a, b), lambda im: pattern)
+    assert float(c.variance.max()) == 0.0
+    d = view(pattern) - view(TRUTH)
+    truth_err = math.sqrt(float(np.mean(d * d)))
+    est = math.sqrt(float(np.mean(c.bias)))
+    assert 0.5 * truth_err < est < 2.0 * truth_err
+
+
+def test_an_isolated_loud_pixel_keeps_half_its_own_estimate():
+    x = np.zeros((5, 5))
+    x[2, 2] = 9.0
+    out = adaptive.local_mean(x, 1)
+    assert out[2, 2] == pytest.approx(adaptive.OWN * 9.0) and out[0, 0] == 0.0
+
+
 def test_blend_edges_zero_errors():
     img, w = checked.blend(
         np.zeros((1, 1, 3)), np.ones((1, 1, 3)), np.zeros((1, 1)), np.zeros((1, 1))
