@@ -40,6 +40,20 @@ from .toml_file import NAME_RE as NAME_RE
 from .toml_file import check_name as check_name
 from .toml_file import parse_toml as parse_toml
 
+__all__ = [
+    "METADATA",
+    "MODELS",
+    "PresetFile",
+    "build_preset",
+    "check_params",
+    "dump_preset",
+    "parse_preset",
+    "parse_value",
+    "preset_document",
+    "read_preset",
+    "split_params",
+]
+
 MODELS: dict[str, type[Params]] = {
     name: registry.MODELS[name].params_type for name in registry.PRESET_MODELS
 }

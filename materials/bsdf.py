@@ -39,6 +39,8 @@ import numpy as np
 
 from .arrays import NumpyOps, from_channel_first, to_channel_first
 
+__all__ = ["ADJOINT", "Lobe", "Model", "density", "draw", "evaluate", "keep_lobes"]
+
 ADJOINT = "adjoint"
 """Key of a prepared material: sample the delta lobes' adjoint (see :class:`Model`)."""
 

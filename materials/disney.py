@@ -80,6 +80,20 @@ from .disney_prepare import (
 )
 from .params import DisneyParams
 
+__all__ = [
+    "MODEL",
+    "eval",
+    "eval_core",
+    "guide_core",
+    "keep_every_lobe",
+    "lobe_model",
+    "pdf",
+    "pdf_core",
+    "restrict",
+    "sample",
+    "sample_core",
+]
+
 
 # -- the frame: thin sheets are two-sided, a solid is seen from inside only through glass --
 def _orient(xp: Any, wi: Any, wo: Any) -> tuple[Any, Any, Any]:

@@ -16,6 +16,22 @@ from .bsdf import Lobe
 from .fresnel import SPECULAR_F0_SCALE
 from .params import DisneyParams
 
+__all__ = [
+    "CLEARCOAT_F0",
+    "DISNEY_LOBES",
+    "ETA_MIN",
+    "INV_PI",
+    "LOBES",
+    "SCHLICK_MEAN",
+    "SHEEN_ALBEDO_GUESS",
+    "TINT_WEIGHTS",
+    "lobe_odds",
+    "luminance",
+    "mix",
+    "prepare",
+    "tint_color",
+]
+
 INV_PI = 1.0 / math.pi
 TINT_WEIGHTS = (0.3, 0.6, 0.1)
 """Burley's tint luminance, from the Disney BRDF Explorer's ``disney.brdf``:

@@ -59,6 +59,29 @@ from .pixar_scatter import (
     scatter_sample,
 )
 
+__all__ = [
+    "CONE_LOBES",
+    "DIELECTRIC_REFL",
+    "FALLOFF_LOBES",
+    "GRAZING",
+    "LAYERED_MODEL",
+    "LOBE_SCALE_MAX",
+    "MODEL",
+    "PixarLobeWeights",
+    "PixarParams",
+    "WEIGHT_NAMES",
+    "Weight",
+    "as_lobe_weights",
+    "ends",
+    "eta_of",
+    "eval",
+    "lobe_weights",
+    "pdf",
+    "sample",
+    "view_independent",
+    "weights",
+]
+
 DIELECTRIC_REFL = 0.05  # Smits' default normal reflectance of a dielectric
 
 WEIGHT_NAMES = (

@@ -15,6 +15,20 @@ from typing import Any
 from . import pixar_lobes as lobes
 from .bsdf import ADJOINT, Lobe
 
+__all__ = [
+    "LOBES",
+    "PIXAR_LOBES",
+    "PREFIX",
+    "at_view",
+    "delta_lobes",
+    "kept_lobes",
+    "prepared",
+    "scatter_eval",
+    "scatter_guide",
+    "scatter_pdf",
+    "scatter_sample",
+]
+
 PIXAR_LOBES = (
     Lobe("diffuse", "diffuse", family="diffuse", params=("diffuse_scale",)),
     Lobe(

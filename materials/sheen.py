@@ -81,6 +81,31 @@ from .sheen_tables import R_MIN_EXACT as R_MIN_EXACT  # re-exported for callers 
 from .sheen_tables import area_nodes as area_nodes
 from .sheen_tables import projected_area as projected_area
 
+__all__ = [
+    "D",
+    "INV_TWO_PI",
+    "MODEL",
+    "SHEEN_LOBES",
+    "SheenParams",
+    "albedo",
+    "albedo_lookup",
+    "base_scale",
+    "distribution",
+    "eval",
+    "fit_coefficients",
+    "interpolate",
+    "lambda_fit",
+    "lambda_table",
+    "lobe",
+    "log_lambda",
+    "log_lambda_light",
+    "pdf",
+    "sample",
+    "shadowing",
+    "softening_exponent",
+    "table_nodes",
+]
+
 INV_TWO_PI = 1.0 / (2.0 * math.pi)
 
 # Table 1: (a, b, c, d, e) of L(x) = a / (1 + b x^c) + d x + e at r = 0 and r = 1.

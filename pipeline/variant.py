@@ -15,6 +15,8 @@ import subprocess
 import warnings
 from pathlib import Path
 
+__all__ = ["find_libllvm", "use_mitsuba"]
+
 _MIN_LLVM = 17
 
 

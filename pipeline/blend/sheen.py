@@ -26,6 +26,8 @@ from lookdev.materials.arrays import NumpyOps
 from .errors import BlendError
 from .result import BlendedMaterial
 
+__all__ = ["base_scale"]
+
 
 def base_scale(blended: BlendedMaterial, cos_theta: float = 1.0) -> Any:
     """The factor on the base under a Conty-Kulla sheen, light and view at ``cos_theta``.

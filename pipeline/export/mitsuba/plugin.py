@@ -84,6 +84,21 @@ from lookdev.materials.errors import LookdevError
 from lookdev.materials.guides import guide_albedo
 from lookdev.materials.registry import is_color_field
 
+__all__ = [
+    "FORCE_ALL_LOBES",
+    "LIVE",
+    "MitsubaExportError",
+    "ONLY_LOBES",
+    "PLUGIN_PREFIX",
+    "WEIGHT_SCALE",
+    "delta_lobes",
+    "lobe_kinds",
+    "lobes_of",
+    "opaque_inputs",
+    "plugin_name",
+    "register_model",
+]
+
 PLUGIN_PREFIX = "lookdev_"
 FORCE_ALL_LOBES = "force_all_lobes"
 LIVE = "live"
