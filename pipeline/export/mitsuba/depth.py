@@ -46,7 +46,7 @@ from lookdev.materials.bsdf import draw
 from lookdev.materials.subsurface import has_interior, interior
 from lookdev.pipeline.blend.result import as_hub
 
-from .plugin import lobe_kinds
+from .components import lobe_kinds
 
 __all__ = [
     "BRIGHT_ALBEDO",

@@ -19,7 +19,7 @@ import numpy as np
 
 from lookdev.materials.bsdf import Model
 
-from .plugin import ONLY_LOBES, WEIGHT_SCALE
+from .inputs import ONLY_LOBES, WEIGHT_SCALE
 
 __all__ = ["Texture", "with_normals"]
 

@@ -17,7 +17,7 @@ from typing import Any
 
 from lookdev.library import files
 
-from .plugin import PLUGIN_PREFIX, MitsubaExportError
+from .inputs import PLUGIN_PREFIX, MitsubaExportError
 from .scene import scene_dict, uses_our_plugins
 
 __all__ = [
