@@ -36,12 +36,14 @@ What designer mode leaves out, against truth mode (the path tracer, :mod:`.truth
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Any
 
 import numpy as np
 
 from lookdev.materials.arrays import DrJitOps
+from lookdev.materials.bsdf import Prepared
 from lookdev.materials.tables import device_tables
 
 from .gbuffer import GBuffer, Hits
@@ -95,6 +97,8 @@ def structure_key(model: Any, params: Any, values: dict[str, Any]) -> str:
     prepared = model.prepare(xp, params, **values)
 
     def plain(value: Any) -> Any:
+        if isinstance(value, Prepared):  # by member, as a dict: Dr.Jit values by type
+            return {f.name: plain(getattr(value, f.name)) for f in dataclasses.fields(value)}
         if isinstance(value, dict):
             return {k: plain(v) for k, v in sorted(value.items())}
         if isinstance(value, list | tuple):

@@ -3,7 +3,7 @@
 The kept lobes of a prepared material fall into four components, in this order:
 reflection and transmission with a density, then the deltas (Mitsuba numbers only the
 components that exist). A model may sample some lobes as Dirac deltas (smooth glass,
-mirrors: ``prepared["delta"]``, :mod:`lookdev.materials.disney_interface`). They form their
+mirrors: ``prepared.delta``, :mod:`lookdev.materials.disney_interface`). They form their
 own components, flagged ``DeltaReflection`` / ``DeltaTransmission`` (a BSDF with no other
 lobe has no ``Smooth`` flag, so the path tracer samples no light at its vertices);
 ``eval`` and ``pdf`` leave them out, as the model does, and a sample of one reports that
@@ -18,7 +18,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
-from lookdev.materials.bsdf import Model
+from lookdev.materials.bsdf import Model, Prepared
 
 from .inputs import MitsubaExportError
 
@@ -29,30 +29,20 @@ __all__ = [
     "hemisphere_mask",
     "lobe_kinds",
     "lobes_of",
-    "prepared_eta",
     "sampled_component",
 ]
 
 
-def lobes_of(prepared: Any) -> tuple[str, ...]:
-    """The lobe names a prepared material kept (``prepared["lobes"]`` or ``.lobes``)."""
-    lobes = (
-        prepared.get("lobes") if isinstance(prepared, dict) else getattr(prepared, "lobes", None)
-    )
-    if lobes is None:
-        raise MitsubaExportError("the model's prepare() does not record its 'lobes'")
-    return tuple(lobes)
+def lobes_of(prepared: Prepared) -> tuple[str, ...]:
+    """The lobe names a prepared material kept (``prepared.lobes``)."""
+    if not isinstance(prepared, Prepared):
+        raise MitsubaExportError("the model's prepare() does not return a Prepared")
+    return tuple(prepared.lobes)
 
 
-def delta_lobes(prepared: Any) -> tuple[str, ...]:
-    """The kept lobes a prepared material samples as deltas (``prepared["delta"]``)."""
-    delta = prepared.get("delta", ()) if isinstance(prepared, dict) else ()
-    return tuple(k for k in lobes_of(prepared) if k in delta)
-
-
-def prepared_eta(prepared: Any) -> Any:
-    """The relative IOR a prepared material records (``prepared["eta"]``), or None."""
-    return prepared.get("eta") if isinstance(prepared, dict) else None
+def delta_lobes(prepared: Prepared) -> tuple[str, ...]:
+    """The kept lobes a prepared material samples as deltas (``prepared.delta``)."""
+    return tuple(k for k in lobes_of(prepared) if k in prepared.delta)
 
 
 def lobe_kinds(lobes: Iterable[str], model: Model, delta: Iterable[str] = ()) -> set[str]:
@@ -136,7 +126,7 @@ def _refracts(params: Any, prepared: Any, transmits: int) -> bool:
     """Whether a transmitted path changes medium (see :func:`.transport.eta_along`)."""
     import mitsuba as mi
 
-    eta = prepared_eta(prepared)
+    eta = prepared.eta
     solid = not getattr(params, "thin", False)
     bends = mi.BSDFFlags.GlossyTransmission | mi.BSDFFlags.DeltaTransmission
     if eta is None or not solid or not bool(transmits & bends):

@@ -15,7 +15,7 @@ in ``sample``), but it is also right for lobes that are not of that form: a Lamb
 (:mod:`lookdev.materials.pixar`) are centred on the refracted view, so f(l, v) ≠ f(v, l) at
 any IOR, and Conty–Kulla's terminator softening (:mod:`lookdev.materials.sheen`) acts on
 the light side only (:attr:`~lookdev.materials.bsdf.Lobe.reciprocal`). A delta sample has
-no f to evaluate, so the model supplies its adjoint itself when ``prepared[ADJOINT]`` asks
+no f to evaluate, so the model supplies its adjoint itself when ``prepared.adjoint`` asks
 (:class:`~lookdev.materials.bsdf.Model`): the Disney glass drops its 1/η², as
 ``dielectric`` does; Smits' refracted view sends light from l to the one viewer whose view
 refracts to l, weight η² W (:mod:`lookdev.materials.pixar_scatter`). A reciprocal BSDF is
@@ -40,11 +40,12 @@ softening changes only grazing light: a white sheen ball agrees either way
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
-from lookdev.materials.bsdf import ADJOINT, Model
+from lookdev.materials.bsdf import Model, Prepared
 
-from .components import Components, prepared_eta
+from .components import Components
 
 __all__ = ["adjoint_prepared", "adjoint_weight", "eta_along", "f_for_mode", "is_adjoint"]
 
@@ -71,11 +72,9 @@ def f_for_mode(ctx, comps: Components, model: Model, xp, prepared, si_wi, wo) ->
     return model.eval(xp, prepared, wo, si_wi)
 
 
-def adjoint_prepared(prepared: Any) -> Any:
-    """``prepared`` asking the model's sampler for its deltas' adjoint (``ADJOINT``)."""
-    if isinstance(prepared, dict):
-        return {**prepared, ADJOINT: True}
-    return prepared
+def adjoint_prepared(prepared: Prepared) -> Prepared:
+    """``prepared`` asking the model's sampler for its deltas' adjoint (``adjoint``)."""
+    return replace(prepared, adjoint=True)
 
 
 def adjoint_weight(ctx, comps, model, xp, prepared, si, bs, weight, delta) -> Any:
@@ -84,7 +83,7 @@ def adjoint_weight(ctx, comps, model, xp, prepared, si, bs, weight, delta) -> An
     The direction is drawn by the model's own sampler with si.wi in the viewer's place, so
     the pdf of a sample with a density is unchanged, and its value is the adjoint f of
     :func:`f_for_mode` over that pdf (what ``eval``/``pdf`` say, so MIS stays consistent).
-    A delta has no f to evaluate: the model, asked through ``prepared[ADJOINT]``, returned
+    A delta has no f to evaluate: the model, asked through ``prepared.adjoint``, returned
     its adjoint direction and weight itself.
     """
     import drjit as dr
@@ -102,13 +101,13 @@ def adjoint_weight(ctx, comps, model, xp, prepared, si, bs, weight, delta) -> An
 def eta_along(comps: Components, params: Any, prepared: Any, cos_view, reflected) -> Any:
     """Relative IOR along a sampled path (Mitsuba's Russian roulette tracks it).
 
-    Through a solid dielectric it is the model's ``prepared["eta"]`` going in and its
+    Through a solid dielectric it is the model's ``prepared.eta`` going in and its
     inverse going out; reflections and thin sheets do not bend the path.
     """
     import drjit as dr
     import mitsuba as mi
 
-    eta = prepared_eta(prepared)
+    eta = prepared.eta
     solid = not getattr(params, "thin", False)
     bends = mi.BSDFFlags.GlossyTransmission | mi.BSDFFlags.DeltaTransmission
     if eta is None or not solid or not comps.transmits & bends:
