@@ -7,6 +7,8 @@ from collections.abc import Iterable
 
 from lookdev.materials.errors import LookdevError
 
+__all__ = ["LibraryError", "PresetError", "PresetNotFoundError", "TextureError", "did_you_mean"]
+
 
 class PresetError(LookdevError):
     """A preset file is malformed, invalid, or cannot be resolved."""

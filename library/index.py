@@ -35,6 +35,20 @@ from . import files
 from .errors import PresetError
 from .toml_file import NAME_RE, parse_toml
 
+__all__ = [
+    "Header",
+    "INDEX_NAME",
+    "INDEX_VERSION",
+    "RACY_S",
+    "SUFFIX",
+    "index_file",
+    "read_header",
+    "read_only_index_file",
+    "scan_folder",
+    "simple_header",
+    "warn",
+]
+
 INDEX_NAME = ".lookdev-index.json"
 INDEX_VERSION = 3
 RACY_S = 2.0

@@ -29,6 +29,18 @@ if TYPE_CHECKING:
     from .material import Material
     from .preset import PresetFile
 
+__all__ = [
+    "BUILTIN_OTHER_DATA",
+    "ENV_PATH",
+    "Library",
+    "apply_changes",
+    "builtin_folder",
+    "links_on_the_way",
+    "load_material",
+    "read_preset",
+    "refuse_links_out",
+]
+
 # The schemas (.preset) and materials (.material) bring pydantic and the models: they are
 # imported where a preset is parsed, so listing headers (`presets list`) needs neither.
 

@@ -36,6 +36,16 @@ from .errors import PresetError, PresetNotFoundError, TextureError
 from .index import held_warnings
 from .preset import MODELS, PresetFile, split_params
 
+__all__ = [
+    "Layer",
+    "Lookup",
+    "Material",
+    "absolute_textures",
+    "merge_params",
+    "multiply_masks",
+    "resolve",
+]
+
 Lookup = Callable[[str], tuple[PresetFile, Path]]
 """Finds a preset by name: its parsed file and where it lives."""
 

@@ -41,6 +41,20 @@ from .toml_file import NAME_RE as NAME_RE
 from .toml_file import check_name as check_name
 from .toml_file import parse_toml as parse_toml
 
+__all__ = [
+    "METADATA",
+    "MODELS",
+    "PresetFile",
+    "build_preset",
+    "check_params",
+    "dump_preset",
+    "parse_preset",
+    "parse_value",
+    "preset_document",
+    "read_preset",
+    "split_params",
+]
+
 MODELS: Mapping[str, type[Params]] = Imported(PARAMS)
 """Parameter schema of each reflectance model a preset may name, imported when first asked
 for (its model's module is not: validating a preset needs no evaluation)."""

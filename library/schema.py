@@ -19,6 +19,8 @@ from lookdev.materials.textures import TextureInput, texturable
 
 from .preset import MODELS, NAME_RE, PresetFile
 
+__all__ = ["BARE_MASK", "GREY", "HEX_COLOR", "params_schema", "preset_schema"]
+
 HEX_COLOR = {"type": "string", "pattern": "^#?[0-9a-fA-F]{6}$", "description": "sRGB '#rrggbb'"}
 GREY = {"type": "number", "minimum": 0, "maximum": 1, "description": "grey: r = g = b"}
 BARE_MASK = {"type": "number", "minimum": 0, "maximum": 1, "description": "constant mask"}

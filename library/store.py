@@ -27,6 +27,18 @@ from pathlib import Path
 from . import files
 from .errors import LibraryError
 
+__all__ = [
+    "LOCK_NAME",
+    "LOCK_TIMEOUT_S",
+    "PAUSE_ENV",
+    "atomic_write",
+    "locked",
+    "make_folder",
+    "read_only",
+    "remove",
+    "unwritable",
+]
+
 LOCK_NAME = ".lookdev.lock"
 PAUSE_ENV = "LOOKDEV_TEST_SAVE_PAUSE"
 LOCK_TIMEOUT_S = 60.0

@@ -36,6 +36,8 @@ from typing import Any
 
 import numpy as np
 
+__all__ = ["DrJitOps", "INV_PI", "NumpyOps", "from_channel_first", "to_channel_first"]
+
 INV_PI = 1.0 / math.pi
 
 

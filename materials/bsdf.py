@@ -32,15 +32,34 @@ return ``(..., 3)`` / ``(...)`` arrays.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from .arrays import NumpyOps, from_channel_first, to_channel_first
 
-ADJOINT = "adjoint"
-"""Key of a prepared material: sample the delta lobes' adjoint (see :class:`Model`)."""
+__all__ = ["Lobe", "Model", "Prepared", "density", "draw", "evaluate", "keep_lobes"]
+
+
+@dataclass(frozen=True, kw_only=True)
+class Prepared:
+    """What every model's ``prepare`` returns: the members every consumer reads.
+
+    Each model subclasses it with its own named members (``DisneyPrepared`` …), as pbrt's
+    and Mitsuba's BSDFs name theirs; a member is either a Python value (a constant the
+    kernel is traced with, so a known-zero lobe is pruned) or an array of the backend
+    (numpy or Dr.Jit). Immutable: :func:`dataclasses.replace` makes a changed copy.
+    """
+
+    lobes: tuple[str, ...]
+    """The lobes ``eval``/``pdf``/``sample`` visit (the live ones, or a restriction)."""
+    delta: tuple[str, ...] = ()
+    """The kept lobes sampled as Dirac deltas (a smooth mirror or refraction)."""
+    eta: Any = None
+    """Relative IOR inside/outside of a refracting solid; None where nothing refracts."""
+    adjoint: bool = False
+    """Sample the delta lobes' adjoint (a light tracer's Importance mode, :class:`Model`)."""
 
 
 @dataclass(frozen=True)
@@ -70,7 +89,7 @@ class Lobe:
     any material has unless others take its energy (the Disney diffuse and specular)."""
     reciprocal: bool = True
     """f(light, viewer) = f(viewer, light), apart from the (η_viewer/η_light)² of a
-    refraction into a solid (Veach 1997 §5.2), which the model's ``prepared["eta"]``
+    refraction into a solid (Veach 1997 §5.2), which the model's ``prepared.eta``
     carries. False for a lobe that is not, for some of its parameters: Smits' transmitted
     highlights are centred on the *refracted view*, Conty–Kulla's terminator softening
     acts on the light side only. A light tracer evaluates such a lobe with the roles as
@@ -92,11 +111,11 @@ class Lobe:
         return self.scattering.title() + ("Transmission" if self.transmits else "Reflection")
 
 
-def keep_lobes(xp: Any, prepared: dict[str, Any], names: Any) -> dict[str, Any]:
+def keep_lobes(xp: Any, prepared: Prepared, names: Any) -> Prepared:
     """``prepared`` with only its lobes named in ``names`` evaluated and sampled: the
-    default :attr:`Model.restrict`, for models that choose among ``prepared["lobes"]``
+    default :attr:`Model.restrict`, for models that choose among ``prepared.lobes``
     as they go (a model that stores sampling odds recomputes them in its own)."""
-    return {**prepared, "lobes": tuple(k for k in prepared["lobes"] if k in names)}
+    return replace(prepared, lobes=tuple(k for k in prepared.lobes if k in names))
 
 
 @dataclass(frozen=True)
@@ -107,7 +126,7 @@ class Model:
     a material whose lobe groups have their own shading normals renders as two
     restricted halves (:mod:`lookdev.pipeline.export.mitsuba.normals`).
 
-    ``prepared[ADJOINT]`` (set by a light tracer's adapter, Mitsuba's Importance mode)
+    ``prepared.adjoint`` (set by a light tracer's adapter, Mitsuba's Importance mode)
     asks ``sample`` for the *adjoint* of its delta lobes: given where the light comes
     from (in the viewer's argument), the direction towards the viewer and the weight
     f(light, viewer)·|cos|/pdf (Veach 1997 §3.7). A delta has no f the adapter could

@@ -74,11 +74,26 @@ from .disney_prepare import (
     DISNEY_LOBES,
     INV_PI,
     LOBES,
-    lobe_odds,
+    DisneyPrepared,
     mix,
     prepare,
+    with_odds,
 )
 from .params import DisneyParams
+
+__all__ = [
+    "MODEL",
+    "eval",
+    "eval_core",
+    "guide_core",
+    "keep_every_lobe",
+    "lobe_model",
+    "pdf",
+    "pdf_core",
+    "restrict",
+    "sample",
+    "sample_core",
+]
 
 
 # -- the frame: thin sheets are two-sided, a solid is seen from inside only through glass --
@@ -88,25 +103,25 @@ def _orient(xp: Any, wi: Any, wo: Any) -> tuple[Any, Any, Any]:
     return xp.vec3(wi[0], wi[1], wi[2] * s), xp.vec3(wo[0], wo[1], wo[2] * s), s
 
 
-def _front(pr: dict[str, Any], s: Any) -> Any:
+def _front(pr: DisneyPrepared, s: Any) -> Any:
     """1 where the outside's lobes exist, 0 inside a solid; None on a (two-sided) thin sheet."""
-    return None if pr["thin"] else 0.5 + 0.5 * s
+    return None if pr.thin else 0.5 + 0.5 * s
 
 
 # -- lobes, in the oriented frame (wo.z ≥ 0) -------------------------------------------------
-def _diffuse_shape(xp: Any, pr: dict[str, Any], ci: Any, co: Any, cos2_d: Any) -> Any:
+def _diffuse_shape(xp: Any, pr: DisneyPrepared, ci: Any, co: Any, cos2_d: Any) -> Any:
     """Burley §5.3 diffuse (without base/π), retro-reflection, flatness and subsurface."""
     fl, fv = fr.schlick_weight(xp, ci), fr.schlick_weight(xp, co)
-    rr = 2.0 * pr["roughness"] * cos2_d
+    rr = 2.0 * pr.roughness * cos2_d
     retro = rr * (fl + fv + fl * fv * (rr - 1.0))  # Schutte's split of (1 + (F_D90 − 1)F)²
-    if pr["volume"]:
+    if pr.volume:
         return retro  # Burley 2015: the Lambertian part enters the medium (diff_trans)
     lambert = (1.0 - 0.5 * fl) * (1.0 - 0.5 * fv)
-    flat, sss = pr["flatness"], pr["subsurface"]
+    flat, sss = pr.flatness, pr.subsurface
     if xp.known_zero(flat) and xp.known_zero(sss):
         return retro + lambert
     # Hanrahan-Krueger; F_ss90 = cos²θd·roughness as the BRDF Explorer (Schutte: roughness²).
-    fss90 = cos2_d * pr["roughness"]
+    fss90 = cos2_d * pr.roughness
     fss = mix(1.0, fss90, fl) * mix(1.0, fss90, fv)
     # 1e-20 keeps HK's integrable 1/(cos θl + cos θv) finite at ci = co = 0 (float32 too).
     hk = 1.25 * (fss * (1.0 / xp.maximum(ci + co, 1e-20) - 0.5) + 0.5)
@@ -118,29 +133,29 @@ def _conty_kulla() -> Any:
     return importlib.import_module(".sheen", __package__)
 
 
-def _conty_kulla_color(xp: Any, pr: dict[str, Any]) -> Any:
+def _conty_kulla_color(xp: Any, pr: DisneyPrepared) -> Any:
     """The microfacet sheen's reflectance F, per channel at most 1.
 
     Burley's tint (base over its luminance) exceeds 1 in saturated channels; a lobe
     reflecting more than all of the light would make the albedo scaling 1 − F·E negative
     and the material gain energy, so the Conty-Kulla colour is clamped to 1.
     """
-    return xp.minimum(pr["sheen"] * pr["sheen_color"], 1.0)
+    return xp.minimum(pr.sheen * pr.sheen_color, 1.0)
 
 
-def _base_scale(xp: Any, pr: dict[str, Any], ci: Any, co: Any) -> Any:
+def _base_scale(xp: Any, pr: DisneyPrepared, ci: Any, co: Any) -> Any:
     """Conty-Kulla §5 albedo scaling of what lies under their sheen (1 elsewhere)."""
-    if "sheen" not in pr["lobes"] or pr["sheen_model"] != "conty_kulla":
+    if "sheen" not in pr.lobes or pr.sheen_model != "conty_kulla":
         return 1.0
     color = _conty_kulla_color(xp, pr)
-    r = xp.asarray(pr["sheen_r"])  # an array of the model's dtype: float32 stays float32
-    scale = _conty_kulla().base_scale(xp, ci, co, r, color, exact=pr["sheen_exact"])
+    r = xp.asarray(pr.sheen_r)  # an array of the model's dtype: float32 stays float32
+    scale = _conty_kulla().base_scale(xp, ci, co, r, color, exact=pr.sheen_exact)
     return xp.maximum(scale, 0.0)
 
 
-def _energy_factor(xp: Any, pr: dict[str, Any], co: Any, front: Any) -> Any:
+def _energy_factor(xp: Any, pr: DisneyPrepared, co: Any, front: Any) -> Any:
     """1 + F0 (1 − E(μo))/E(μo) outside, 1 inside a solid (the glass's own reflection)."""
-    extra = energy.factor(xp, pr["energy_f0"], co, pr["energy_r"]) - 1.0
+    extra = energy.factor(xp, pr.energy_f0, co, pr.energy_r) - 1.0
     return 1.0 + times(extra, front)
 
 
@@ -153,14 +168,14 @@ def _masked(xp: Any, cond: Any, x: Any) -> Any:
     return x * cond if isinstance(xp, NumpyOps) else xp.select(cond, x, 0.0)
 
 
-def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> list:
+def _reflection_terms(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any) -> list:
     """(colour or None, scalar) pairs summing to the reflection lobes, masked to wi, wo up.
 
     Scalars carry every per-direction factor and colours are constants (or per-element
     maps), so each lobe costs one colour product. The half vector is h = wi + wo,
     unnormalised: |h|² = 4 cos²θd and D is homogeneous in h.
     """
-    lobes = pr["lobes"]
+    lobes = pr.lobes
     up = (wi[2] > 0.0) & (wo[2] > 0.0)
     # Clamped cosines keep every term finite where ``up`` is false, so masking is a product.
     ci, co = xp.maximum(wi[2], 0.0), xp.maximum(wo[2], 0.0)
@@ -174,19 +189,19 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
     zi2, zo2 = ci * ci, co * co
     scale = _base_scale(xp, pr, ci, co)
     terms = []
-    if "specular" in lobes and "specular" not in pr["delta"]:
+    if "specular" in lobes and "specular" not in pr.delta:
         d = specular_d(xp, pr, h, h2)
-        if pr["ggx"]:
+        if pr.ggx:
             g = mf.g1_over_cos(xp, ci, projected(pr, wi, zi2), zi2) * mf.g1_over_cos(
                 xp, co, projected(pr, wo, zo2), zo2
             )
         else:
             g = v_cavity_over_cos(xp, h, h2, ci, co)
-        dg = _masked(xp, up, 0.25 * d * g) if pr["ggx"] else xp.select(up, 0.25 * d * g, 0.0)
-        a, b, c = pr["spec_a"], pr["spec_b"], pr["spec_c"]
+        dg = _masked(xp, up, 0.25 * d * g) if pr.ggx else xp.select(up, 0.25 * d * g, 0.0)
+        a, b, c = pr.spec_a, pr.spec_b, pr.spec_c
         dg_out = times(dg, front)
         spec_scale = scale
-        if pr["energy"]:
+        if pr.energy:
             # Turquin 2019, seen from outside only (:mod:`.energy`): a colour factor
             # on this lobe alone (the layers under it keep ``scale``).
             ms = _energy_factor(xp, pr, co, front)
@@ -194,56 +209,56 @@ def _reflection_terms(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any)
         terms += [(a * spec_scale, dg_out), ((b - a) * spec_scale, dg_out * w)]
         if not xp.known_zero(c):
             # The glass reflects the exact Fresnel on either side; inside, nothing else does.
-            f_exact = fr.dielectric(xp, cos_d, pick(xp, front, pr["eta"], 1.0 / pr["eta"]))
-            k = f_exact * dg * pick(xp, front, c, pr["glass"])
+            f_exact = fr.dielectric(xp, cos_d, pick(xp, front, pr.eta, 1.0 / pr.eta))
+            k = f_exact * dg * pick(xp, front, c, pr.glass)
             terms.append((None if isinstance(spec_scale, float) else spec_scale, k))
     if "diffuse" in lobes:
         shape = _diffuse_shape(xp, pr, ci, co, cos2_d)
-        k = times(pr["diffuse"] * INV_PI * shape, front)
-        terms.append((pr["base"] * scale, _masked(xp, up, k)))
+        k = times(pr.diffuse * INV_PI * shape, front)
+        terms.append((pr.base * scale, _masked(xp, up, k)))
     if "sheen" in lobes:
-        if pr["sheen_model"] == "conty_kulla":
-            r = xp.asarray(pr["sheen_r"])
-            lobe = _conty_kulla().lobe(xp, wi, wo, r, True, pr["sheen_exact"])
+        if pr.sheen_model == "conty_kulla":
+            r = xp.asarray(pr.sheen_r)
+            lobe = _conty_kulla().lobe(xp, wi, wo, r, True, pr.sheen_exact)
             color = _conty_kulla_color(xp, pr)
         else:
-            lobe = w * pr["sheen"]  # 2014 addendum: sheen · (1 − cos θd)⁵, no 1/π (Explorer)
-            color = pr["sheen_color"]
+            lobe = w * pr.sheen  # 2014 addendum: sheen · (1 − cos θd)⁵, no 1/π (Explorer)
+            color = pr.sheen_color
         terms.append((color, _masked(xp, up, times(lobe, front))))
     if "clearcoat" in lobes:
         inv_h2 = 1.0 / xp.maximum(h2, xp.tiny)
         sin2_h = (h[0] * h[0] + h[1] * h[1]) * inv_h2  # not 1 − cos²: the α = 10⁻³ peak
-        d = mf.gtr_d(xp, 1.0, pr["clearcoat_a2"], h[2] * h[2] * inv_h2, sin2_h)
+        d = mf.gtr_d(xp, 1.0, pr.clearcoat_a2, h[2] * h[2] * inv_h2, sin2_h)
         a2 = mf.CLEARCOAT_G_ALPHA * mf.CLEARCOAT_G_ALPHA
         g = mf.g1_over_cos(xp, ci, a2 * (1.0 - zi2), zi2) * mf.g1_over_cos(
             xp, co, a2 * (1.0 - zo2), zo2
         )
         f = fr.schlick(xp, CLEARCOAT_F0, cos_d)
         # Burley's clearcoat keeps the 1/(4 cos cos) that Schutte and Mitsuba leave out.
-        k = times((0.25 * pr["clearcoat"]) * f * d * g, front)
+        k = times((0.25 * pr.clearcoat) * f * d * g, front)
         terms.append((None, xp.select(up, k, 0.0)))  # D is 0/0 at wi = −wo: a true select
     return terms
 
 
 # -- the model's four core functions -------------------------------------------------------
-def _eval_oriented(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> Any:
+def _eval_oriented(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any) -> Any:
     terms = _reflection_terms(xp, pr, wi, wo, front)
-    lobes = pr["lobes"]
-    glossy_t = "spec_trans" in lobes and "spec_trans" not in pr["delta"]
+    lobes = pr.lobes
+    glossy_t = "spec_trans" in lobes and "spec_trans" not in pr.delta
     if "diff_trans" in lobes or glossy_t:
         down = (wi[2] < 0.0) & (wo[2] > 0.0)
-        t = pr["diff_trans"] * INV_PI if "diff_trans" in lobes else 0.0
-        if pr["volume"] and "diff_trans" in lobes:
+        t = pr.diff_trans * INV_PI if "diff_trans" in lobes else 0.0
+        if pr.volume and "diff_trans" in lobes:
             # The entry into (and exit from) the medium is the diffuse's Lambertian part,
             # Schutte's f_lambert (1 − F_L/2)(1 − F_V/2): symmetric, and with no internal
             # reflection it keeps the boundary's albedo below 1 from either side.
             t = t * (1.0 - 0.5 * fr.schlick_weight(xp, -wi[2]))
             t = t * (1.0 - 0.5 * fr.schlick_weight(xp, wo[2]))
         if glossy_t:
-            t = t + pr["glass"] * transmission(xp, pr, wi, wo, front, pdf=False)
-        terms.append((pr["trans_color"], xp.select(down, t, 0.0)))
+            t = t + pr.glass * transmission(xp, pr, wi, wo, front, pdf=False)
+        terms.append((pr.trans_color, xp.select(down, t, 0.0)))
     grey = [s for c, s in terms if c is None]
-    f = xp.zeros(wi[2]) * pr["base"] if not grey else None
+    f = xp.zeros(wi[2]) * pr.base if not grey else None
     for color, scalar in terms:
         f = _add(f, color * scalar if color is not None else None)
     return _add(f, sum(grey[1:], grey[0]) if grey else None)
@@ -255,11 +270,11 @@ def _add(total: Any, term: Any) -> Any:
     return term if total is None else total + term
 
 
-def _odds(xp: Any, pr: dict[str, Any], front: Any) -> dict[str, Any]:
-    return {k: pick(xp, front, v, pr["odds_inside"][k]) for k, v in pr["odds"].items()}
+def _odds(xp: Any, pr: DisneyPrepared, front: Any) -> dict[str, Any]:
+    return {k: pick(xp, front, v, pr.odds_inside[k]) for k, v in pr.odds.items()}
 
 
-def _pdf_oriented(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> Any:
+def _pdf_oriented(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any) -> Any:
     odds = _odds(xp, pr, front)
     ci, co = wi[2], wo[2]
     up = (ci > 0.0) & (co > 0.0)
@@ -271,47 +286,45 @@ def _pdf_oriented(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any) -> 
         p_up = (odds.get("diffuse", 0.0) + odds.get("sheen", 0.0)) * INV_PI * ci
     if "clearcoat" in odds:
         # D(h) cos θh / (4 wo·h) with cos θh = h_z/|h| and wo·h = |h|/2.
-        d = mf.gtr_d(
-            xp, 1.0, pr["clearcoat_a2"], h[2] * h[2] / h2, (h[0] * h[0] + h[1] * h[1]) / h2
-        )
+        d = mf.gtr_d(xp, 1.0, pr.clearcoat_a2, h[2] * h[2] / h2, (h[0] * h[0] + h[1] * h[1]) / h2)
         p_up = p_up + odds["clearcoat"] * d * h[2] / (2.0 * h2)
     p = xp.select(up, p_up, 0.0)
     if "diff_trans" in odds:
         p = p + xp.select(down, odds["diff_trans"] * -ci * INV_PI, 0.0)
-    glossy = [k for k in INTERFACE if k in odds and k not in pr["delta"]]
+    glossy = [k for k in INTERFACE if k in odds and k not in pr.delta]
     if glossy:
         o_d = sum(odds[k] for k in INTERFACE if k in odds)
         p = p + o_d * interface_pdf(xp, pr, wi, wo, front, h2, up, down)
     return p
 
 
-def _oriented(xp: Any, pr: dict[str, Any], wi: Any, wo: Any) -> tuple[Any, Any, Any, Any]:
+def _oriented(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any) -> tuple[Any, Any, Any, Any]:
     """(wi, wo, front, s) in the frame where wo is up; untouched when nothing needs it.
 
     Only a thin sheet (two-sided) or transmission looks at a viewer below the surface:
     without them every lobe is masked to wo.z > 0 anyway, and the flip is skipped.
     """
-    if not (pr["thin"] or "spec_trans" in pr["lobes"] or "diff_trans" in pr["lobes"]):
+    if not (pr.thin or "spec_trans" in pr.lobes or "diff_trans" in pr.lobes):
         return wi, wo, None, None
     wi_, wo_, s = _orient(xp, wi, wo)
     return wi_, wo_, _front(pr, s), s
 
 
-def eval_core(xp: Any, pr: dict[str, Any], wi: Any, wo: Any) -> Any:
+def eval_core(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any) -> Any:
     """f(wi, wo) without the cosine (the :class:`~.bsdf.Model` contract)."""
     wi_, wo_, front, _ = _oriented(xp, pr, wi, wo)
     return _eval_oriented(xp, pr, wi_, wo_, front)
 
 
-def pdf_core(xp: Any, pr: dict[str, Any], wi: Any, wo: Any) -> Any:
+def pdf_core(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any) -> Any:
     """Solid-angle density of :func:`sample_core` producing wi: the lobe mixture."""
     wi_, wo_, front, _ = _oriented(xp, pr, wi, wo)
     return _pdf_oriented(xp, pr, wi_, wo_, front)
 
 
-def _candidates(xp: Any, pr: dict[str, Any], wo: Any, u1: Any, u2: Any) -> dict:
+def _candidates(xp: Any, pr: DisneyPrepared, wo: Any, u1: Any, u2: Any) -> dict:
     """One direction per present lobe outside the interface, and whether it is valid."""
-    lobes = pr["lobes"]
+    lobes = pr.lobes
     out = {}
     if {"diffuse", "sheen", "diff_trans"} & set(lobes):
         r, phi = xp.sqrt(u1), 2.0 * math.pi * u2  # Malley's method
@@ -319,12 +332,12 @@ def _candidates(xp: Any, pr: dict[str, Any], wo: Any, u1: Any, u2: Any) -> dict:
         out["diffuse"] = out["sheen"] = (xp.vec3(x, y, z), z > 0.0)
         out["diff_trans"] = (xp.vec3(x, y, -z), z > 0.0)
     if "clearcoat" in lobes:
-        wi = mf.reflect(xp, wo, mf.sample_gtr(xp, 1.0, pr["clearcoat_a2"], u1, u2))
+        wi = mf.reflect(xp, wo, mf.sample_gtr(xp, 1.0, pr.clearcoat_a2, u1, u2))
         out["clearcoat"] = (wi, wi[2] > 0.0)
     return out
 
 
-def sample_core(xp: Any, pr: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any, Any, Any]:
+def sample_core(xp: Any, pr: DisneyPrepared, wo: Any, u: Any) -> tuple[Any, Any, Any, Any]:
     """(wi, f·|cos θi|/pdf, pdf, delta): u[0] picks a lobe by its odds, u[1], u[2] its
     direction. The specular interface (reflection and glass) is one choice, taking the
     last share of u[0], and splits by the Fresnel term (:mod:`.disney_interface`); a delta
@@ -333,7 +346,7 @@ def sample_core(xp: Any, pr: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any,
     odds = _odds(xp, pr, front)
     zero = xp.zeros(wo_[2])
     if not odds:  # nothing to sample (an opaque solid seen from inside)
-        return xp.vec3(zero, zero, zero), zero * pr["base"], zero, False
+        return xp.vec3(zero, zero, zero), zero * pr.base, zero, False
     interface = [k for k in INTERFACE if k in odds]
     others = [k for k in LOBES if k in odds and k not in INTERFACE]
     cands = _candidates(xp, pr, wo_, u[1], u[2])
@@ -364,13 +377,13 @@ def sample_core(xp: Any, pr: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any,
     valid = valid & (wo_[2] > 0.0)
     # A failed candidate may be NaN; evaluate at a harmless finite direction instead.
     wi = xp.vec3(*(xp.select(valid, wi[k], wo_[k]) for k in range(3)))
-    if any(k not in pr["delta"] for k in odds):
+    if any(k not in pr.delta for k in odds):
         pdf = xp.select(valid, _pdf_oriented(xp, pr, wi, wo_, front), 0.0)
         f = _eval_oriented(xp, pr, wi, wo_, front)
         ok = pdf > 0.0
         weight = f * xp.select(ok, xp.abs(wi[2]) / xp.select(ok, pdf, 1.0), 0.0)
     else:  # only delta lobes: nothing has a density
-        pdf, weight = zero, zero * pr["base"]
+        pdf, weight = zero, zero * pr.base
     if delta is not False:
         p_delta = o_d * p_choice
         ok_d = valid & (p_delta > 0.0)
@@ -386,14 +399,12 @@ def sample_core(xp: Any, pr: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any,
     return wi, weight, pdf, delta
 
 
-def restrict(xp: Any, prepared: dict[str, Any], names: Any) -> dict[str, Any]:
+def restrict(xp: Any, prepared: DisneyPrepared, names: Any) -> DisneyPrepared:
     """``prepared`` with only the lobes in ``names``, their sampling odds renormalised."""
-    pr = {**prepared, "lobes": tuple(k for k in prepared["lobes"] if k in names)}
-    pr["odds"], pr["odds_inside"] = lobe_odds(xp, pr)
-    return pr
+    return with_odds(xp, prepared, tuple(k for k in prepared.lobes if k in names))
 
 
-def guide_core(xp: Any, pr: dict[str, Any], wo: Any) -> Any:
+def guide_core(xp: Any, pr: DisneyPrepared, wo: Any) -> Any:
     """The glossy lobes' share of a denoiser's albedo guide (:mod:`.guides`), by OIDN's
     rules: a metal its colour at normal incidence (metallic·base, the F0 of the Schlick
     blend in ``spec_a``); glass the Fresnel blend of its reflection (1) and its
@@ -401,19 +412,19 @@ def guide_core(xp: Any, pr: dict[str, Any], wo: Any) -> Any:
     the dielectric specular of a plastic and the clearcoat (non-absorbing coats) nothing.
     Seen from inside an opaque solid, nothing at all. None when no glossy lobe adds.
     """
-    lobes = pr["lobes"]
+    lobes = pr.lobes
     _, wo_, front, _ = _oriented(xp, pr, wo, wo)
-    if front is None and not pr["thin"]:
+    if front is None and not pr.thin:
         front = xp.select(wo[2] > 0.0, 1.0, 0.0)  # one-sided: nothing from below, as eval
     out = None
     if "specular" in lobes:
         # 1 − w_d − w_g = metallic (disney_prepare: w_d + w_g = 1 − metallic).
-        metallic = 1.0 - pr["diffuse"] - pr["diff_trans"] - pr["glass"]
+        metallic = 1.0 - pr.diffuse - pr.diff_trans - pr.glass
         if not xp.known_zero(metallic):
-            out = times(metallic * pr["base"], front)
+            out = times(metallic * pr.base, front)
     if "spec_trans" in lobes:
-        f = fr.dielectric(xp, wo_[2], pick(xp, front, pr["eta"], 1.0 / pr["eta"]))
-        out = _add(out, pr["glass"] * (f + (1.0 - f) * pr["trans_color"]))
+        f = fr.dielectric(xp, wo_[2], pick(xp, front, pr.eta, 1.0 / pr.eta))
+        out = _add(out, pr.glass * (f + (1.0 - f) * pr.trans_color))
     return out
 
 
@@ -430,14 +441,12 @@ MODEL = Model(
 )
 
 
-def keep_every_lobe(xp: Any, prepared: dict[str, Any]) -> dict[str, Any]:
+def keep_every_lobe(xp: Any, prepared: DisneyPrepared) -> DisneyPrepared:
     """A prepared material with pruning undone: every lobe evaluated, zero weights and all.
 
     The same values at a higher cost; the baseline that measures what pruning saves.
     """
-    pr = {**prepared, "lobes": LOBES}
-    pr["odds"], pr["odds_inside"] = lobe_odds(xp, pr)
-    return pr
+    return with_odds(xp, prepared, LOBES)
 
 
 def lobe_model(*names: str) -> Model:
@@ -448,7 +457,7 @@ def lobe_model(*names: str) -> Model:
     if unknown:
         raise ValueError(f"unknown lobe(s) {sorted(unknown)}; known: {', '.join(LOBES)}")
 
-    def prepare_only(xp: Any, params: DisneyParams, **maps: Any) -> dict[str, Any]:
+    def prepare_only(xp: Any, params: DisneyParams, **maps: Any) -> DisneyPrepared:
         return restrict(xp, prepare(xp, params, **maps), names)
 
     return dataclasses.replace(MODEL, name="disney[" + ",".join(names) + "]", prepare=prepare_only)

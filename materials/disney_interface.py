@@ -34,7 +34,7 @@ from typing import Any
 
 from . import fresnel as fr
 from . import microfacet as mf
-from .bsdf import ADJOINT
+from .disney_prepare import DisneyPrepared
 
 __all__ = [
     "INTERFACE",
@@ -63,31 +63,31 @@ def times(x: Any, front: Any) -> Any:
     return x if front is None else x * front
 
 
-def projected(pr: dict[str, Any], w: Any, z2: Any, prefix: str = "") -> Any:
+def projected(pr: DisneyPrepared, w: Any, z2: Any, transmitted: bool = False) -> Any:
     """αx² x² + αy² y², the projected roughness of Smith's Λ (Heitz 2014 eq. 86).
 
     Isotropic constants use x² + y² = 1 − z² (only its absolute error matters: q is
     added to z²), which saves two products per direction.
     """
-    ax2, ay2 = pr[prefix + "ax2"], pr[prefix + "ay2"]
+    ax2, ay2 = (pr.tax2, pr.tay2) if transmitted else (pr.ax2, pr.ay2)
     if isinstance(ax2, float) and ax2 == ay2:
         return ax2 * (1.0 - z2)
     return ax2 * (w[0] * w[0]) + ay2 * (w[1] * w[1])
 
 
-def _qt(pr: dict[str, Any], w: Any) -> Any:
-    return projected(pr, w, w[2] * w[2], "t")
+def _qt(pr: DisneyPrepared, w: Any) -> Any:
+    return projected(pr, w, w[2] * w[2], transmitted=True)
 
 
-def etap(xp: Any, pr: dict[str, Any], front: Any) -> Any:
+def etap(xp: Any, pr: DisneyPrepared, front: Any) -> Any:
     """η of the far side over the viewer's side (a thin sheet: η on both sides)."""
-    return pick(xp, front, pr["eta"], 1.0 / pr["eta"])
+    return pick(xp, front, pr.eta, 1.0 / pr.eta)
 
 
-def transmission(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any, pdf: bool) -> Any:
+def transmission(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any, pdf: bool) -> Any:
     """f (without weight and colour) of the glossy transmission, or its lobe pdf; wi below."""
-    ax, ay = pr["tax"], pr["tay"]
-    if pr["thin"]:
+    ax, ay = pr.tax, pr.tay
+    if pr.thin:
         # Schutte: reflection about the rougher thin α, mirrored through the sheet.
         wm = xp.vec3(wi[0], wi[1], -wi[2])
         h = xp.normalize(wm + wo)
@@ -95,22 +95,22 @@ def transmission(xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any, pdf:
         if pdf:
             return mf.visible_ggx_pdf(xp, wo, h, ax, ay) / xp.maximum(4.0 * oh, xp.tiny)
         g = mf.g1_over_cos(xp, wm[2], _qt(pr, wm)) * mf.g1_over_cos(xp, wo[2], _qt(pr, wo))
-        return (1.0 - fr.dielectric(xp, oh, pr["eta"])) * mf.ggx_d(xp, h, ax, ay) * g * 0.25
+        return (1.0 - fr.dielectric(xp, oh, pr.eta)) * mf.ggx_d(xp, h, ax, ay) * g * 0.25
     return mf.dielectric_btdf(xp, wi, wo, etap(xp, pr, front), ax, ay, pdf)
 
 
-def specular_d(xp: Any, pr: dict[str, Any], h: Any, h2: Any) -> Any:
+def specular_d(xp: Any, pr: DisneyPrepared, h: Any, h2: Any) -> Any:
     """D of the primary specular lobe at the unnormalised half vector h (|h|² = ``h2``):
     the anisotropic GGX (eq. 13) at γ = 2, else the isotropic GTR of eq. 1 with α² = αx αy
     (``specular_gamma``, Burley 2012 App. B).
 
     The GTR D is ∞ at h = 0 (wi = −wo, never a reflection pair): callers select, not mask.
     """
-    if pr["ggx"]:
-        return mf.ggx_d(xp, h, pr["ax"], pr["ay"], n2=h2)
+    if pr.ggx:
+        return mf.ggx_d(xp, h, pr.ax, pr.ay, n2=h2)
     inv_h2 = 1.0 / xp.maximum(h2, xp.tiny)
     sin2_h = (h[0] * h[0] + h[1] * h[1]) * inv_h2  # not 1 − cos²: the α = 10⁻³ peak
-    return mf.gtr_d(xp, pr["gamma"], pr["a2"], h[2] * h[2] * inv_h2, sin2_h)
+    return mf.gtr_d(xp, pr.gamma, pr.a2, h[2] * h[2] * inv_h2, sin2_h)
 
 
 def v_cavity_over_cos(xp: Any, h: Any, h2: Any, ci: Any, co: Any) -> Any:
@@ -128,21 +128,21 @@ def v_cavity_over_cos(xp: Any, h: Any, h2: Any, ci: Any, co: Any) -> Any:
     return xp.minimum(inv, k / xp.maximum(xp.maximum(ci, co), xp.tiny))
 
 
-def _has(pr: dict[str, Any]) -> tuple[bool, bool, bool, bool]:
+def _has(pr: DisneyPrepared) -> tuple[bool, bool, bool, bool]:
     """(reflection present, transmission present, reflection delta, transmission delta)."""
-    lobes, delta = pr["lobes"], pr["delta"]
+    lobes, delta = pr.lobes, pr.delta
     r, t = "specular" in lobes, "spec_trans" in lobes
     return r, t, r and "specular" in delta, t and "spec_trans" in delta
 
 
-def per_facet(pr: dict[str, Any]) -> bool:
+def per_facet(pr: DisneyPrepared) -> bool:
     """Whether the choice takes F at the sampled microfacet (a solid, rough, both lobes)."""
     r, t, dr, _ = _has(pr)
     # A GTR reflection (γ ≠ 2) and the GGX glass have different micro-normals: no sharing.
-    return r and t and not dr and not pr["thin"] and pr["ggx"]
+    return r and t and not dr and not pr.thin and pr.ggx
 
 
-def split(xp: Any, pr: dict[str, Any], cos: Any, front: Any) -> tuple[Any, Any]:
+def split(xp: Any, pr: DisneyPrepared, cos: Any, front: Any) -> tuple[Any, Any]:
     """(P_R, P_T): the probabilities of reflecting and transmitting at incidence ``cos``.
 
     P_R = F_R / (F_R + F_T): F_R the luminance of the specular lobe's Fresnel (Schlick's
@@ -153,15 +153,15 @@ def split(xp: Any, pr: dict[str, Any], cos: Any, front: Any) -> tuple[Any, Any]:
     if not has_t:
         return 1.0, 0.0
     f = fr.dielectric(xp, cos, etap(xp, pr, front))
-    t = pr["glass"] * (1.0 - f)
+    t = pr.glass * (1.0 - f)
     if not has_r:
         r = 0.0
     else:
-        lum_a = pr["spec_lum_a"]
-        r = pick(xp, front, pr["spec_c"], pr["glass"]) * f
-        if not (xp.known_zero(lum_a) and xp.known_zero(pr["spec_b"])):
+        lum_a = pr.spec_lum_a
+        r = pick(xp, front, pr.spec_c, pr.glass) * f
+        if not (xp.known_zero(lum_a) and xp.known_zero(pr.spec_b)):
             w = fr.schlick_weight(xp, cos)
-            r = r + times(lum_a + (pr["spec_b"] - lum_a) * w, front)
+            r = r + times(lum_a + (pr.spec_b - lum_a) * w, front)
     total = r + t
     # A subnormal total (spec_trans = 1e-45 in float32) has no finite reciprocal: r·∞ is NaN
     ok = total > xp.tiny
@@ -169,34 +169,34 @@ def split(xp: Any, pr: dict[str, Any], cos: Any, front: Any) -> tuple[Any, Any]:
     return r * inv, t * inv
 
 
-def delta_reflectance(xp: Any, pr: dict[str, Any], co: Any, front: Any, scale: Any) -> Any:
+def delta_reflectance(xp: Any, pr: DisneyPrepared, co: Any, front: Any, scale: Any) -> Any:
     """The smooth specular lobe's weight at the mirror direction: its Fresnel at θo.
 
     The α → 0 limit of ∫ f cos θi dωi: F_front(θo) = A + (B − A)(1 − cos θo)⁵ + c F(θo)
     outside (:func:`.disney_prepare._fresnel_terms`), w_g F(θo, 1/η) inside a solid,
     times the Conty-Kulla scaling under a sheen.
     """
-    a, b = pr["spec_a"], pr["spec_b"]
+    a, b = pr.spec_a, pr.spec_b
     col = times(a + (b - a) * fr.schlick_weight(xp, co), front)
-    if not xp.known_zero(pr["spec_c"]):
+    if not xp.known_zero(pr.spec_c):
         f = fr.dielectric(xp, co, etap(xp, pr, front))
-        col = col + pick(xp, front, pr["spec_c"], pr["glass"]) * f
+        col = col + pick(xp, front, pr.spec_c, pr.glass) * f
     return col * scale
 
 
-def delta_transmittance(xp: Any, pr: dict[str, Any], co: Any, front: Any) -> Any:
+def delta_transmittance(xp: Any, pr: DisneyPrepared, co: Any, front: Any) -> Any:
     """The smooth glass's transmitted weight: w_g T (1 − F(θo)), over η² through a solid
     (radiance, as :func:`.microfacet.dielectric_btdf`); a thin sheet does not refract.
 
-    The adjoint (``pr["adjoint"]``, a light tracer: ``co`` is then the light's side)
+    The adjoint (``pr.adjoint``, a light tracer: ``co`` is then the light's side)
     has no 1/η²: Snell pairs have one Fresnel, and radiance/η² is what is conserved,
     so the η² of the radiance form is all that differs (Mitsuba's ``dielectric``).
     """
     e = etap(xp, pr, front)
-    t = pr["glass"] * (1.0 - fr.dielectric(xp, co, e))
-    if not pr["thin"] and not pr.get(ADJOINT, False):
+    t = pr.glass * (1.0 - fr.dielectric(xp, co, e))
+    if not pr.thin and not pr.adjoint:
         t = t / (e * e)
-    return pr["trans_color"] * t
+    return pr.trans_color * t
 
 
 def _snell(xp: Any, wo: Any, e: Any) -> tuple[Any, Any]:
@@ -209,7 +209,7 @@ def _snell(xp: Any, wo: Any, e: Any) -> tuple[Any, Any]:
 
 
 def sample_interface(
-    xp: Any, pr: dict[str, Any], wo: Any, v: Any, u1: Any, u2: Any, front: Any, scale: Any
+    xp: Any, pr: DisneyPrepared, wo: Any, v: Any, u1: Any, u2: Any, front: Any, scale: Any
 ) -> tuple[Any, Any, Any, Any, Any]:
     """One direction of the interface from ``v`` (the choice) and ``u1, u2`` (its direction).
 
@@ -225,24 +225,24 @@ def sample_interface(
         if d_r:
             wr, ok_r = xp.vec3(-wo[0], -wo[1], co), co > 0.0
         else:
-            if pr["ggx"]:
-                h = mf.sample_visible_ggx(xp, wo, pr["ax"], pr["ay"], u1, u2)
+            if pr.ggx:
+                h = mf.sample_visible_ggx(xp, wo, pr.ax, pr.ay, u1, u2)
             else:  # visible-normal sampling exists for GGX only: App. B eqs. 2–3
-                h = mf.sample_gtr(xp, pr["gamma"], pr["a2"], u1, u2)
+                h = mf.sample_gtr(xp, pr.gamma, pr.a2, u1, u2)
             wr = mf.reflect(xp, wo, h)
             ok_r = wr[2] > 0.0
     if has_t:
         e = etap(xp, pr, front)
         if d_t:
-            if pr["thin"]:
+            if pr.thin:
                 wt, ok_t = xp.vec3(-wo[0], -wo[1], -co), co > 0.0
             else:
                 wt, ok_t = _snell(xp, wo, e)
         else:
-            ht = h if h is not None and not pr["thin"] and pr["ggx"] else None
+            ht = h if h is not None and not pr.thin and pr.ggx else None
             if ht is None:
-                ht = mf.sample_visible_ggx(xp, wo, pr["tax"], pr["tay"], u1, u2)
-            if pr["thin"]:
+                ht = mf.sample_visible_ggx(xp, wo, pr.tax, pr.tay, u1, u2)
+            if pr.thin:
                 m = mf.reflect(xp, wo, ht)
                 wt, ok_t = xp.vec3(m[0], m[1], -m[2]), m[2] > 0.0
             else:
@@ -261,7 +261,7 @@ def sample_interface(
     delta = d_r if d_r == d_t else xp.select(reflect, d_r, d_t)
     value = None
     if d_r or d_t:
-        zero = xp.zeros(co) * pr["trans_color"]
+        zero = xp.zeros(co) * pr.trans_color
         vr = delta_reflectance(xp, pr, co, front, scale) if d_r else zero
         vt = delta_transmittance(xp, pr, co, front) if d_t else zero
         value = xp.select(reflect, vr, vt)
@@ -269,7 +269,7 @@ def sample_interface(
 
 
 def interface_pdf(
-    xp: Any, pr: dict[str, Any], wi: Any, wo: Any, front: Any, h2: Any, up: Any, down: Any
+    xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any, h2: Any, up: Any, down: Any
 ) -> Any:
     """Density of the interface's glossy lobes producing wi (without the interface odds).
 
@@ -283,11 +283,11 @@ def interface_pdf(
         p_r, p_t = split(xp, pr, co, front)
     if has_r and not d_r:
         h = wi + wo
-        if pr["ggx"]:
+        if pr.ggx:
             # Visible normals: D_wo(h)/(4 wo·h) = G1(wo) D(h) / (4 cos θo).
             zo2 = co * co
             g1 = mf.g1_over_cos(xp, co, projected(pr, wo, zo2), zo2)
-            vndf = 0.25 * mf.ggx_d(xp, h, pr["ax"], pr["ay"], n2=h2) * g1
+            vndf = 0.25 * mf.ggx_d(xp, h, pr.ax, pr.ay, n2=h2) * g1
         else:
             # GTR (App. B eqs. 2–3): D(h) cos θh / (4 wo·h), cos θh = h_z/|h|, wo·h = |h|/2.
             vndf = xp.select(up, specular_d(xp, pr, h, h2) * h[2] / (2.0 * h2), 0.0)
@@ -299,7 +299,7 @@ def interface_pdf(
             e = etap(xp, pr, front)
             ht = mf.transmission_half(xp, wi, wo, e)
             p_t = split(xp, pr, xp.dot(wo, ht), front)[1]
-            pt = mf.dielectric_btdf(xp, wi, wo, e, pr["tax"], pr["tay"], True, h=ht)
+            pt = mf.dielectric_btdf(xp, wi, wo, e, pr.tax, pr.tay, True, h=ht)
         else:
             pt = transmission(xp, pr, wi, wo, front, pdf=True)
         p = p + xp.select(down, p_t * pt, 0.0)

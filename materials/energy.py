@@ -103,13 +103,12 @@ def factor(xp: Any, f0: Any, cos_o: Any, r: Any) -> Any:
     return 1.0 + f0 * (1.0 / e - 1.0)
 
 
-def f0_of(xp: Any, pr: dict[str, Any]) -> Any:
+def f0_of(xp: Any, spec_a: Any, spec_c: Any, eta: Any) -> Any:
     """The specular lobe's Fresnel at normal incidence, seen from outside (a colour):
     A of the Schlick blend plus the exact-Fresnel part c·F(0, η)."""
-    a = pr["spec_a"]
-    if xp.known_zero(pr["spec_c"]):
-        return a
-    return a + pr["spec_c"] * fr.ior_to_f0(pr["eta"])
+    if xp.known_zero(spec_c):
+        return spec_a
+    return spec_a + spec_c * fr.ior_to_f0(eta)
 
 
 # -- numpy --------------------------------------------------------------------------------

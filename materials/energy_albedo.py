@@ -7,6 +7,8 @@ max abs 0.004466 at cos θ = 0.0217, r = 0.113;
 max rel 0.00496 at cos θ = 0.0217, r = 0.113.
 """
 
+__all__ = ["N_MU", "N_R", "VALUES"]
+
 N_MU = 64
 N_R = 32
 # fmt: off

@@ -15,6 +15,15 @@ from typing import TYPE_CHECKING, Any, TypeVar
 if TYPE_CHECKING:  # pydantic costs a command line a tenth of a second: only for types here
     from pydantic import BaseModel, ValidationError
 
+__all__ = [
+    "LookdevError",
+    "ParameterError",
+    "argument",
+    "check_range",
+    "one_line",
+    "register_schema",
+    "short_repr",
+]
 
 _ARGUMENT = re.compile("\ue000([A-Za-z_][A-Za-z0-9_]*)\ue001")
 

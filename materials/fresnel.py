@@ -23,6 +23,19 @@ from typing import Any
 
 import numpy as np
 
+__all__ = [
+    "ETA_MAX",
+    "F0_MAX",
+    "SPECULAR_F0_SCALE",
+    "dielectric",
+    "f0_to_ior",
+    "ior_to_f0",
+    "ior_to_specular",
+    "schlick",
+    "schlick_weight",
+    "specular_to_ior",
+]
+
 SPECULAR_F0_SCALE = 0.08
 """Burley 2012 §5.4: ``specular`` 0..1 is remapped linearly to F0 0..0.08 (IOR 1.0..1.8)."""
 

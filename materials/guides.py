@@ -44,7 +44,7 @@ __all__ = ["diffuse_lobes", "guide_albedo", "albedo_guide"]
 def diffuse_lobes(model: Model, prepared: Any) -> tuple[str, ...]:
     """The kept lobes of ``prepared`` that the registry calls diffuse (Mitsuba's
     ``DiffuseReflection`` / ``DiffuseTransmission`` flags)."""
-    kept = prepared["lobes"]
+    kept = prepared.lobes
     return tuple(
         lobe.name for lobe in model.lobes if lobe.scattering == "diffuse" and lobe.name in kept
     )

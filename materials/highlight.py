@@ -39,7 +39,7 @@ def half_width(params: DisneyParams) -> float:
     wi = np.stack([np.sin(2.0 * th), 0.0 * th, np.cos(2.0 * th)])
     wo = np.array([[0.0], [0.0], [1.0]])
     prepared = _SPECULAR.prepare(xp, params)
-    if "specular" in prepared["delta"]:
+    if "specular" in prepared.delta:
         return 0.0  # a smooth GGX lobe is a delta (microfacet.is_delta): no width
     f = _SPECULAR.eval(xp, prepared, wi, wo)[1]  # green: any channel
     below = np.flatnonzero(f < 0.5 * f[0])

@@ -31,6 +31,29 @@ from pydantic import BeforeValidator, Field, TypeAdapter, model_validator
 
 from .params import Params, register_schema
 
+__all__ = [
+    "CombineMask",
+    "ConstantMask",
+    "InvertMask",
+    "LayerSpec",
+    "LevelsMask",
+    "Mask",
+    "NoiseMask",
+    "RAMP_MAX",
+    "RAMP_MIN_SPAN",
+    "RampMask",
+    "SEED_MAX",
+    "TextureMask",
+    "UV",
+    "UV_MAX",
+    "Wrap",
+    "check_texture_reference",
+    "children",
+    "map_textures",
+    "mask_adapter",
+    "textures",
+]
+
 UV_MAX = 4096.0
 """Ceiling of ``|uv_scale|`` and ``|uv_offset|`` of a texture (repeats of the UV square)."""
 UV = Annotated[float, Field(ge=-UV_MAX, le=UV_MAX)]

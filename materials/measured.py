@@ -32,18 +32,20 @@ that).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import BeforeValidator, ConfigDict, Field, field_validator
 
-from .bsdf import Lobe, Model
+from .bsdf import Lobe, Model, Prepared
 from .params import Params
 from .tables import gather
 
 __all__ = [
     "GRIDS",
     "MODEL",
+    "MeasuredPrepared",
     "MeasuredParams",
     "MeasuredTable",
     "grid_directions",
@@ -234,10 +236,10 @@ def _gather(xp: Any, channels: tuple[np.ndarray, ...], index: Any) -> Any:
     return xp.vec3(*(gather(xp, c, index) for c in channels))
 
 
-def _interpolate(xp: Any, prepared: dict[str, Any], x0: Any, x1: Any, x2: Any) -> Any:
+def _interpolate(xp: Any, prepared: MeasuredPrepared, x0: Any, x1: Any, x2: Any) -> Any:
     """Trilinear interpolation; the third axis wraps where the grid is periodic."""
-    n0, n1, n2 = prepared["shape"]
-    periodic = prepared["grid"] == "merl"
+    n0, n1, n2 = prepared.shape
+    periodic = prepared.grid == "merl"
 
     def split(x: Any, n: int, wrap: bool) -> tuple[Any, Any, Any]:
         if wrap:
@@ -252,7 +254,7 @@ def _interpolate(xp: Any, prepared: dict[str, Any], x0: Any, x1: Any, x2: Any) -
     i0, j0, t0 = split(x0, n0, False)
     i1, j1, t1 = split(x1, n1, False)
     i2, j2, t2 = split(x2, n2, periodic)
-    channels = prepared["channels"]
+    channels = prepared.channels
     out = 0.0
     for a, wa in ((i0, 1 - t0), (j0, t0)):
         for b, wb in ((i1, 1 - t1), (j1, t1)):
@@ -262,37 +264,51 @@ def _interpolate(xp: Any, prepared: dict[str, Any], x0: Any, x1: Any, x2: Any) -
 
 
 # -- the core functions ------------------------------------------------------------------------
-def prepare(xp: Any, params: MeasuredParams, **maps: Any) -> dict[str, Any]:
+@dataclass(frozen=True, kw_only=True)
+class MeasuredPrepared(Prepared):
+    """What the interpolated table reads (no IOR, no delta)."""
+
+    channels: tuple[Any, Any, Any]
+    """The table's red, green and blue values, each flattened over its grid."""
+    grid: Any
+    """The table's parametrisation (:data:`GRIDS`)."""
+    shape: tuple[int, ...]
+    """Its node counts per coordinate."""
+    scale: Any
+    """A factor on f."""
+
+
+def prepare(xp: Any, params: MeasuredParams, **maps: Any) -> MeasuredPrepared:
     """The table as the backend reads it (a flattened array), its grid and the scale."""
     table = params.table
     dtype = xp.dtype if xp.name == "numpy" else np.float32
     flat = table.flat().astype(dtype)
-    return {
-        "lobes": ("measured",) if params.scale > 0 else (),
-        "channels": tuple(np.ascontiguousarray(flat[:, c]) for c in range(3)),
-        "grid": table.grid,
-        "shape": table.shape,
-        "scale": maps.get("scale", params.scale),
-    }
+    return MeasuredPrepared(
+        lobes=("measured",) if params.scale > 0 else (),
+        channels=tuple(np.ascontiguousarray(flat[:, c]) for c in range(3)),
+        grid=table.grid,
+        shape=table.shape,
+        scale=maps.get("scale", params.scale),
+    )
 
 
-def eval(xp: Any, prepared: dict[str, Any], wi: Any, wo: Any) -> Any:  # noqa: A001
+def eval(xp: Any, prepared: MeasuredPrepared, wi: Any, wo: Any) -> Any:  # noqa: A001
     """f(wi, wo): the interpolated table times ``scale``; 0 below either side."""
     above = (wi[2] > _COS_FLOOR) & (wo[2] > _COS_FLOOR)
-    if not prepared["lobes"]:
+    if not prepared.lobes:
         return xp.zeros(wi[2]) * xp.color((0.0, 0.0, 0.0))
-    x = table_coordinates(xp, prepared["grid"], prepared["shape"], wi, wo)
-    f = _interpolate(xp, prepared, *x) * prepared["scale"]
+    x = table_coordinates(xp, prepared.grid, prepared.shape, wi, wo)
+    f = _interpolate(xp, prepared, *x) * prepared.scale
     return xp.select(above, f, 0.0 * f)
 
 
-def pdf(xp: Any, prepared: dict[str, Any], wi: Any, wo: Any) -> Any:
+def pdf(xp: Any, prepared: MeasuredPrepared, wi: Any, wo: Any) -> Any:
     """Cosine-weighted hemisphere density cos θi / π, on the viewer's side only."""
     ok = (wi[2] > 0) & (wo[2] > 0)
     return xp.select(ok, wi[2] * (1.0 / math.pi), 0.0 * wi[2])
 
 
-def sample(xp: Any, prepared: dict[str, Any], wo: Any, u: Any):
+def sample(xp: Any, prepared: MeasuredPrepared, wo: Any, u: Any):
     """A cosine-weighted direction (Malley's method); weight f·cos θi / pdf = π f."""
     r = xp.safe_sqrt(u[1])
     phi = 2.0 * math.pi * u[2]

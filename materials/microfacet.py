@@ -50,6 +50,33 @@ import numpy as np
 
 from . import fresnel as fr
 
+__all__ = [
+    "ALPHA_MIN",
+    "CLEARCOAT_G_ALPHA",
+    "anisotropic_alphas",
+    "dielectric_btdf",
+    "exprel",
+    "g1_over_cos",
+    "ggx_d",
+    "ggx_roughness_like_gtr",
+    "gtr_d",
+    "gtr_half_max_sin2",
+    "gtr_norm",
+    "gtr_sample_cos2",
+    "gtr_sample_sin2",
+    "is_delta",
+    "log_exprel",
+    "projected_roughness",
+    "reflect",
+    "refract",
+    "sample_ggx",
+    "sample_gtr",
+    "sample_visible_ggx",
+    "smith_g1",
+    "transmission_half",
+    "visible_ggx_pdf",
+]
+
 ALPHA_MIN = 1e-3
 CLEARCOAT_G_ALPHA = 0.25  # Burley 2012 §5.6: the clearcoat's fixed GGX G roughness
 _SERIES = 1e-6  # |x| below which exprel and the sampling ratio use their series

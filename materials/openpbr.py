@@ -50,10 +50,11 @@ True
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 from . import energy, fresnel, sheen
-from .bsdf import Lobe, Model
+from .bsdf import Lobe, Model, Prepared
 from .microfacet import (
     ALPHA_MIN,
     dielectric_btdf,
@@ -74,7 +75,7 @@ from .openpbr_params import (
     schlick_split,
 )
 
-__all__ = ["MODEL", "OpenPBRParams"]
+__all__ = ["MODEL", "OpenPBRParams", "OpenPBRPrepared"]
 
 MAPPED = ("base_color", "base_weight", "base_metalness", "specular_roughness")
 """Inputs that may vary per element (the rest are constants of a material)."""
@@ -94,7 +95,78 @@ def _positive(value: Any) -> bool:
     return not isinstance(value, float) or value > 0.0
 
 
-def prepare(xp: Any, params: OpenPBRParams, **maps: Any) -> dict[str, Any]:
+@dataclass(frozen=True, kw_only=True)
+class OpenPBRPrepared(Prepared):
+    """What the OpenPBR lobes read (OpenPBR 1.1 names in brackets); ``eta`` is the
+    specular IOR as modulated by the coat above it."""
+
+    m: Any
+    """Metalness (``base_metalness``)."""
+    t: float
+    """``transmission_weight``."""
+    s: float
+    """``subsurface_weight``."""
+    c: float
+    """``coat_weight``."""
+    fuzz_w: float
+    """``fuzz_weight``."""
+    base: Any
+    """``base_color`` × ``base_weight``."""
+    sss: Any
+    """``subsurface_color``."""
+    sigma: float
+    """Oren–Nayar roughness of the diffuse (``base_diffuse_roughness``)."""
+    spec_color: Any
+    """``specular_color``."""
+    spec_weight: float
+    """``specular_weight``."""
+    trans_color: Any
+    """``transmission_color``."""
+    coat_color: Any
+    """``coat_color``."""
+    coat_ior: float
+    """``coat_ior``."""
+    darken: float
+    """``coat_darkening``."""
+    fuzz_color: Any
+    """``fuzz_color``."""
+    fuzz_r: float
+    """``fuzz_roughness``."""
+    opacity: float
+    """``geometry_opacity``."""
+    thin: bool
+    """``geometry_thin_walled``."""
+    eta_r: Any
+    """The IOR the reflection is read with: max(η, 1/η) (no total internal reflection)."""
+    ax: Any
+    """Specular GGX αx."""
+    ay: Any
+    """Specular GGX αy."""
+    r: Any
+    """The specular roughness (αx αy)^¼ the energy tables are read at."""
+    cax: Any
+    """Coat GGX αx."""
+    cay: Any
+    """Coat GGX αy."""
+    cr: float
+    """The coat's (αx αy)^¼."""
+    e_base: Any
+    """Normal-incidence albedo of the base under the coat (the darkening's E_b)."""
+    r_b: Any
+    """The base's roughness for the darkening."""
+    k_r: float
+    """The coat's internal reflectance 1 − (1 − F̄)/n² (the darkening)."""
+    p_cos: float
+    """Probability of a cosine-weighted sample (diffuse, subsurface, fuzz)."""
+    p_spec: float
+    """Probability of a specular (metal or dielectric) sample."""
+    p_coat: float
+    """Probability of a coat sample."""
+    p_trans: float
+    """Probability of a transmission sample."""
+
+
+def prepare(xp: Any, params: OpenPBRParams, **maps: Any) -> OpenPBRPrepared:
     """Weights, alphas, IORs and the view-independent parts of the darkening."""
     p = params
     m = maps.get("base_metalness", p.base_metalness)
@@ -143,41 +215,44 @@ def prepare(xp: Any, params: OpenPBRParams, **maps: Any) -> dict[str, Any]:
         "trans": t if "transmission" in lobes else 0.0,
     }
     total = sum(live.values()) or 1.0
-    return {
-        "lobes": tuple(lobes),
-        "m": m,
-        "t": t,
-        "s": s,
-        "c": c,
-        "fuzz_w": fz,
-        "base": base,
-        "sss": xp.color(p.subsurface_color),
-        "sigma": p.base_diffuse_roughness,
-        "spec_color": spec_color,
-        "spec_weight": p.specular_weight,
-        "trans_color": xp.color(p.transmission_color),
-        "coat_color": xp.color(p.coat_color),
-        "coat_ior": p.coat_ior,
-        "darken": p.coat_darkening,
-        "fuzz_color": xp.color(p.fuzz_color),
-        "fuzz_r": p.fuzz_roughness,
-        "opacity": p.geometry_opacity,
-        "thin": p.geometry_thin_walled,
-        "eta": eta,
+    return OpenPBRPrepared(
+        lobes=tuple(lobes),
+        m=m,
+        t=t,
+        s=s,
+        c=c,
+        fuzz_w=fz,
+        base=base,
+        sss=xp.color(p.subsurface_color),
+        sigma=p.base_diffuse_roughness,
+        spec_color=spec_color,
+        spec_weight=p.specular_weight,
+        trans_color=xp.color(p.transmission_color),
+        coat_color=xp.color(p.coat_color),
+        coat_ior=p.coat_ior,
+        darken=p.coat_darkening,
+        fuzz_color=xp.color(p.fuzz_color),
+        fuzz_r=p.fuzz_roughness,
+        opacity=p.geometry_opacity,
+        thin=p.geometry_thin_walled,
+        eta=eta,
         # under a denser coat η′ < 1: the reflection is read with 1/η′ (same F0, no
         # total internal reflection, which the light refracted into the coat never meets)
-        "eta_r": max(eta, 1.0 / eta),
-        "ax": ax,
-        "ay": ay,
-        "r": r_spec,
-        "cax": cax,
-        "cay": cay,
-        "cr": math.sqrt(math.sqrt(cax * cay)),
-        "e_base": e_base,
-        "r_b": r_b,
-        "k_r": k_r,
-        **{f"p_{k}": v / total for k, v in live.items()},
-    }
+        eta_r=max(eta, 1.0 / eta),
+        ax=ax,
+        ay=ay,
+        r=r_spec,
+        cax=cax,
+        cay=cay,
+        cr=math.sqrt(math.sqrt(cax * cay)),
+        e_base=e_base,
+        r_b=r_b,
+        k_r=k_r,
+        p_cos=live["cos"] / total,
+        p_spec=live["spec"] / total,
+        p_coat=live["coat"] / total,
+        p_trans=live["trans"] / total,
+    )
 
 
 def _ggx(xp: Any, h: Any, wi: Any, wo: Any, ax: Any, ay: Any) -> Any:
@@ -193,69 +268,69 @@ def _lobe_albedo(xp: Any, f0: Any, mu: Any, r: Any) -> Any:
     return f0 * (e - b) + b
 
 
-def eval(xp: Any, p: dict[str, Any], wi: Any, wo: Any) -> Any:
+def eval(xp: Any, p: OpenPBRPrepared, wi: Any, wo: Any) -> Any:
     """f(wi, wo) without the cosine, for a view above the surface."""
-    lobes = p["lobes"]
+    lobes = p.lobes
     mu_o = xp.maximum(wo[2], 1e-9)
     up = (wi[2] > 0.0) & (wo[2] > 0.0)
     down = (wi[2] < 0.0) & (wo[2] > 0.0)
     h = xp.normalize(wi + wo)
     oh = xp.clip(xp.dot(wo, h), 0.0, 1.0)
-    m = p["m"]
-    zero = 0.0 * p["base"] * wi[2]
+    m = p.m
+    zero = 0.0 * p.base * wi[2]
     reflected, transmitted = zero, zero
-    term = _ggx(xp, h, wi, wo, p["ax"], p["ay"]) if {"metal", "specular"} & set(lobes) else 0.0
+    term = _ggx(xp, h, wi, wo, p.ax, p.ay) if {"metal", "specular"} & set(lobes) else 0.0
     e_spec = zero
     if "specular" in lobes:
-        f0 = fresnel.ior_to_f0(p["eta"])
-        comp = energy.factor(xp, f0, mu_o, p["r"])
-        spec = p["spec_color"] * fresnel.dielectric(xp, oh, p["eta_r"]) * (term * comp)
+        f0 = fresnel.ior_to_f0(p.eta)
+        comp = energy.factor(xp, f0, mu_o, p.r)
+        spec = p.spec_color * fresnel.dielectric(xp, oh, p.eta_r) * (term * comp)
         reflected = reflected + (1.0 - m) * spec
-        e_spec = p["spec_color"] * (_lobe_albedo(xp, f0, mu_o, p["r"]) * comp)
+        e_spec = p.spec_color * (_lobe_albedo(xp, f0, mu_o, p.r) * comp)
     under = zero
-    t, s = p["t"], p["s"]
+    t, s = p.t, p.s
     if "diffuse" in lobes:
-        under = under + (1.0 - t) * (1.0 - s) * eon(xp, p["base"], p["sigma"], wi, wo)
+        under = under + (1.0 - t) * (1.0 - s) * eon(xp, p.base, p.sigma, wi, wo)
     if "subsurface" in lobes:
-        under = under + (1.0 - t) * s * p["sss"] * (1.0 / math.pi)
+        under = under + (1.0 - t) * s * p.sss * (1.0 / math.pi)
     reflected = reflected + (1.0 - m) * (1.0 - e_spec) * under
     if "transmission" in lobes:
         wi_t = xp.select(down, wi, -wi)  # keeps the masked-out lanes finite
-        btdf = dielectric_btdf(xp, wi_t, wo, p["eta"], p["ax"], p["ay"], False)
-        h_t = xp.normalize(wi_t * p["eta"] + wo)
-        keep = 1.0 - fresnel.dielectric(xp, xp.abs(xp.dot(wo, h_t)), p["eta"])
+        btdf = dielectric_btdf(xp, wi_t, wo, p.eta, p.ax, p.ay, False)
+        h_t = xp.normalize(wi_t * p.eta + wo)
+        keep = 1.0 - fresnel.dielectric(xp, xp.abs(xp.dot(wo, h_t)), p.eta)
         lobe = btdf / xp.maximum(keep, 1e-6)  # the specification omits this Fresnel factor
-        if p["thin"]:
+        if p.thin:
             # a thin wall's second interface undoes the first's radiance compression
-            lobe = lobe * (p["eta"] * p["eta"])
-        transmitted = (1.0 - m) * t * (1.0 - e_spec) * p["trans_color"] * lobe
+            lobe = lobe * (p.eta * p.eta)
+        transmitted = (1.0 - m) * t * (1.0 - e_spec) * p.trans_color * lobe
     if "metal" in lobes:
-        f = f82_tint(xp, p["base"], p["spec_color"], oh) * p["spec_weight"]
-        comp = energy.factor(xp, p["base"], mu_o, p["r"])
+        f = f82_tint(xp, p.base, p.spec_color, oh) * p.spec_weight
+        comp = energy.factor(xp, p.base, mu_o, p.r)
         reflected = reflected + m * f * (term * comp)
     if "coat" in lobes:
-        c = p["c"]
-        cterm = _ggx(xp, h, wi, wo, p["cax"], p["cay"])
-        ccomp = energy.factor(xp, fresnel.ior_to_f0(p["coat_ior"]), mu_o, p["cr"])
-        f_view = fresnel.dielectric(xp, mu_o, p["coat_ior"])
-        e_coat = _lobe_albedo(xp, fresnel.ior_to_f0(p["coat_ior"]), mu_o, p["cr"]) * ccomp
-        k = f_view + (p["k_r"] - f_view) * p["r_b"]
-        dark = 1.0 + (darkening(k, p["e_base"]) - 1.0) * (c * p["darken"])
-        scale = (1.0 - c + c * p["coat_color"] * (1.0 - e_coat)) * dark
-        coat = c * fresnel.dielectric(xp, oh, p["coat_ior"]) * cterm * ccomp
+        c = p.c
+        cterm = _ggx(xp, h, wi, wo, p.cax, p.cay)
+        ccomp = energy.factor(xp, fresnel.ior_to_f0(p.coat_ior), mu_o, p.cr)
+        f_view = fresnel.dielectric(xp, mu_o, p.coat_ior)
+        e_coat = _lobe_albedo(xp, fresnel.ior_to_f0(p.coat_ior), mu_o, p.cr) * ccomp
+        k = f_view + (p.k_r - f_view) * p.r_b
+        dark = 1.0 + (darkening(k, p.e_base) - 1.0) * (c * p.darken)
+        scale = (1.0 - c + c * p.coat_color * (1.0 - e_coat)) * dark
+        coat = c * fresnel.dielectric(xp, oh, p.coat_ior) * cterm * ccomp
         reflected = reflected * scale + coat
         transmitted = transmitted * scale
     if "fuzz" in lobes:
-        fz = p["fuzz_w"]
-        fuzz = sheen.lobe(xp, wi, wo, p["fuzz_r"], True)
-        e_fuzz = sheen.albedo_lookup(xp, mu_o, p["fuzz_r"])
-        reflected = fz * p["fuzz_color"] * fuzz + (1.0 - fz * e_fuzz) * reflected
+        fz = p.fuzz_w
+        fuzz = sheen.lobe(xp, wi, wo, p.fuzz_r, True)
+        e_fuzz = sheen.albedo_lookup(xp, mu_o, p.fuzz_r)
+        reflected = fz * p.fuzz_color * fuzz + (1.0 - fz * e_fuzz) * reflected
         transmitted = (1.0 - fz * e_fuzz) * transmitted
     out = xp.select(up, reflected, zero) + xp.select(down, transmitted, zero)
-    return out * p["opacity"]
+    return out * p.opacity
 
 
-def pdf(xp: Any, p: dict[str, Any], wi: Any, wo: Any) -> Any:
+def pdf(xp: Any, p: OpenPBRPrepared, wi: Any, wo: Any) -> Any:
     """Density of :func:`sample`: cosine, visible-normal GGX reflection (base and coat),
     visible-normal refraction."""
     up = (wi[2] > 0.0) & (wo[2] > 0.0)
@@ -263,34 +338,34 @@ def pdf(xp: Any, p: dict[str, Any], wi: Any, wo: Any) -> Any:
     h = xp.normalize(wi + wo)
     jac = 1.0 / xp.maximum(4.0 * xp.abs(xp.dot(wo, h)), 1e-12)
     out = 0.0 * wi[2]
-    if p["p_cos"] > 0.0:
-        out = out + p["p_cos"] * xp.maximum(wi[2], 0.0) / math.pi
-    if p["p_spec"] > 0.0:
-        out = out + p["p_spec"] * visible_ggx_pdf(xp, wo, h, p["ax"], p["ay"]) * jac
-    if p["p_coat"] > 0.0:
-        out = out + p["p_coat"] * visible_ggx_pdf(xp, wo, h, p["cax"], p["cay"]) * jac
+    if p.p_cos > 0.0:
+        out = out + p.p_cos * xp.maximum(wi[2], 0.0) / math.pi
+    if p.p_spec > 0.0:
+        out = out + p.p_spec * visible_ggx_pdf(xp, wo, h, p.ax, p.ay) * jac
+    if p.p_coat > 0.0:
+        out = out + p.p_coat * visible_ggx_pdf(xp, wo, h, p.cax, p.cay) * jac
     nothing = 0.0 * wi[2]  # not 0·out: masked lanes may hold NaN (a view below)
     out = xp.select(up, out, nothing)
-    if p["p_trans"] > 0.0:
+    if p.p_trans > 0.0:
         wi_t = xp.select(down, wi, -wi)
-        pt = p["p_trans"] * dielectric_btdf(xp, wi_t, wo, p["eta"], p["ax"], p["ay"], True)
+        pt = p.p_trans * dielectric_btdf(xp, wi_t, wo, p.eta, p.ax, p.ay, True)
         out = out + xp.select(down, pt, nothing)
     return out
 
 
-def sample(xp: Any, p: dict[str, Any], wo: Any, u: Any) -> Any:
+def sample(xp: Any, p: OpenPBRPrepared, wo: Any, u: Any) -> Any:
     """Pick cosine, base reflection, coat reflection or refraction by ``u[0]``."""
     u0, u1, u2 = u[0], u[1], u[2]
     r = xp.sqrt(u1)
     phi = 2.0 * math.pi * u2
     cos_dir = xp.vec3(r * xp.cos(phi), r * xp.sin(phi), xp.safe_sqrt(1.0 - u1))
     wo_up = xp.vec3(wo[0], wo[1], xp.maximum(wo[2], 1e-6))
-    h = sample_visible_ggx(xp, wo_up, p["ax"] + 0.0 * u1, p["ay"] + 0.0 * u1, u1, u2)
-    hc = sample_visible_ggx(xp, wo_up, p["cax"] + 0.0 * u1, p["cay"] + 0.0 * u1, u1, u2)
-    refr, _ = refract(xp, wo_up, h, p["eta"])
-    c1 = p["p_cos"]
-    c2 = c1 + p["p_spec"]
-    c3 = c2 + p["p_coat"]
+    h = sample_visible_ggx(xp, wo_up, p.ax + 0.0 * u1, p.ay + 0.0 * u1, u1, u2)
+    hc = sample_visible_ggx(xp, wo_up, p.cax + 0.0 * u1, p.cay + 0.0 * u1, u1, u2)
+    refr, _ = refract(xp, wo_up, h, p.eta)
+    c1 = p.p_cos
+    c2 = c1 + p.p_spec
+    c3 = c2 + p.p_coat
     wi = xp.select(
         u0 < c1,
         cos_dir,
@@ -300,9 +375,7 @@ def sample(xp: Any, p: dict[str, Any], wo: Any, u: Any) -> Any:
     f = eval(xp, p, wi, wo)
     ok = (density > 0.0) & (wo[2] > 0.0)
     nothing = 0.0 * u0
-    weight = xp.select(
-        ok, f * xp.abs(wi[2]) / xp.maximum(density, 1e-30), nothing + 0.0 * p["base"]
-    )
+    weight = xp.select(ok, f * xp.abs(wi[2]) / xp.maximum(density, 1e-30), nothing + 0.0 * p.base)
     return wi, weight, xp.select(ok, density, nothing), False
 
 

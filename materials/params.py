@@ -35,6 +35,19 @@ from .errors import ParameterError as ParameterError  # re-exported
 from .errors import one_line, register_schema
 from .fresnel import SPECULAR_F0_SCALE, ior_to_specular, specular_to_ior
 
+__all__ = [
+    "Channel",
+    "Color",
+    "DisneyParams",
+    "Params",
+    "SCATTER_DISTANCE_MAX",
+    "SCATTER_DISTANCE_MIN",
+    "SHEEN_MAX",
+    "SPECULAR_GAMMA_MAX",
+    "SheenLambda",
+    "parse_color",
+]
+
 _HEX = re.compile(r"^#?([0-9a-fA-F]{6})$")
 
 

@@ -25,7 +25,7 @@ Two models share these lobes. :data:`MODEL` takes Smits' parameters
 (:class:`PixarParams`); :data:`LAYERED_MODEL` takes the twelve weights themselves at the
 two ends of the view, cones, falloffs and IOR (:data:`PixarLobeWeights`), which is what
 compositing a layered stack produces (:mod:`lookdev.pipeline.blend.pixar_composite`). The first
-is the second after one step: parameters → weights → the same prepared dict
+is the second after one step: parameters → weights → the same prepared values
 (:func:`.pixar_scatter.prepared`), so a one-layer stack renders as its preset.
 
 >>> w = lobe_weights(PixarParams(surface_color=1.0, metallic=0.0, roughness=0.0))
@@ -50,6 +50,7 @@ from .pixar_lobes import LN_10, reflection_cone, specular_cone
 from .pixar_scatter import (
     PIXAR_LOBES,
     PREFIX,
+    PixarPrepared,
     at_view,
     delta_lobes,
     prepared,
@@ -58,6 +59,29 @@ from .pixar_scatter import (
     scatter_pdf,
     scatter_sample,
 )
+
+__all__ = [
+    "CONE_LOBES",
+    "DIELECTRIC_REFL",
+    "FALLOFF_LOBES",
+    "GRAZING",
+    "LAYERED_MODEL",
+    "LOBE_SCALE_MAX",
+    "MODEL",
+    "PixarLobeWeights",
+    "PixarParams",
+    "WEIGHT_NAMES",
+    "Weight",
+    "as_lobe_weights",
+    "ends",
+    "eta_of",
+    "eval",
+    "lobe_weights",
+    "pdf",
+    "sample",
+    "view_independent",
+    "weights",
+]
 
 DIELECTRIC_REFL = 0.05  # Smits' default normal reflectance of a dielectric
 
@@ -261,7 +285,7 @@ def weights(xp: Any, w: dict[str, Any], cos_view: Any) -> dict[str, Any]:
     return at_view(xp, ends(xp, w), cos_view)
 
 
-def _prepare(xp: Any, params: PixarParams, **maps: Any) -> dict[str, Any]:
+def _prepare(xp: Any, params: PixarParams, **maps: Any) -> PixarPrepared:
     """Parameters → Smits' weights and exponents → :func:`.pixar_scatter.prepared`."""
     v = _values(xp, params, maps)
     r = v["roughness"]
@@ -278,7 +302,7 @@ def _prepare(xp: Any, params: PixarParams, **maps: Any) -> dict[str, Any]:
     return prepared(xp, ends(xp, view_independent(xp, v)), powers, eta, delta)
 
 
-def _prepare_weights(xp: Any, params: Any, **maps: Any) -> dict[str, Any]:
+def _prepare_weights(xp: Any, params: Any, **maps: Any) -> PixarPrepared:
     """Composited weights (:data:`PixarLobeWeights`) → :func:`.pixar_scatter.prepared`.
 
     Each weight is taken at the two view ends and interpolated in s = (1 − V·n)⁵

@@ -20,6 +20,31 @@ from __future__ import annotations
 import math
 from typing import Any
 
+__all__ = [
+    "CONE_MIN_DEG",
+    "DEG",
+    "INV_PI",
+    "LN_10",
+    "back_view",
+    "cone_power",
+    "cosine_hemisphere",
+    "distribution",
+    "frn_blend",
+    "half_vector_pdf",
+    "p_diffuse",
+    "p_specular",
+    "power_reflection",
+    "power_specular",
+    "reflect",
+    "reflection_cone",
+    "sample_half_vector",
+    "schlick_weight",
+    "sin2_of",
+    "specular_cone",
+    "to_back",
+    "weight",
+]
+
 INV_PI = 1.0 / math.pi
 LN_10 = math.log(10.0)
 DEG = math.pi / 180.0

@@ -1,19 +1,35 @@
 """Scattering by Smits' six lobes once their weights are known: f, pdf and sampling.
 
-Both Pixar models (:mod:`.pixar`) reduce a material to one *prepared* dict
+Both Pixar models (:mod:`.pixar`) reduce a material to one :class:`PixarPrepared`
 (:func:`prepared`): the twelve weights at the two ends of the view, each highlight lobe's
 exponent, the IOR and the lobes whose weights are not known to be zero. The functions
-here read only that dict, so a plain material and a composited stack scatter by the same
+here read only that, so a plain material and a composited stack scatter by the same
 code. Lobe shapes are in :mod:`.pixar_lobes`; the surface is two-sided (the view's side
 is +z), and a lobe is sampled with the probability of its estimated albedo at the view.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 from . import pixar_lobes as lobes
-from .bsdf import ADJOINT, Lobe
+from .bsdf import Lobe, Prepared
+
+__all__ = [
+    "LOBES",
+    "PixarPrepared",
+    "PIXAR_LOBES",
+    "PREFIX",
+    "at_view",
+    "delta_lobes",
+    "kept_lobes",
+    "prepared",
+    "scatter_eval",
+    "scatter_guide",
+    "scatter_pdf",
+    "scatter_sample",
+]
 
 PIXAR_LOBES = (
     Lobe("diffuse", "diffuse", family="diffuse", params=("diffuse_scale",)),
@@ -107,20 +123,33 @@ def delta_lobes(cones: dict[str, Any], falloffs: dict[str, Any]) -> tuple[str, .
     return tuple(out)
 
 
+@dataclass(frozen=True, kw_only=True)
+class PixarPrepared(Prepared):
+    """What Smits' lobes read, for plain and composited (layered) Pixar materials alike;
+    ``eta`` is the IOR the transmitted highlights refract the view by."""
+
+    ends: dict[str, Any]
+    """Each of the twelve weights (``specN``, ``specG`` …, :data:`PREFIX`) at normal and
+    grazing view (None at grazing where it is view-independent), interpolated by
+    :func:`at_view`."""
+    power: dict[str, Any]
+    """Each highlight lobe's Phong-like exponent (:mod:`.pixar_lobes`)."""
+
+
 def prepared(
     xp: Any, pairs: dict, powers: dict[str, Any], eta: Any, delta: tuple[str, ...] = ()
-) -> dict[str, Any]:
+) -> PixarPrepared:
     """What eval/pdf/sample consume, from the weights' two ends, each highlight lobe's
     exponent, the IOR and the delta lobes (:func:`delta_lobes`): the one path for plain
     and composited materials."""
     kept = kept_lobes(xp, pairs)
-    return {
-        "ends": pairs,
-        "power": powers,
-        "eta": eta,
-        "lobes": kept,
-        "delta": tuple(k for k in delta if k in kept),
-    }
+    return PixarPrepared(
+        lobes=kept,
+        delta=tuple(k for k in delta if k in kept),
+        eta=eta,
+        ends=pairs,
+        power=powers,
+    )
 
 
 def _upper(xp: Any, wi: Any, wo: Any) -> tuple[Any, Any]:
@@ -129,11 +158,11 @@ def _upper(xp: Any, wi: Any, wo: Any) -> tuple[Any, Any]:
     return xp.vec3(wi[0], wi[1], wi[2] * s), xp.vec3(wo[0], wo[1], wo[2] * s)
 
 
-def _power(prep: dict[str, Any], lobe: str) -> Any:
-    return prep["power"][lobe]
+def _power(prep: PixarPrepared, lobe: str) -> Any:
+    return prep.power[lobe]
 
 
-def _lobe_value(xp: Any, prep: dict[str, Any], w: dict, lobe: str, wi: Any, wo: Any) -> Any:
+def _lobe_value(xp: Any, prep: PixarPrepared, w: dict, lobe: str, wi: Any, wo: Any) -> Any:
     """One lobe's f(wi, wo) (colour), zero on the side it does not cover."""
     p = PREFIX[lobe]
     n, g = w[p + "N"], w[p + "G"]
@@ -144,7 +173,7 @@ def _lobe_value(xp: Any, prep: dict[str, Any], w: dict, lobe: str, wi: Any, wo: 
         else:
             # Blended by the view's incidence on the front, where the light crosses: the
             # transmitted weights are the share the front Fresnel did not reflect.
-            back_i, back_o = lobes.to_back(xp, wi), lobes.back_view(xp, wo, prep["eta"])
+            back_i, back_o = lobes.to_back(xp, wi), lobes.back_view(xp, wo, prep.eta)
             f = lobes.p_specular(xp, back_i, back_o, _power(prep, lobe), n, g, wo[2])
     else:
         side = wi[2] > 0.0
@@ -155,12 +184,12 @@ def _lobe_value(xp: Any, prep: dict[str, Any], w: dict, lobe: str, wi: Any, wo: 
     return xp.select(side & (wo[2] > 0.0), f, 0.0)
 
 
-def scatter_eval(xp: Any, prep: dict[str, Any], wi: Any, wo: Any) -> Any:
+def scatter_eval(xp: Any, prep: PixarPrepared, wi: Any, wo: Any) -> Any:
     wi, wo = _upper(xp, wi, wo)
-    w = at_view(xp, prep["ends"], wo[2])
+    w = at_view(xp, prep.ends, wo[2])
     f = xp.zeros(wi[2]) * w["specN"]
-    for lobe in prep["lobes"]:
-        if lobe not in prep["delta"]:  # a delta has no value at any given direction
+    for lobe in prep.lobes:
+        if lobe not in prep.delta:  # a delta has no value at any given direction
             f = f + _lobe_value(xp, prep, w, lobe, wi, wo)
     return f
 
@@ -169,11 +198,11 @@ def _mean(c: Any) -> Any:
     return (c[0] + c[1] + c[2]) * (1.0 / 3.0)
 
 
-def _selection(xp: Any, prep: dict[str, Any], wo: Any) -> dict[str, Any]:
+def _selection(xp: Any, prep: PixarPrepared, wo: Any) -> dict[str, Any]:
     """Probability of sampling each kept lobe: its estimated albedo at this view."""
-    w = at_view(xp, prep["ends"], wo[2])
+    w = at_view(xp, prep.ends, wo[2])
     est = {}
-    for lobe in prep["lobes"]:
+    for lobe in prep.lobes:
         n, g = w[PREFIX[lobe] + "N"], w[PREFIX[lobe] + "G"]
         if lobe.startswith("diffuse"):
             albedo = n + (g - n) / 21.0  # exact: ∫ 2(1 − μ)⁵ μ dμ = 1/21
@@ -185,57 +214,57 @@ def _selection(xp: Any, prep: dict[str, Any], wo: Any) -> dict[str, Any]:
     return {lobe: e * inv for lobe, e in est.items()}
 
 
-def _lobe_pdf(xp: Any, prep: dict[str, Any], lobe: str, wi: Any, wo: Any) -> Any:
+def _lobe_pdf(xp: Any, prep: PixarPrepared, lobe: str, wi: Any, wo: Any) -> Any:
     if lobe == "diffuse":
         return xp.maximum(wi[2], 0.0) * lobes.INV_PI
     if lobe == "diffuse_t":
         return xp.maximum(-wi[2], 0.0) * lobes.INV_PI
     if lobe.endswith("_t"):
-        back_i, back_o = lobes.to_back(xp, wi), lobes.back_view(xp, wo, prep["eta"])
+        back_i, back_o = lobes.to_back(xp, wi), lobes.back_view(xp, wo, prep.eta)
         pdf = lobes.half_vector_pdf(xp, back_i, back_o, _power(prep, lobe))
         return xp.select(wi[2] < 0.0, pdf, 0.0)
     return xp.select(wi[2] > 0.0, lobes.half_vector_pdf(xp, wi, wo, _power(prep, lobe)), 0.0)
 
 
-def _mixture_pdf(xp: Any, prep: dict[str, Any], wi: Any, wo: Any) -> Any:
+def _mixture_pdf(xp: Any, prep: PixarPrepared, wi: Any, wo: Any) -> Any:
     probs = _selection(xp, prep, wo)
     pdf = xp.zeros(wi[2])
     for lobe, prob in probs.items():
-        if lobe not in prep["delta"]:
+        if lobe not in prep.delta:
             pdf = pdf + prob * _lobe_pdf(xp, prep, lobe, wi, wo)
     return xp.select(wo[2] > 0.0, pdf, 0.0)
 
 
-def scatter_pdf(xp: Any, prep: dict[str, Any], wi: Any, wo: Any) -> Any:
+def scatter_pdf(xp: Any, prep: PixarPrepared, wi: Any, wo: Any) -> Any:
     wi, wo = _upper(xp, wi, wo)
     return _mixture_pdf(xp, prep, wi, wo)
 
 
-def _candidate(xp: Any, prep: dict[str, Any], lobe: str, wo: Any, u1: Any, u2: Any) -> Any:
+def _candidate(xp: Any, prep: PixarPrepared, lobe: str, wo: Any, u1: Any, u2: Any) -> Any:
     """The direction lobe ``lobe`` would sample (upper side = the view's side)."""
     if lobe == "diffuse":
         return lobes.cosine_hemisphere(xp, u1, u2)
     if lobe == "diffuse_t":
         return lobes.to_back(xp, lobes.cosine_hemisphere(xp, u1, u2))
-    if lobe in prep["delta"]:  # the lobe's axis itself: the mirror, or the refracted view
-        view = lobes.back_view(xp, wo, prep["eta"]) if lobe.endswith("_t") else wo
+    if lobe in prep.delta:  # the lobe's axis itself: the mirror, or the refracted view
+        view = lobes.back_view(xp, wo, prep.eta) if lobe.endswith("_t") else wo
         mirror = xp.vec3(-view[0], -view[1], view[2])
         return lobes.to_back(xp, mirror) if lobe.endswith("_t") else mirror
     h = lobes.sample_half_vector(xp, _power(prep, lobe), u1, u2)
     if lobe.endswith("_t"):
-        view = lobes.back_view(xp, wo, prep["eta"])
+        view = lobes.back_view(xp, wo, prep.eta)
         return lobes.to_back(xp, lobes.reflect(xp, view, h))
     return lobes.reflect(xp, wo, h)
 
 
-def _delta_weight(xp: Any, prep: dict[str, Any], lobe: str, wo: Any) -> Any:
+def _delta_weight(xp: Any, prep: PixarPrepared, lobe: str, wo: Any) -> Any:
     """A delta lobe's weight: FrnBlend[N, G, cos θo], its albedo as the cone closes."""
-    w = at_view(xp, prep["ends"], wo[2])
+    w = at_view(xp, prep.ends, wo[2])
     p = PREFIX[lobe]
     return lobes.frn_blend(xp, w[p + "N"], w[p + "G"], wo[2])
 
 
-def _adjoint_refraction(xp: Any, prep: dict[str, Any], lobe: str, wl: Any) -> tuple[Any, Any]:
+def _adjoint_refraction(xp: Any, prep: PixarPrepared, lobe: str, wl: Any) -> tuple[Any, Any]:
     """The adjoint of a delta transmitted lobe, for light arriving from ``wl`` (+z side):
     (the viewer's direction, its weight).
 
@@ -246,7 +275,7 @@ def _adjoint_refraction(xp: Any, prep: dict[str, Any], lobe: str, wl: Any) -> tu
     the weight is η² W(v*), W the radiance weight FrnBlend[N, G, cos θv*] (Veach 1997
     §5.2: the adjoint of a bending without the 1/η² of radiance transport).
     """
-    eta = prep["eta"]
+    eta = prep.eta
     sin2 = eta * eta * (1.0 - wl[2] * wl[2])
     cos_v = xp.safe_sqrt(1.0 - sin2)
     view = xp.vec3(-wl[0] * eta, -wl[1] * eta, -cos_v)
@@ -254,31 +283,31 @@ def _adjoint_refraction(xp: Any, prep: dict[str, Any], lobe: str, wl: Any) -> tu
     return view, xp.select(sin2 < 1.0, weight, 0.0)
 
 
-def scatter_sample(xp: Any, prep: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any, Any, Any]:
-    """One sampled direction; with ``prep[ADJOINT]`` the delta lobes' adjoint (``wo`` is
+def scatter_sample(xp: Any, prep: PixarPrepared, wo: Any, u: Any) -> tuple[Any, Any, Any, Any]:
+    """One sampled direction; with ``prep.adjoint`` the delta lobes' adjoint (``wo`` is
     then where the light comes from, :class:`~.bsdf.Model`): the mirror is its own,
     a transmitted lobe's is :func:`_adjoint_refraction`."""
-    adjoint = prep.get(ADJOINT, False)
+    adjoint = prep.adjoint
     s = xp.select(wo[2] < 0.0, -1.0, 1.0)
     wo = xp.vec3(wo[0], wo[1], wo[2] * s)
     wi = xp.vec3(xp.zeros(u[0]), xp.zeros(u[0]), xp.zeros(u[0]) + 1.0)
     transmitted = u[0] < 0.0  # all False: the chosen lobe's side, filled in below
     delta = u[0] < 0.0
-    delta_value = xp.zeros(u[0]) * prep["ends"]["specN"][0]
+    delta_value = xp.zeros(u[0]) * prep.ends["specN"][0]
     delta_prob = xp.zeros(u[0])
     cumulative = 0.0
     for lobe, prob in _selection(xp, prep, wo).items():
         chosen = (u[0] >= cumulative) & (u[0] < cumulative + prob)
         cumulative = cumulative + prob
-        if adjoint and lobe in prep["delta"] and lobe.endswith("_t"):
+        if adjoint and lobe in prep.delta and lobe.endswith("_t"):
             candidate, value = _adjoint_refraction(xp, prep, lobe, wo)
         else:
             candidate = _candidate(xp, prep, lobe, wo, u[1], u[2])
-            value = _delta_weight(xp, prep, lobe, wo) if lobe in prep["delta"] else None
+            value = _delta_weight(xp, prep, lobe, wo) if lobe in prep.delta else None
         wi = xp.select(chosen, candidate, wi)
         if lobe.endswith("_t"):
             transmitted = transmitted | chosen
-        if lobe in prep["delta"]:
+        if lobe in prep.delta:
             delta = delta | chosen
             delta_value = xp.select(chosen, value, delta_value)
             delta_prob = xp.select(chosen, prob, delta_prob)
@@ -287,7 +316,7 @@ def scatter_sample(xp: Any, prep: dict[str, Any], wo: Any, u: Any) -> tuple[Any,
     pdf = xp.select(ok, _mixture_pdf(xp, prep, wi, wo), 0.0)
     f = scatter_eval(xp, prep, wi, wo)
     weight = f * xp.select(pdf > 0.0, xp.abs(wi[2]) / xp.maximum(pdf, xp.tiny), 0.0)
-    if prep["delta"]:
+    if prep.delta:
         ok_d = ok & delta & (delta_prob > 0.0)
         w_d = delta_value * xp.select(ok_d, 1.0 / xp.maximum(delta_prob, xp.tiny), 0.0)
         weight = xp.select(delta, w_d, weight)
@@ -298,16 +327,16 @@ def scatter_sample(xp: Any, prep: dict[str, Any], wo: Any, u: Any) -> tuple[Any,
     return xp.vec3(wi[0], wi[1], wi[2] * s), weight, pdf, delta
 
 
-def scatter_guide(xp: Any, prep: dict[str, Any], wo: Any) -> Any:
+def scatter_guide(xp: Any, prep: PixarPrepared, wo: Any) -> Any:
     """The highlight lobes' share of a denoiser's albedo guide (:mod:`.guides`): each
     one's weight at the view, FrnBlend[N, G, cos θo]. Smits' weights already partition
     the energy by Fresnel, so a metal gives its coloured reflectance and a glass the
     Fresnel blend of its reflection and its tinted transmission, as OIDN asks; a
     dielectric's reflection adds its few percent of white. None without highlights."""
     cos_v = xp.abs(wo[2])
-    w = at_view(xp, prep["ends"], cos_v)
+    w = at_view(xp, prep.ends, cos_v)
     out = None
-    for lobe in prep["lobes"]:
+    for lobe in prep.lobes:
         if not lobe.startswith("diffuse"):
             a = lobes.frn_blend(xp, w[PREFIX[lobe] + "N"], w[PREFIX[lobe] + "G"], cos_v)
             out = a if out is None else out + a

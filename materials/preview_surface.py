@@ -36,16 +36,17 @@ True
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 from pydantic import Field
 
-from .bsdf import Lobe, Model
+from .bsdf import Lobe, Model, Prepared
 from .fresnel import schlick_weight
 from .microfacet import ggx_d, sample_ggx
 from .params import Color, Params
 
-__all__ = ["MODEL", "PreviewParams"]
+__all__ = ["MODEL", "PreviewParams", "PreviewPrepared"]
 
 ALPHA_MIN = 0.001 * 0.001
 """The reference clamps roughness at 0.001 before squaring."""
@@ -70,7 +71,31 @@ def _alpha(xp: Any, r: Any) -> Any:
     return xp.maximum(r * r, ALPHA_MIN)
 
 
-def prepare(xp: Any, params: PreviewParams, **maps: Any) -> dict[str, Any]:
+@dataclass(frozen=True, kw_only=True)
+class PreviewPrepared(Prepared):
+    """What UsdPreviewSurface's lobes read (its reference implementation's terms)."""
+
+    diffuse: Any
+    """The Lambertian colour (``diffuseColor``, times 1 − metallic)."""
+    f0: Any
+    """Schlick's F0 of the specular."""
+    f90: Any
+    """Schlick's F90 of the specular."""
+    alpha: Any
+    """GGX α = roughness² of the specular (at least :data:`ALPHA_MIN`)."""
+    cc: float
+    """``clearcoat`` weight."""
+    cc_alpha: float
+    """GGX α of the clearcoat."""
+    cc_f0: float
+    """F0 of the clearcoat, from ``ior``."""
+    p_diffuse: float
+    """Probability of sampling the diffuse."""
+    p_coat: float
+    """Probability of sampling the clearcoat."""
+
+
+def prepare(xp: Any, params: PreviewParams, **maps: Any) -> PreviewPrepared:
     """F0, F90, the diffuse colour and the lobe weights of the metallic or specular workflow.
 
     ``maps`` may vary ``diffuse_color``, ``metallic`` and ``roughness`` per element."""
@@ -91,18 +116,18 @@ def prepare(xp: Any, params: PreviewParams, **maps: Any) -> dict[str, Any]:
     lobes = ["specular"] if metal else ["diffuse", "specular"]  # a pure metal has no diffuse
     if params.clearcoat > 0.0:
         lobes.append("clearcoat")
-    return {
-        "diffuse": diffuse,
-        "f0": f0,
-        "f90": f90,
-        "alpha": _alpha(xp, maps.get("roughness", params.roughness)),
-        "cc": params.clearcoat,
-        "cc_alpha": _alpha(xp, params.clearcoat_roughness),
-        "cc_f0": r2,
-        "lobes": tuple(lobes),
-        "p_diffuse": 0.0 if metal else 0.5,
-        "p_coat": 0.2 if params.clearcoat > 0.0 else 0.0,
-    }
+    return PreviewPrepared(
+        lobes=tuple(lobes),
+        diffuse=diffuse,
+        f0=f0,
+        f90=f90,
+        alpha=_alpha(xp, maps.get("roughness", params.roughness)),
+        cc=params.clearcoat,
+        cc_alpha=_alpha(xp, params.clearcoat_roughness),
+        cc_f0=r2,
+        p_diffuse=0.0 if metal else 0.5,
+        p_coat=0.2 if params.clearcoat > 0.0 else 0.0,
+    )
 
 
 def _schlick_ggx_g(nl: Any, nv: Any, alpha: float) -> Any:
@@ -111,50 +136,50 @@ def _schlick_ggx_g(nl: Any, nv: Any, alpha: float) -> Any:
     return (nv / (nv * (1.0 - k) + k)) * (nl / (nl * (1.0 - k) + k))
 
 
-def eval(xp: Any, p: dict[str, Any], wi: Any, wo: Any) -> Any:
+def eval(xp: Any, p: PreviewPrepared, wi: Any, wo: Any) -> Any:
     """f(wi, wo) without the cosine; 0 below either horizon."""
     nl, nv = wi[2], wo[2]
     up = (nl > 0.0) & (nv > 0.0)
     nl_, nv_ = xp.maximum(nl, 1e-9), xp.maximum(nv, 1e-9)
     h = xp.normalize(wi + wo)
     w = schlick_weight(xp, xp.clip(xp.dot(wo, h), 0.0, 1.0))
-    f = p["f0"] + (p["f90"] - p["f0"]) * w
+    f = p.f0 + (p.f90 - p.f0) * w
     denom = 4.0 * nl_ * nv_
-    a = p["alpha"]
+    a = p.alpha
     spec = f * (ggx_d(xp, h, a, a, 1.0) * _schlick_ggx_g(nl_, nv_, a) / denom)
-    out = p["diffuse"] * (1.0 / math.pi) * (1.0 - f) + spec
-    if "clearcoat" in p["lobes"]:
-        ca = p["cc_alpha"]
-        fc = p["cc_f0"] + (1.0 - p["cc_f0"]) * w
-        out = out + p["cc"] * fc * ggx_d(xp, h, ca, ca, 1.0) * _schlick_ggx_g(nl_, nv_, ca) / denom
+    out = p.diffuse * (1.0 / math.pi) * (1.0 - f) + spec
+    if "clearcoat" in p.lobes:
+        ca = p.cc_alpha
+        fc = p.cc_f0 + (1.0 - p.cc_f0) * w
+        out = out + p.cc * fc * ggx_d(xp, h, ca, ca, 1.0) * _schlick_ggx_g(nl_, nv_, ca) / denom
     return xp.select(up, out, 0.0 * out)
 
 
-def pdf(xp: Any, p: dict[str, Any], wi: Any, wo: Any) -> Any:
+def pdf(xp: Any, p: PreviewPrepared, wi: Any, wo: Any) -> Any:
     """Density of :func:`sample`: cosine diffuse, GGX micro-normals D(h)cosθh/(4|wo·h|)."""
     nl = wi[2]
     h = xp.normalize(wi + wo)
     jac = 1.0 / xp.maximum(4.0 * xp.abs(xp.dot(wo, h)), 1e-12)
-    pd = p["p_diffuse"]
-    pc = p["p_coat"]
+    pd = p.p_diffuse
+    pc = p.p_coat
     ps = 1.0 - pd - pc
-    a = p["alpha"]
+    a = p.alpha
     out = pd * xp.maximum(nl, 0.0) / math.pi + ps * ggx_d(xp, h, a, a, 1.0) * h[2] * jac
     if pc > 0.0:
-        ca = p["cc_alpha"]
+        ca = p.cc_alpha
         out = out + pc * ggx_d(xp, h, ca, ca, 1.0) * h[2] * jac
     return xp.select((nl > 0.0) & (wo[2] > 0.0), out, 0.0 * out)
 
 
-def sample(xp: Any, p: dict[str, Any], wo: Any, u: Any) -> Any:
+def sample(xp: Any, p: PreviewPrepared, wo: Any, u: Any) -> Any:
     """Pick diffuse (cosine), specular or coat (GGX micro-normal, reflected) by ``u[0]``."""
-    pd, pc = p["p_diffuse"], p["p_coat"]
+    pd, pc = p.p_diffuse, p.p_coat
     u1, u2 = u[1], u[2]
     r = xp.sqrt(u1)
     phi = 2.0 * math.pi * u2
     cos_dir = xp.vec3(r * xp.cos(phi), r * xp.sin(phi), xp.safe_sqrt(1.0 - u1))
-    a = p["alpha"] + 0.0 * u1  # arrays, so select works on either backend
-    ca = (p["cc_alpha"] if pc > 0.0 else p["alpha"]) + 0.0 * u1
+    a = p.alpha + 0.0 * u1  # arrays, so select works on either backend
+    ca = (p.cc_alpha if pc > 0.0 else p.alpha) + 0.0 * u1
     use_coat = u[0] >= 1.0 - pc
     alpha = xp.select(use_coat, ca, a)
     h = sample_ggx(xp, alpha, alpha, u1, u2)

@@ -100,7 +100,7 @@ def live_lobes(model: Model, params: Any, maps: Mapping[str, Any] | None = None)
     flat = _flattened(model.params_type, maps or {})
     with np.errstate(all="ignore"):
         prepared = model.prepare(NumpyOps(), _stored(params), **flat)
-    return tuple(prepared["lobes"])
+    return tuple(prepared.lobes)
 
 
 def _stored(params: Any) -> Any:

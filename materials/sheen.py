@@ -52,13 +52,14 @@ shows what the proofs show (the two modes' albedos differ by up to 0.07 at r = 0
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from pydantic import Field
 
 from .arrays import NumpyOps
-from .bsdf import Lobe, Model, density, draw, evaluate
+from .bsdf import Lobe, Model, Prepared, density, draw, evaluate
 from .params import Color, Params, SheenLambda, register_schema
 from .sheen_albedo import N_MU as _N_MU
 from .sheen_albedo import N_R as _N_R
@@ -80,6 +81,32 @@ from .sheen_tables import (
 from .sheen_tables import R_MIN_EXACT as R_MIN_EXACT  # re-exported for callers of sheen
 from .sheen_tables import area_nodes as area_nodes
 from .sheen_tables import projected_area as projected_area
+
+__all__ = [
+    "D",
+    "SheenPrepared",
+    "INV_TWO_PI",
+    "MODEL",
+    "SHEEN_LOBES",
+    "SheenParams",
+    "albedo",
+    "albedo_lookup",
+    "base_scale",
+    "distribution",
+    "eval",
+    "fit_coefficients",
+    "interpolate",
+    "lambda_fit",
+    "lambda_table",
+    "lobe",
+    "log_lambda",
+    "log_lambda_light",
+    "pdf",
+    "sample",
+    "shadowing",
+    "softening_exponent",
+    "table_nodes",
+]
 
 INV_TWO_PI = 1.0 / (2.0 * math.pi)
 
@@ -257,33 +284,47 @@ def base_scale(
 
 
 # -- the Model -----------------------------------------------------------------------------
-def _prepare(xp: Any, params: SheenParams, **maps: Any) -> dict[str, Any]:
+@dataclass(frozen=True, kw_only=True)
+class SheenPrepared(Prepared):
+    """What Conty–Kulla's sheen lobe reads (no IOR, no delta)."""
+
+    color: Any
+    """The sheen colour, channel-first."""
+    r: Any
+    """Sheen roughness r (the distribution's exponent 1/r, Conty–Kulla 2017 §2)."""
+    soften: bool
+    """The terminator softening of Λ on the light side (§3)."""
+    exact: bool
+    """Λ from the exact table, not the fit."""
+
+
+def _prepare(xp: Any, params: SheenParams, **maps: Any) -> SheenPrepared:
     color = xp.color(maps.get("color", params.color))
     r = xp.scalar(maps.get("roughness", params.roughness))
     lobes = () if xp.known_zero(color) else (SHEEN_LOBES[0].name,)
-    return {
-        "color": color,
-        "r": r,
-        "soften": params.terminator_softening,
-        "exact": params.sheen_lambda == "exact",
-        "lobes": lobes,
-    }
+    return SheenPrepared(
+        lobes=lobes,
+        color=color,
+        r=r,
+        soften=params.terminator_softening,
+        exact=params.sheen_lambda == "exact",
+    )
 
 
-def _eval(xp: Any, prepared: dict[str, Any], wi: Any, wo: Any) -> Any:
-    if not prepared["lobes"]:
-        return xp.zeros(wi[2]) * prepared["color"]
-    r, soften, exact = prepared["r"], prepared["soften"], prepared["exact"]
-    return prepared["color"] * lobe(xp, wi, wo, r, soften, exact)
+def _eval(xp: Any, prepared: SheenPrepared, wi: Any, wo: Any) -> Any:
+    if not prepared.lobes:
+        return xp.zeros(wi[2]) * prepared.color
+    r, soften, exact = prepared.r, prepared.soften, prepared.exact
+    return prepared.color * lobe(xp, wi, wo, r, soften, exact)
 
 
-def _pdf(xp: Any, prepared: dict[str, Any], wi: Any, wo: Any) -> Any:
-    if not prepared["lobes"]:
+def _pdf(xp: Any, prepared: SheenPrepared, wi: Any, wo: Any) -> Any:
+    if not prepared.lobes:
         return xp.zeros(wi[2])
     return xp.select((wi[2] > 0.0) & (wo[2] > 0.0), INV_TWO_PI, 0.0)
 
 
-def _sample(xp: Any, prepared: dict[str, Any], wo: Any, u: Any) -> tuple[Any, Any, Any, bool]:
+def _sample(xp: Any, prepared: SheenPrepared, wo: Any, u: Any) -> tuple[Any, Any, Any, bool]:
     # Uniform hemisphere (§2): cos θi = u1, φ = 2π u2; pdf 1/2π.
     z = u[1]
     s = xp.safe_sqrt(1.0 - z * z)
@@ -308,13 +349,13 @@ SHEEN_LOBES = (
 )
 
 
-def _guide(xp: Any, prepared: dict[str, Any], wo: Any) -> Any:
+def _guide(xp: Any, prepared: SheenPrepared, wo: Any) -> Any:
     """A denoiser's albedo guide (:mod:`.guides`): the cloth's colour times the lobe's
     directional albedo E(θo) from the table (OIDN: the surface's approximate colour)."""
-    if not prepared["lobes"]:
+    if not prepared.lobes:
         return None
-    e = albedo_lookup(xp, xp.abs(wo[2]), prepared["r"], prepared["soften"], prepared["exact"])
-    return prepared["color"] * e
+    e = albedo_lookup(xp, xp.abs(wo[2]), prepared.r, prepared.soften, prepared.exact)
+    return prepared.color * e
 
 
 MODEL = Model("sheen", SheenParams, _prepare, _eval, _pdf, _sample, lobes=SHEEN_LOBES, guide=_guide)

@@ -10,6 +10,8 @@ max abs 0.00149 at cos θ = 1.18e-05, r = 0.995;
 max rel 0.0439 at cos θ = 0.989, r = 0.128.
 """
 
+__all__ = ["N_MU", "N_R", "VALUES"]
+
 N_MU = 64
 N_R = 32
 # fmt: off

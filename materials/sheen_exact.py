@@ -14,6 +14,8 @@ The exact-Λ Conty-Kulla sheen (``sheen_lambda = "exact"``, r ≥ 0.01):
   max rel 0.187 at cos θ = 0.989, r = 0.0998.
 """
 
+__all__ = ["ALBEDO", "AREA", "N_MU", "N_R", "N_R_AREA", "N_THETA"]
+
 N_THETA = 64
 N_R_AREA = 24
 N_MU = 64

@@ -16,6 +16,8 @@ import threading
 import warnings
 from pathlib import Path
 
+__all__ = ["find_libllvm", "use_mitsuba"]
+
 _MIN_LLVM = 17
 
 

@@ -7,8 +7,10 @@ closed forms: f = ρ/π, albedo ρ at every angle, sphere radiance ρ/π · N·L
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import Any
 
-from lookdev.materials.bsdf import Model
+from lookdev.materials.bsdf import Model, Prepared
 from lookdev.materials.params import Color, Params
 
 
@@ -16,13 +18,20 @@ class LambertParams(Params):
     base_color: Color = (0.8, 0.5, 0.2)
 
 
+@dataclass(frozen=True, kw_only=True)
+class LambertPrepared(Prepared):
+    rho: Any  # the colour
+
+
 def _prepare(xp, params, **maps):
-    return {"rho": xp.color(maps.get("base_color", params.base_color))}
+    return LambertPrepared(
+        lobes=("diffuse",), rho=xp.color(maps.get("base_color", params.base_color))
+    )
 
 
 def _eval(xp, prepared, wi, wo):
     upper = (wi[2] > 0) & (wo[2] > 0)
-    return prepared["rho"] * xp.select(upper, 1.0 / math.pi, 0.0)
+    return prepared.rho * xp.select(upper, 1.0 / math.pi, 0.0)
 
 
 def _pdf(xp, prepared, wi, wo):
@@ -37,7 +46,7 @@ def _sample(xp, prepared, wo, u):
     wi = xp.vec3(r * xp.cos(phi), r * xp.sin(phi), z)
     ok = wo[2] > 0
     pdf = xp.select(ok, z / math.pi, 0.0)
-    weight = prepared["rho"] * xp.select(ok, 1.0, 0.0)
+    weight = prepared.rho * xp.select(ok, 1.0, 0.0)
     return wi, weight, pdf, False
 
 
@@ -57,25 +66,30 @@ def _phong_lobe(xp, exponent, wi, wo):
     return xp.power(cos_a, exponent) / (2.0 * math.pi)
 
 
+@dataclass(frozen=True, kw_only=True)
+class PhongPrepared(Prepared):
+    n: float  # the exponent
+
+
 def _phong_prepare(xp, params, **maps):
-    return {"n": params.exponent}
+    return PhongPrepared(lobes=("phong",), n=params.exponent)
 
 
 def _phong_eval(xp, prepared, wi, wo):
-    n = prepared["n"]
+    n = prepared.n
     f = (n + 2.0) * _phong_lobe(xp, n, wi, wo) * xp.select((wi[2] > 0) & (wo[2] > 0), 1.0, 0.0)
     return xp.vec3(f, f, f)
 
 
 def _phong_pdf(xp, prepared, wi, wo):
-    n = prepared["n"]
+    n = prepared.n
     return (n + 1.0) * _phong_lobe(xp, n, wi, wo)
 
 
 def _phong_sample(xp, prepared, wo, u):
     # Normalised Phong (Lafortune & Willems 1994): f = (n+2)/2π cos^n α around the mirror
     # direction r, sampled exactly in α with pdf (n+1)/2π cos^n α.
-    n = prepared["n"]
+    n = prepared.n
     r = _mirror(xp, wo)
     cos_a = xp.power(u[1], 1.0 / (n + 1.0))
     sin_a = xp.safe_sqrt(1.0 - cos_a * cos_a)

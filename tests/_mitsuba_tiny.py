@@ -8,10 +8,12 @@ show. ``prepare`` records the lobes it keeps, as the shipped models do.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import Any
 
 from pydantic import Field
 
-from lookdev.materials.bsdf import Lobe, Model
+from lookdev.materials.bsdf import Lobe, Model, Prepared
 from lookdev.materials.params import Color, Params
 
 
@@ -20,17 +22,23 @@ class TinyParams(Params):
     translucency: float = Field(0.0, ge=0.0, le=1.0)
 
 
+@dataclass(frozen=True, kw_only=True)
+class TinyPrepared(Prepared):
+    rho: Any  # the colour
+    t: Any  # the transmitted share
+
+
 def _lobe_weight(xp, p, wi, wo):
     same = wi[2] * wo[2] > 0
-    if "diff_trans" not in p["lobes"]:
+    if "diff_trans" not in p.lobes:
         return xp.select(same, 1.0, 0.0)
-    return xp.select(same, 1.0 - p["t"], p["t"])
+    return xp.select(same, 1.0 - p.t, p.t)
 
 
 def _prepare(xp, params, **maps):
     t = maps.get("translucency", params.translucency)
     lobes = ("diffuse",) if xp.known_zero(t) else ("diffuse", "diff_trans")
-    return {"rho": xp.color(maps.get("base_color", params.base_color)), "t": t, "lobes": lobes}
+    return TinyPrepared(lobes=lobes, rho=xp.color(maps.get("base_color", params.base_color)), t=t)
 
 
 def _view_factor(xp, wo):
@@ -39,7 +47,7 @@ def _view_factor(xp, wo):
 
 
 def _eval(xp, p, wi, wo):
-    return p["rho"] * (_lobe_weight(xp, p, wi, wo) * _view_factor(xp, wo) / math.pi)
+    return p.rho * (_lobe_weight(xp, p, wi, wo) * _view_factor(xp, wo) / math.pi)
 
 
 def _pdf(xp, p, wi, wo):
@@ -50,10 +58,10 @@ def _sample(xp, p, wo, u):
     r = xp.sqrt(u[1])
     phi = 2.0 * math.pi * u[2]
     side = xp.select(wo[2] >= 0, 1.0, -1.0)
-    if "diff_trans" in p["lobes"]:
-        side = xp.select(u[0] < p["t"], -side, side)
+    if "diff_trans" in p.lobes:
+        side = xp.select(u[0] < p.t, -side, side)
     wi = xp.vec3(r * xp.cos(phi), r * xp.sin(phi), xp.safe_sqrt(1.0 - u[1]) * side)
-    return wi, p["rho"] * _view_factor(xp, wo), _pdf(xp, p, wi, wo), False
+    return wi, p.rho * _view_factor(xp, wo), _pdf(xp, p, wi, wo), False
 
 
 LOBES = (Lobe("diffuse", "diffuse"), Lobe("diff_trans", "diffuse", transmits=True))

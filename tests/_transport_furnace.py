@@ -16,7 +16,7 @@ view of an environment is noisy and tests nothing here), box-filtered 8×8 film:
   be connected (``ptracer`` renders them black), so smooth and thin glass use ``inside``.
 
 ``python tests/_transport_furnace.py`` prints the table quoted in the README and in
-:mod:`lookdev.pipeline.export.mitsuba.plugin`.
+:mod:`lookdev.pipeline.export.mitsuba.transport`.
 """
 
 from __future__ import annotations

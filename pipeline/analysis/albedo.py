@@ -35,6 +35,18 @@ import numpy as np
 
 from lookdev.materials.bsdf import Model, draw, evaluate
 
+__all__ = [
+    "AlbedoCurve",
+    "Hemisphere",
+    "albedo_monte_carlo",
+    "albedo_quadrature",
+    "albedo_tabulated",
+    "register_table",
+    "sheen_table",
+    "table_for",
+    "view_direction",
+]
+
 Hemisphere = Literal["reflect", "both"]
 
 

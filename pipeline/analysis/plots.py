@@ -26,6 +26,33 @@ from typing import Any
 
 import matplotlib
 
+__all__ = [
+    "ALBEDO_SAMPLES",
+    "CHANNEL_COLOURS",
+    "MAP_RESOLUTION",
+    "OVERLAY_STYLES",
+    "POLAR_DECADES",
+    "PlotError",
+    "VIEWS",
+    "albedo_curves",
+    "at_uv",
+    "brdf_slice",
+    "draw_albedo",
+    "draw_albedo_overlay",
+    "draw_polar",
+    "draw_polar_overlay",
+    "draw_slice",
+    "draw_sphere",
+    "figure",
+    "incidence_on_slice",
+    "load_environment",
+    "polar_curves",
+    "save_figure",
+    "slice_directions",
+    "total_curve",
+    "varied",
+]
+
 matplotlib.use("Agg")
 
 import matplotlib.pyplot as plt  # noqa: E402

@@ -34,6 +34,23 @@ from lookdev.materials.errors import LookdevError
 
 from . import review
 
+__all__ = [
+    "Entry",
+    "NOT_IN_TABLE",
+    "PLOT_VIEWS",
+    "REPORT_DIR",
+    "ReportError",
+    "WEB_IMAGES",
+    "contact_sheets",
+    "material_plots",
+    "read_manifests",
+    "render_page",
+    "summary",
+    "table_rows",
+    "web_image",
+    "write_report",
+]
+
 REPORT_DIR = "report"
 WEB_IMAGES = (".png", ".jpg", ".jpeg", ".gif", ".webp", ".svg")
 PLOT_VIEWS = ("slice", "albedo", "polar", "sphere")

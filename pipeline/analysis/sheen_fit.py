@@ -31,6 +31,28 @@ from lookdev.materials.arrays import NumpyOps
 
 from .table_module import write_module
 
+__all__ = [
+    "AREA_SHAPE",
+    "EXACT_TABLE_SHAPE",
+    "FitError",
+    "GENERATOR",
+    "TABLE_SHAPE",
+    "albedo_integrated",
+    "albedo_table_error",
+    "area_table_error",
+    "build_albedo_table",
+    "build_area_table",
+    "build_exact",
+    "gauss_legendre",
+    "lambda_fit_error",
+    "lambda_integrated",
+    "lambda_table_error",
+    "main",
+    "projected_area_integrated",
+    "write_albedo_module",
+    "write_exact_module",
+]
+
 
 @functools.cache
 def gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:

@@ -25,6 +25,18 @@ import numpy as np
 from lookdev.materials.bsdf import Model, density, draw, evaluate
 from lookdev.materials.colour import luminance
 
+__all__ = [
+    "LatLong",
+    "MARGIN",
+    "ibl_sphere",
+    "maps_at",
+    "point_light_sphere",
+    "shading_frames",
+    "sphere_normals",
+    "sphere_uv",
+    "to_local",
+]
+
 MARGIN = 1.08
 
 

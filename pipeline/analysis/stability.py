@@ -36,6 +36,23 @@ from .stability_cases import (
     white,
 )
 
+__all__ = [
+    "DTYPES",
+    "FURNACE_PHI_DEG",
+    "FURNACE_SAMPLES",
+    "FURNACE_THETA_DEG",
+    "Finding",
+    "KINDS",
+    "MAPS_LABEL",
+    "MEDIUM_UNITS",
+    "ModelReport",
+    "ROUNDING",
+    "SIGMAS",
+    "case_count",
+    "check_model",
+    "run",
+]
+
 DTYPES = (np.float32, np.float64)
 MAPS_LABEL = "per-element maps of every field"
 FURNACE_THETA_DEG = (0.0, 45.0, 60.0, 75.0, 89.0, 89.99)

@@ -52,6 +52,26 @@ from lookdev.materials.bsdf import Model
 from lookdev.materials.errors import LookdevError, argument
 from lookdev.materials.params import SCATTER_DISTANCE_MAX, SCATTER_DISTANCE_MIN
 
+__all__ = [
+    "ALLOWANCE",
+    "COMBINATIONS",
+    "CheckError",
+    "SHEEN_ROUGHNESS",
+    "UNBOUNDED_HIGH",
+    "allowance",
+    "directions",
+    "extremes",
+    "furnace_cases",
+    "measured_cases",
+    "models_named",
+    "parameter_cases",
+    "per_element_maps",
+    "plausible",
+    "short",
+    "uniforms",
+    "white",
+]
+
 ALLOWANCE = {
     "disney": 0.79,
     "sheen": 0.002,

@@ -45,6 +45,26 @@ from lookdev.materials.params import DisneyParams
 from lookdev.pipeline.blend import blend
 from lookdev.pipeline.blend.disney import SCALARS
 
+__all__ = [
+    "LAYERS",
+    "PRUNING_PRESET",
+    "TARGETS",
+    "UDIM_TILES",
+    "bench_material",
+    "child_peak",
+    "interleaved_best",
+    "large_mask_material",
+    "met",
+    "peak_bytes",
+    "peak_rss",
+    "pruning_saving",
+    "run",
+    "udim_material",
+    "verdict",
+    "with_prunable_layers",
+    "write_mask",
+]
+
 LAYERS = 4
 PRUNING_PRESET = "rusty_car_paint"
 

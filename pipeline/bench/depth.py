@@ -22,6 +22,8 @@ import numpy as np
 from lookdev.materials.colour import luminance
 from lookdev.materials.errors import LookdevError
 
+__all__ = ["BenchDepthError", "DEFAULT_PRESETS", "Settings", "loss", "measure", "run"]
+
 DEFAULT_PRESETS = ("plastic_matte", "gold", "leaf", "glass_thin", "glass_clear")
 """One preset per depth class: dark opaque, bright opaque, diffuse and glossy thin
 transmission, solid glass."""

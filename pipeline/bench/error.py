@@ -49,6 +49,25 @@ from . import detail as detail_bench
 from . import measure, quality
 from .measure import Row
 
+__all__ = [
+    "BenchError",
+    "EDGE_CASES",
+    "ERROR_NAMES",
+    "ITEMS",
+    "LOBE_CASES",
+    "MARKERS",
+    "RENDER_IBL",
+    "RENDER_PRESETS",
+    "Report",
+    "Settings",
+    "lambda_fit",
+    "model_cases",
+    "plot_error_vs_time",
+    "render_cases",
+    "run",
+    "write_outputs",
+]
+
 ITEMS = (
     "render", "albedo", "lambda", "precision", "denoise", "sheen_lambda", "energy", "mainjob",
     "adaptive", "detail",

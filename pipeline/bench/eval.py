@@ -44,6 +44,19 @@ from lookdev.materials import disney
 from lookdev.materials.arrays import NumpyOps
 from lookdev.materials.params import DisneyParams
 
+__all__ = [
+    "AGREEMENT_CASES",
+    "DRJIT_MODES",
+    "PARAM_SETS",
+    "TARGET_FROZEN",
+    "agreement",
+    "direction_pairs",
+    "mitsuba_eval",
+    "principled_dict",
+    "relative_difference",
+    "run",
+]
+
 PARAM_SETS: dict[str, DisneyParams] = {
     "plastic": DisneyParams(base_color=(0.6, 0.2, 0.1), roughness=0.4),
     "gold": DisneyParams(base_color=(1.0, 0.77, 0.34), metallic=1.0, roughness=0.25),

@@ -30,6 +30,17 @@ from lookdev.library import Library
 from lookdev.library import listing as listing_of
 from lookdev.library.index import INDEX_NAME
 
+__all__ = [
+    "MODELS",
+    "TARGET_RATIO",
+    "build_library",
+    "listing",
+    "measure",
+    "preset_text",
+    "report",
+    "run",
+]
+
 TARGET_RATIO = 2.0
 MODELS = ("disney", "disney", "disney", "layered")
 

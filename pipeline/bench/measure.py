@@ -27,6 +27,25 @@ from lookdev.pipeline.analysis.albedo import albedo_monte_carlo, albedo_quadratu
 
 from .timing import best_time
 
+__all__ = [
+    "ALBEDO_ANGLES",
+    "LAMBDA_COS",
+    "LAMBDA_ROUGHNESS",
+    "Row",
+    "SHEEN_LAMBDA_ROUGHNESS",
+    "albedo_reference",
+    "bench_albedo",
+    "bench_lambda",
+    "bench_precision",
+    "bench_render",
+    "bench_sheen_lambda",
+    "direction_pairs",
+    "once",
+    "relative_mse",
+    "relative_rms",
+    "timed",
+]
+
 
 @dataclass(frozen=True)
 class Row:

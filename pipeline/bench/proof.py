@@ -37,6 +37,23 @@ from typing import Any
 
 import numpy as np
 
+__all__ = [
+    "Clock",
+    "Settings",
+    "Timing",
+    "by_frame_size",
+    "compare",
+    "interleaved",
+    "naive_scene",
+    "run",
+    "target_met_up_to",
+    "time_bare",
+    "time_kernels",
+    "time_naive",
+    "time_pipeline",
+    "turntable_cases",
+]
+
 
 @dataclass(frozen=True)
 class Settings:

@@ -6,6 +6,8 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+__all__ = ["best_time"]
+
 
 def best_time(fn: Callable[[], Any], *, repeat: int = 3, min_time: float = 0.0) -> float:
     """Best wall time of ``repeat`` calls (after one warm-up call), in seconds.

@@ -68,6 +68,17 @@ from lookdev.pipeline.export.usd.writer import (
     value_types,
 )
 
+__all__ = [
+    "author_fast",
+    "author_floor",
+    "author_naive",
+    "bench_sources",
+    "bench_specs",
+    "end_to_end",
+    "run",
+    "spec_paths",
+]
+
 
 def _timed(fn) -> float:
     gc.collect()

@@ -34,6 +34,8 @@ from lookdev.pipeline.exr import colour_space_of, write_exr
 from .errors import BlendError
 from .result import BlendedMaterial
 
+__all__ = ["SCHEMA", "bake", "sidecar_dict"]
+
 SCHEMA = "lookdev.blend/1"
 
 

@@ -31,6 +31,18 @@ from lookdev.materials.params import DisneyParams
 
 from .errors import BlendError
 
+__all__ = [
+    "COLOR",
+    "DISCRETE",
+    "SCALARS",
+    "VOTERS",
+    "assemble",
+    "check_discrete",
+    "layer_values",
+    "spell_specular",
+    "stack_weights",
+]
+
 COLOR = "base_color"
 SCALARS = tuple(
     name

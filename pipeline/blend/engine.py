@@ -37,6 +37,8 @@ from .result import TILE_TEXELS, BlendedMaterial
 from .stack import Decision, Entry, prune_stack, stack_of
 from .textures import extent_of, open_textures, sample
 
+__all__ = ["Progress", "Textured", "blend"]
+
 Progress = Callable[[int, int], None]
 """Called as ``progress(rows_done, rows_total)`` after each tile."""
 

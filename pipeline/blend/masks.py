@@ -41,6 +41,16 @@ from lookdev.materials.layers import (
 
 from .resample import TextureFile, as_float, resample, taps
 
+__all__ = [
+    "BoxReduced",
+    "MaskSampler",
+    "WHOLE_BUDGET",
+    "combine",
+    "fractal_noise",
+    "levels",
+    "ramp",
+]
+
 WHOLE_BUDGET = 0.5
 """Share of the output's bytes that textures decoded whole may take; the rest stream."""
 

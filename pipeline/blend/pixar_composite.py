@@ -56,6 +56,21 @@ from lookdev.materials.pixar_scatter import LOBES, PIXAR_LOBES, PREFIX
 
 from .errors import BlendError
 
+__all__ = [
+    "BLUR",
+    "FLAT",
+    "GROUP",
+    "Lobes",
+    "Part",
+    "REFLECTED",
+    "TRANSMITTED",
+    "TYPE_OF",
+    "composite",
+    "energy_sum",
+    "layer_lobes",
+    "unit",
+]
+
 BLUR = {"reflection": 0, "specular": 1, "diffuse": 2}
 """Smits' order of blurring: reflection/refraction < specular < diffuse."""
 # Smits' lobe types, their reflected and transmitted lobes and the normal each is shaded

@@ -33,6 +33,8 @@ from lookdev.materials.params import Params
 
 from .errors import BlendError
 
+__all__ = ["BlendedMaterial", "LOBE_WEIGHTS", "PARAMS", "TILE_TEXELS", "as_hub"]
+
 TILE_TEXELS = 1 << 16
 """Texels per tile: a tile's temporaries (a few channels) stay within a CPU cache."""
 

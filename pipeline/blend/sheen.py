@@ -26,6 +26,8 @@ from lookdev.materials.arrays import NumpyOps
 from .errors import BlendError
 from .result import BlendedMaterial
 
+__all__ = ["base_scale"]
+
 
 def base_scale(blended: BlendedMaterial, cos_theta: float = 1.0) -> Any:
     """The factor on the base under a Conty-Kulla sheen, light and view at ``cos_theta``.
@@ -42,11 +44,11 @@ def base_scale(blended: BlendedMaterial, cos_theta: float = 1.0) -> Any:
     maps = {k: _elements(v) for k, v in blended.maps.items()}
     params = disney_model.DisneyParams.parse(_uniform_part(blended), where=blended.name)
     prepared = disney_model.MODEL.prepare(xp, params, **maps)
-    if "sheen" not in prepared["lobes"]:
+    if "sheen" not in prepared.lobes:
         return (1.0, 1.0, 1.0)
-    color = xp.color(prepared["sheen"] * prepared["sheen_color"])
+    color = xp.color(prepared.sheen * prepared.sheen_color)
     mu = np.float64(cos_theta)
-    r, exact = xp.asarray(prepared["sheen_r"]), prepared["sheen_exact"]
+    r, exact = xp.asarray(prepared.sheen_r), prepared.sheen_exact
     scale = np.maximum(sheen.base_scale(xp, mu, mu, r, color, exact=exact), 0.0)
     scale = np.broadcast_to(scale, (3, np.size(scale) // 3))
     if scale.shape[1] == 1:

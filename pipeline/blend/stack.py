@@ -19,6 +19,8 @@ from lookdev.materials.layers import ConstantMask, Mask, TextureMask
 from .errors import BlendError
 from .masks import MaskSampler
 
+__all__ = ["Decision", "Entry", "prune_stack", "stack_of"]
+
 
 @dataclass(frozen=True)
 class Decision:

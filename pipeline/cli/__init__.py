@@ -20,6 +20,18 @@ from lookdev.materials.errors import LookdevError
 
 from .lazy import Lazy, lazy_group
 
+__all__ = [
+    "COLOUR_PANEL",
+    "COMMANDS",
+    "GLOBAL_OPTIONS",
+    "INTERRUPTED",
+    "app",
+    "error",
+    "main",
+    "os_error_line",
+    "quiet_numerics",
+]
+
 COMMANDS = {
     "presets": Lazy(".presets:app", "Browse, show, create, edit and validate presets."),
     "plot": Lazy(".plot:plot", "Draw presets as one BRDF-explorer view, to an image."),

@@ -9,6 +9,8 @@ import typer
 
 from .common import console, err_console, print_json, table
 
+__all__ = ["ITEMS", "designer_"]
+
 ITEMS = ("designer", "rotation", "converge", "truth", "compare")
 
 

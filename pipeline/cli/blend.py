@@ -11,6 +11,8 @@ import typer
 
 from .common import console, err_console, print_json, table
 
+__all__ = ["LARGE", "blend"]
+
 LARGE = 1024 * 1024
 """Texels from which a bake shows a progress bar."""
 

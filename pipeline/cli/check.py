@@ -12,6 +12,8 @@ from lookdev.pipeline.analysis import stability
 
 from .common import console, err_console, print_json, table
 
+__all__ = ["COLUMNS", "check"]
+
 COLUMNS = ["precision", "cases", "raised", "NaN", "inf", "negative", "energy gain"]
 
 

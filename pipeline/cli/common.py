@@ -10,6 +10,8 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+__all__ = ["JsonOut", "Repeat", "console", "err_console", "print_json", "table"]
+
 console = Console()
 err_console = Console(stderr=True)
 

@@ -7,6 +7,8 @@ from typing import Annotated
 
 import typer
 
+__all__ = ["designer"]
+
 
 def designer(
     presets: Annotated[

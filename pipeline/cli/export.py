@@ -10,6 +10,8 @@ import typer
 from .common import console, print_json
 from .lazy import Lazy, lazy_group
 
+__all__ = ["app", "mitsuba"]
+
 app = typer.Typer(
     cls=lazy_group(
         {"usd": Lazy(".export_usd:export_usd", "Write presets as UsdShade materials for DCCs.")}

@@ -11,6 +11,19 @@ import typer
 
 from .common import console, print_json, table
 
+__all__ = [
+    "Context",
+    "ImportOpenPBR",
+    "MtlxSurface",
+    "PARTLY_IMPORTED",
+    "PreviewOpacity",
+    "export_usd",
+    "import_app",
+    "import_usd",
+    "validate_app",
+    "validate_usd",
+]
+
 import_app = typer.Typer(
     help="Read materials written by other tools back into presets.", no_args_is_help=True
 )

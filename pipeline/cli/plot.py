@@ -10,6 +10,8 @@ import typer
 
 from .common import console, print_json
 
+__all__ = ["View", "plot"]
+
 
 class View(StrEnum):
     slice = "slice"

@@ -16,6 +16,21 @@ from lookdev.materials.model_names import PRESET_MODELS
 
 from .common import console, err_console, print_json
 
+__all__ = [
+    "JsonOpt",
+    "LibraryOpt",
+    "TABLE_MAX_ROWS",
+    "app",
+    "list_",
+    "new",
+    "parse_assignments",
+    "rm",
+    "schema",
+    "set_",
+    "show",
+    "validate",
+]
+
 # `presets list` reads headers only: the schemas (pydantic and the models, through
 # lookdev.library.preset), Rich's syntax highlighting and the resolved views are imported
 # by the commands that show or change a preset.

@@ -11,6 +11,8 @@ from .common import console, table
 if TYPE_CHECKING:  # listing presets reads headers only: no materials imported for it
     from lookdev.library import Material
 
+__all__ = ["material_json", "print_resolved", "text_table"]
+
 
 def text_table(title: str, columns: list[str], rows: list[list[str]]) -> Table:
     """A Rich table of text columns: left-aligned, names never wrapped."""

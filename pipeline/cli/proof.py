@@ -31,6 +31,8 @@ from lookdev.pipeline.proof.settings import (
 
 from .common import console, err_console, print_json, table
 
+__all__ = ["ProofContext", "Rig", "proof"]
+
 
 class ProofContext(StrEnum):
     universal = "universal"

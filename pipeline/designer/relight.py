@@ -8,7 +8,7 @@ by the model's ``sample``. The material's pixels are shaded by the model's core 
 (``prepare``, ``eval``, ``pdf``, ``sample``) on the Dr.Jit backend of the array shim, the
 very code the Mitsuba plugin and the numpy plots run; there is no other copy of any
 formula. Every continuous parameter enters as an opaque Dr.Jit value
-(:func:`lookdev.pipeline.export.mitsuba.plugin.opaque_inputs`), or as a per-pixel array
+(:func:`lookdev.pipeline.export.mitsuba.inputs.opaque_inputs`), or as a per-pixel array
 read from the blended maps at the g-buffer's UVs, so every lobe a control can switch on
 is traced and an edit changes data, not the kernel.
 
@@ -36,12 +36,14 @@ What designer mode leaves out, against truth mode (the path tracer, :mod:`.truth
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Any
 
 import numpy as np
 
 from lookdev.materials.arrays import DrJitOps
+from lookdev.materials.bsdf import Prepared
 from lookdev.materials.tables import device_tables
 
 from .gbuffer import GBuffer, Hits
@@ -62,7 +64,7 @@ def material_values(hub: Any, hits: Hits) -> tuple[Any, dict[str, Any], tuple[st
     import mitsuba as mi
 
     from lookdev.materials.registry import is_color_field
-    from lookdev.pipeline.export.mitsuba.plugin import opaque_inputs
+    from lookdev.pipeline.export.mitsuba.inputs import opaque_inputs
     from lookdev.pipeline.export.mitsuba.scene import plugin_inputs
 
     model = hub.bsdf_model
@@ -95,6 +97,8 @@ def structure_key(model: Any, params: Any, values: dict[str, Any]) -> str:
     prepared = model.prepare(xp, params, **values)
 
     def plain(value: Any) -> Any:
+        if isinstance(value, Prepared):  # by member, as a dict: Dr.Jit values by type
+            return {f.name: plain(getattr(value, f.name)) for f in dataclasses.fields(value)}
         if isinstance(value, dict):
             return {k: plain(v) for k, v in sorted(value.items())}
         if isinstance(value, list | tuple):

@@ -2,7 +2,7 @@
 
 The scene is the proofs' shader ball (:class:`lookdev.pipeline.proof.turntable.Turntable`:
 the same scene dict, camera, rig, frozen ``mi.render``) with the material's plugin in its
-``live`` form (:data:`lookdev.pipeline.export.mitsuba.plugin.LIVE`): every continuous
+``live`` form (:data:`lookdev.pipeline.export.mitsuba.inputs.LIVE`): every continuous
 parameter is a traversed value the kernels read from memory and every lobe a value can
 switch on is traced, so an edit is a ``mi.traverse`` update and the next pass replays
 the recorded kernels (no scene reload, no new kernel). Passes of ``pass_spp`` samples
@@ -61,8 +61,8 @@ def _digest(array: Any) -> str:
 
 def structure(hub: Any) -> str:
     """Everything about ``hub`` that shapes the truth scene's kernels (module docstring)."""
+    from lookdev.pipeline.export.mitsuba.inputs import opaque_inputs
     from lookdev.pipeline.export.mitsuba.medium import interior_dict
-    from lookdev.pipeline.export.mitsuba.plugin import opaque_inputs
     from lookdev.pipeline.export.mitsuba.scene import plugin_inputs
 
     from .relight import structure_key
@@ -147,11 +147,12 @@ class TruthMode:
         out: dict[str, list[str]] = {}
         for key in self.params.keys():
             node = self.params.properties[key][2]
-            if getattr(node, "live", False) and hasattr(node, "traversed"):
+            inputs = getattr(node, "inputs", None)  # a lookdev plugin's (mitsuba.inputs)
+            if getattr(inputs, "live", False) and hasattr(node, "traversed"):
                 field = key.rsplit(".", 1)[-1]
                 if field in node.traversed:
                     out.setdefault(field, []).append(key)
-                elif key.endswith(".data") and key.rsplit(".", 2)[-2] in node.textures:
+                elif key.endswith(".data") and key.rsplit(".", 2)[-2] in inputs.textures:
                     out.setdefault(key.rsplit(".", 2)[-2] + ".data", []).append(key)
         return out
 

@@ -18,6 +18,20 @@ from lookdev.library import files
 from lookdev.library.files import quiet_c_stderr
 from lookdev.materials.errors import LookdevError
 
+__all__ = [
+    "BACKGROUND",
+    "GAP",
+    "ProofImageError",
+    "TEXT",
+    "bitmap_text",
+    "contact_sheet",
+    "draw_text",
+    "file_entry",
+    "read_rgb",
+    "write_exr",
+    "write_png",
+]
+
 BACKGROUND = 0.08
 TEXT = (0.92, 0.92, 0.92)
 GAP = 4

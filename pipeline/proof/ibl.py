@@ -51,6 +51,42 @@ from lookdev.materials.errors import LookdevError, one_line
 
 from .contact import ProofImageError, write_exr
 
+__all__ = [
+    "CieSky",
+    "DEFAULT_WIDTH",
+    "Environment",
+    "GENERATOR_VERSION",
+    "Gradient",
+    "Ground",
+    "IBL_SPACE",
+    "IblDefinition",
+    "IblError",
+    "ORIENTATION",
+    "REAL_HDR",
+    "Rgb",
+    "SUFFIXES",
+    "SoftBox",
+    "Sun",
+    "builtin_names",
+    "cache_dir",
+    "check_latlong",
+    "cie_sky",
+    "definition",
+    "definitions_folder",
+    "direction",
+    "directions",
+    "envmap_to_world",
+    "file_space",
+    "generate",
+    "gradient",
+    "load",
+    "read_image",
+    "resample",
+    "resolve",
+    "soft_box",
+    "sun_disc",
+]
+
 ORIENTATION = {
     "up": "+y",
     "camera": "on +z looking towards -z, +x to its right",

@@ -28,6 +28,33 @@ from . import rig as rig_module
 from .ibl import cache_dir, envmap_to_world
 from .rig import DEFAULT_RIG
 
+__all__ = [
+    "BALL_CENTER",
+    "CUP_CENTER",
+    "CUP_TILT_DEG",
+    "CUP_WALL",
+    "DISTANCE",
+    "ELEVATION_DEG",
+    "GROUND_ALBEDO",
+    "MARGIN",
+    "METERS_PER_UNIT",
+    "MeshData",
+    "PAIR_HALF_WIDTH",
+    "PIXEL_FILTERS",
+    "ball_to_world",
+    "camera",
+    "cup_mesh",
+    "cup_ply",
+    "cup_profile",
+    "cup_to_world",
+    "eye",
+    "framed",
+    "lathe",
+    "rotation_x",
+    "scene_dict",
+    "write_ply",
+]
+
 GROUND_ALBEDO = 0.18  # a photographer's mid-grey card
 BALL_CENTER = (-1.2, 1.0, 0.0)
 CUP_CENTER = (1.2, 1.0, 0.0)

@@ -24,6 +24,8 @@ from . import shaderball
 from .ibl import envmap_to_world
 from .rig import DEFAULT_RIG
 
+__all__ = ["Frame", "Turntable", "frames", "material_bsdf", "material_interior"]
+
 
 @dataclass(frozen=True)
 class Frame:

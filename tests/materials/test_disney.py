@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -164,7 +165,7 @@ def test_a_broken_pdf_is_caught():
     model = disney.lobe_model("specular")
 
     def wide_pdf(xp, pr, wi, wo):
-        return model.pdf(xp, {**pr, "ax": pr["ax"] * 1.1, "ay": pr["ay"] * 1.1}, wi, wo)
+        return model.pdf(xp, dataclasses.replace(pr, ax=pr.ax * 1.1, ay=pr.ay * 1.1), wi, wo)
 
     broken = Model("broken", DisneyParams, model.prepare, model.eval, wide_pdf, model.sample)
     assert not chi2_details(broken, params, _view(40), 100_000, 12).passed
@@ -387,13 +388,13 @@ def test_zero_weight_lobes_are_not_kept():
     from lookdev.materials.arrays import NumpyOps
 
     xp = NumpyOps()
-    assert disney.prepare(xp, DisneyParams())["lobes"] == ("diffuse", "specular")
-    assert disney.prepare(xp, DisneyParams(metallic=1.0, sheen=1.0))["lobes"] == ("specular",)
-    glass = disney.prepare(xp, DisneyParams(spec_trans=1.0, clearcoat=0.5))["lobes"]
+    assert disney.prepare(xp, DisneyParams()).lobes == ("diffuse", "specular")
+    assert disney.prepare(xp, DisneyParams(metallic=1.0, sheen=1.0)).lobes == ("specular",)
+    glass = disney.prepare(xp, DisneyParams(spec_trans=1.0, clearcoat=0.5)).lobes
     assert glass == ("specular", "clearcoat", "spec_trans")
     # A per-element map that is zero everywhere prunes too; one non-zero texel keeps it.
-    assert "sheen" not in disney.prepare(xp, DisneyParams(), sheen=np.zeros(4))["lobes"]
-    assert "sheen" in disney.prepare(xp, DisneyParams(), sheen=np.array([0, 0, 1.0]))["lobes"]
+    assert "sheen" not in disney.prepare(xp, DisneyParams(), sheen=np.zeros(4)).lobes
+    assert "sheen" in disney.prepare(xp, DisneyParams(), sheen=np.array([0, 0, 1.0])).lobes
 
 
 def test_maps_override_parameters_per_element():

@@ -38,15 +38,15 @@ def test_delta_below_the_glossy_minimum_alpha_and_only_for_constants():
     assert mf.is_delta(0.02, 0.5) and not mf.is_delta(0.03, 1.0)  # the larger α decides
     assert not mf.is_delta(np.zeros(4))  # a per-element roughness stays glossy
     xp = NumpyOps()
-    assert disney.prepare(xp, DisneyParams(spec_trans=1.0, roughness=0.0))["delta"] == (
+    assert disney.prepare(xp, DisneyParams(spec_trans=1.0, roughness=0.0)).delta == (
         "specular",
         "spec_trans",
     )
-    assert disney.prepare(xp, DisneyParams(spec_trans=1.0, roughness=0.3))["delta"] == ()
+    assert disney.prepare(xp, DisneyParams(spec_trans=1.0, roughness=0.3)).delta == ()
     # A thin sheet's transmission has its own, rougher α (Burley 2015): at η = 3 the
     # reflection of roughness 0.03 is a delta, its transmission (×1.6) is not.
     thin = disney.prepare(xp, DisneyParams(spec_trans=1.0, roughness=0.03, ior=3.0, thin=True))
-    assert thin["delta"] == ("specular",)
+    assert thin.delta == ("specular",)
 
 
 def test_smooth_glass_has_no_density_anywhere():
@@ -154,7 +154,7 @@ def test_rough_glass_chooses_by_the_fresnel_of_the_sampled_microfacet():
     ok = pdf > 0
     assert not delta.any()
     pr = disney.prepare(NumpyOps(), p)
-    g1 = mf.smith_g1(NumpyOps(), wi[ok].T, pr["ax"], pr["ay"])
+    g1 = mf.smith_g1(NumpyOps(), wi[ok].T, pr.ax, pr.ay)
     refracted = wi[ok, 2] < 0
     expected = np.where(refracted, g1 / 1.5**2, g1)
     np.testing.assert_allclose(w[ok, 0], expected, rtol=1e-6)

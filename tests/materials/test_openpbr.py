@@ -27,7 +27,7 @@ XP = NumpyOps()
 
 def _albedo(p: OpenPBRParams, n: int = 16384):
     m = measure(MODEL, p, {}, samples=n)
-    eta = MODEL.prepare(XP, p)["eta"]
+    eta = MODEL.prepare(XP, p).eta
     return m.reflected, m.transmitted * eta * eta  # energy, not radiance
 
 

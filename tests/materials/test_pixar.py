@@ -282,7 +282,7 @@ def test_a_closed_reflection_cone_is_a_delta_along_the_mirror_and_the_refraction
     # roughness 0.05: cone 0.5°, the old floor: now the delta limit of the lobe (issue 16).
     eta = 1.5
     p = P(surface_color=1.0, roughness=0.05, clear=1.0, ior=eta)
-    assert pixar.MODEL.prepare(XP, p)["delta"] == ("reflection", "reflection_t")
+    assert pixar.MODEL.prepare(XP, p).delta == ("reflection", "reflection_t")
     wo = _dir(math.cos(math.radians(45.0)))
     u = np.random.default_rng(2).random((4096, 3))
     wi, weight, pdf, delta = pixar.sample(p, wo, u, delta=True)
@@ -301,9 +301,9 @@ def test_a_closed_reflection_cone_is_a_delta_along_the_mirror_and_the_refraction
 
 
 def test_the_adjoint_of_the_refraction_delta_sees_the_light_from_its_one_viewer():
-    """A light tracer (prepared[ADJOINT]) gets, for light from l, the viewer v* whose
+    """A light tracer (prepared.adjoint) gets, for light from l, the viewer v* whose
     refracted view is l, weighted η² W(v*): projected solid angle goes as sin²θ."""
-    from lookdev.materials.bsdf import ADJOINT
+    import dataclasses
 
     eta = 1.52
     p = P(surface_color=(0.9, 0.8, 0.7), roughness=0.0, clear=1.0, ior=eta)
@@ -315,7 +315,7 @@ def test_the_adjoint_of_the_refraction_delta_sees_the_light_from_its_one_viewer(
     r = np.sqrt(1.0 - z * z)
     light = XP.vec3(r * np.cos(phi), r * np.sin(phi), z)
     u = XP.vec3(np.full(n, 0.99999), np.full(n, 0.5), np.full(n, 0.5))  # the last lobe
-    v, w_adj, p_adj, d_adj = pixar.MODEL.sample(XP, {**pr, ADJOINT: True}, light, u)
+    v, w_adj, p_adj, d_adj = pixar.MODEL.sample(XP, dataclasses.replace(pr, adjoint=True), light, u)
     ok = p_adj > 0
     assert np.all(d_adj[ok]) and np.all(v[2][ok] < 0)
     # Light beyond sin θ = 1/η reaches no viewer through this lobe.
@@ -340,7 +340,7 @@ def test_two_sided():
 
 def test_lobes_known_zero_are_dropped():
     def kept(**kw):
-        return pixar.MODEL.prepare(XP, P(**kw))["lobes"]
+        return pixar.MODEL.prepare(XP, P(**kw)).lobes
 
     assert kept(roughness=0.5) == ("diffuse", "specular")  # reflRatio = 0 from 0.5 up
     assert kept(roughness=1.0) == ("diffuse",)  # the (1 − rough) fade

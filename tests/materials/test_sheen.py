@@ -138,7 +138,7 @@ def test_color_scales_the_lobe():
 
 def test_black_sheen_keeps_no_lobe():
     prepared = sheen.MODEL.prepare(NumpyOps(), sheen.SheenParams(color=(0, 0, 0)))
-    assert prepared["lobes"] == ()
+    assert prepared.lobes == ()
 
 
 @pytest.mark.parametrize(("r", "cos_o"), [(sheen.R_MIN, 0.3), (0.3, 0.9), (1.0, 0.05)])

@@ -104,7 +104,7 @@ def model_albedo(params: OpenPBRParams, samples: int = 65536) -> tuple[np.ndarra
     m = measure(MODEL, params, {}, samples=samples)
     # lookdev's BTDF carries radiance's 1/η² into a denser medium; the reference's
     # sampler weights carry energy: compare energies
-    eta = MODEL.prepare(NumpyOps(), params)["eta"]
+    eta = MODEL.prepare(NumpyOps(), params).eta
     return m.reflected, m.transmitted * eta * eta
 
 

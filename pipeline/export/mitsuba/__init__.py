@@ -6,7 +6,8 @@
 """
 
 from .depth import max_depth_for
-from .plugin import MitsubaExportError, register_model
+from .inputs import MitsubaExportError
+from .plugin import register_model
 from .scene import bsdf_dict, register_plugins, scene_dict
 from .xml import export_scene, write_xml
 

@@ -46,7 +46,21 @@ from lookdev.materials.bsdf import draw
 from lookdev.materials.subsurface import has_interior, interior
 from lookdev.pipeline.blend.result import as_hub
 
-from .plugin import lobe_kinds
+from .components import lobe_kinds
+
+__all__ = [
+    "BRIGHT_ALBEDO",
+    "BRIGHT_MEDIUM",
+    "DEPTH_BRIGHT",
+    "DEPTH_DARK",
+    "DEPTH_SOLID_GLOSSY",
+    "DEPTH_SUBSURFACE",
+    "DEPTH_SUBSURFACE_BRIGHT",
+    "DEPTH_THIN_DIFFUSE",
+    "DEPTH_THIN_GLOSSY",
+    "albedo_for",
+    "max_depth_for",
+]
 
 DEPTH_DARK = 4
 DEPTH_BRIGHT = 6

@@ -19,7 +19,9 @@ import numpy as np
 
 from lookdev.materials.bsdf import Model
 
-from .plugin import ONLY_LOBES, WEIGHT_SCALE
+from .inputs import ONLY_LOBES, WEIGHT_SCALE
+
+__all__ = ["Texture", "with_normals"]
 
 Texture = Callable[[np.ndarray, str], dict[str, Any]]
 """(unit normals (H, W, 3), a name for the file) → a Mitsuba texture dict."""

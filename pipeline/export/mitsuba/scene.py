@@ -31,9 +31,23 @@ from lookdev.pipeline.blend.result import LOBE_WEIGHTS, BlendedMaterial, as_hub
 from lookdev.pipeline.exr import colour_space_of
 
 from .depth import max_depth_for
+from .inputs import FORCE_ALL_LOBES, LIVE, ONLY_LOBES, MitsubaExportError
 from .medium import integrator, interior_dict
 from .normals import with_normals
-from .plugin import FORCE_ALL_LOBES, LIVE, ONLY_LOBES, MitsubaExportError, register_model
+from .plugin import register_model
+
+__all__ = [
+    "BLEND_ONLY",
+    "bsdf_dict",
+    "files_of",
+    "plugin_inputs",
+    "principled_equivalent",
+    "register_plugins",
+    "scene_dict",
+    "uses_our_plugins",
+    "with_bump",
+    "write_exr",
+]
 
 BLEND_ONLY = frozenset({"layering"})
 """Constants a blend records for the record, which no BSDF takes."""

@@ -17,8 +17,18 @@ from typing import Any
 
 from lookdev.library import files
 
-from .plugin import PLUGIN_PREFIX, MitsubaExportError
+from .inputs import PLUGIN_PREFIX, MitsubaExportError
 from .scene import scene_dict, uses_our_plugins
+
+__all__ = [
+    "LOAD_HINT",
+    "colour_note",
+    "export_scene",
+    "orientation_note",
+    "to_element",
+    "to_xml",
+    "write_xml",
+]
 
 LOAD_HINT = (
     " lookdev BSDF plugins: in Python, run import lookdev.pipeline.export.mitsuba as m; "

@@ -28,6 +28,8 @@ from .lobes import canonical
 from .names import Slot
 from .network import Connection, Image, Node, same_or_eq
 
+__all__ = ["LiveLayer", "live_stack", "mixed_input"]
+
 
 @dataclass
 class LiveLayer:

@@ -23,6 +23,16 @@ from lookdev.materials import registry
 from lookdev.materials.params import DisneyParams
 from lookdev.materials.pixar import PixarParams
 
+__all__ = [
+    "DEFAULTS",
+    "FINER_GROUPS",
+    "REGISTRY_MODEL",
+    "active_lobes",
+    "canonical",
+    "effective",
+    "parameter_groups",
+]
+
 FINER_GROUPS: dict[str, dict[str, str]] = {
     "disney": {
         "specular": "dielectric",

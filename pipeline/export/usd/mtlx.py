@@ -41,6 +41,22 @@ from .network import (
 )
 from .textures import MTLX_ADDRESS, affine, converted, output_of
 
+__all__ = [
+    "EXTRA_LOSS",
+    "MX_TYPES",
+    "NORMAL_INPUT",
+    "SURFACE",
+    "TANGENT_NORMAL_MODELS",
+    "build",
+    "document",
+    "fixed_transmission_roughness",
+    "mtlx_color_space",
+    "mtlx_version",
+    "node_defaults",
+    "validate_document",
+    "write_document",
+]
+
 SURFACE = "mtlx_surface"
 MX_TYPES = {
     "float": "float",

@@ -23,6 +23,30 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+__all__ = [
+    "CLEARCOAT_ALPHA",
+    "CLEARCOAT_PREVIEW_SCALE",
+    "DERIVED_FROM",
+    "MTLX_DISNEY",
+    "MTLX_PIXAR",
+    "OPACITY_SLOTS",
+    "PREVIEW_DISNEY",
+    "PREVIEW_OPACITY",
+    "PREVIEW_PIXAR",
+    "PREVIEW_WEIGHTS",
+    "RI_DISNEY",
+    "RI_PIXAR",
+    "SUBSURFACE_WEIGHT",
+    "SURFACE_IDS",
+    "Slot",
+    "TABLES",
+    "WEIGHTS_DERIVED_FROM",
+    "gloss_to_roughness",
+    "mapped_params",
+    "roughness_to_gloss",
+    "table_for",
+]
+
 CLEARCOAT_ALPHA = (0.1, 0.001)  # Burley App. B.2: α_c = mix(0.1, 0.001, clearcoat_gloss)
 CLEARCOAT_PREVIEW_SCALE = 0.25  # Burley App. B.2: the clearcoat lobe is weighted 0.25·clearcoat
 

@@ -27,6 +27,41 @@ from .lobes import DEFAULTS, REGISTRY_MODEL, active_lobes, canonical, effective
 from .names import SUBSURFACE_WEIGHT, Slot
 from .sheen_lambda import exact_sheen
 
+__all__ = [
+    "CONTEXTS",
+    "CONTEXT_OUTPUT",
+    "Connection",
+    "DEFAULT_SPELLING",
+    "DISPLACEMENT_OUTPUT",
+    "ExportError",
+    "F0_KEYS",
+    "Image",
+    "Interface",
+    "LOCAL",
+    "LOCAL_SUBSURFACE_M",
+    "MaterialSpec",
+    "Network",
+    "Node",
+    "ST_PRIMVAR",
+    "Source",
+    "TextureFactory",
+    "UNIT",
+    "WEIGHTS",
+    "gtr_as_ggx",
+    "lobe_coverage",
+    "local_subsurface",
+    "loss_note",
+    "noted_values",
+    "plain_value",
+    "prim_name",
+    "same",
+    "same_or_eq",
+    "source_from_params",
+    "subsurface_radius",
+    "surface_inputs",
+    "untargeted",
+]
+
 CONTEXT_OUTPUT = {"universal": "surface", "mtlx": "mtlx:surface", "ri": "ri:surface"}
 """render context → the Material's terminal output name (UsdShade convention)."""
 

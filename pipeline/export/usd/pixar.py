@@ -32,6 +32,18 @@ from lookdev.materials.pixar import (
 )
 from lookdev.materials.pixar_lobes import power_specular, reflection_cone
 
+__all__ = [
+    "DEFAULT_ETA",
+    "WEIGHTS",
+    "cone_roughness",
+    "derived",
+    "from_weights",
+    "ggx_roughness",
+    "highlight_roughness",
+    "ior_to_normal_fresnel",
+    "metallic_workflow",
+]
+
 WEIGHTS = ("specN", "specG", "reflN", "reflG", "reflTN")
 """Smits' view-independent weights a target reads (RGB)."""
 

@@ -20,6 +20,8 @@ from lookdev.materials.errors import LookdevError
 from .network import ExportError
 from .reader import Imported
 
+__all__ = ["check_preset", "import_names", "preset_name", "preset_toml", "screen", "write_presets"]
+
 
 def preset_name(name: str) -> str:
     """A valid preset name for an imported material name.

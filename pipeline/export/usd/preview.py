@@ -38,6 +38,16 @@ from .textures import (
     usd_color_space,
 )
 
+__all__ = [
+    "KEPT_OPAQUE",
+    "SHAPE_NOTES",
+    "ST_READER",
+    "SURFACE",
+    "TRANSMISSION_LOBES",
+    "build",
+    "preview_defaults",
+]
+
 SURFACE = "preview_surface"
 ST_READER = "preview_st"
 SHAPE_NOTES = {

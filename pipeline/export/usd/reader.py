@@ -53,6 +53,24 @@ from .preview import preview_defaults
 from .read_maps import image_input, round32, settle_maps, texture_file, texture_input
 from .record import network_digest, read_record
 
+__all__ = [
+    "DOC_KEY",
+    "F0_SPELLING",
+    "Imported",
+    "MTLX_PREVIEW",
+    "NO_SURFACE",
+    "PRIM_KEY",
+    "READABLE",
+    "READ_ORDER",
+    "SKIPPED_WHY",
+    "UNTARGETED",
+    "colour_spaces",
+    "import_usd",
+    "model_of",
+    "read_networks",
+    "refusal",
+]
+
 PRIM_KEY = "prim_path"
 DOC_KEY = "material_doc"
 """Where :func:`read_networks` keeps the Material's ``doc`` (lookdev's loss lines)."""

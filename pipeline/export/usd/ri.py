@@ -34,6 +34,23 @@ from .network import (
 )
 from .textures import affine, converted, output_of, preview_color_space
 
+__all__ = [
+    "EXTRA_LOSS",
+    "GLASS_REFLECTION",
+    "INPUTS_FILE",
+    "PIXAR_LOSS",
+    "PXR_SURFACE_GAINS",
+    "PXR_SURFACE_MODELS",
+    "PXR_SURFACE_WITH",
+    "RESULTS",
+    "RI_DEFAULTS",
+    "SURFACE",
+    "build",
+    "check_network",
+    "renderman_inputs",
+    "unknown_inputs",
+]
+
 INPUTS_FILE = Path(__file__).with_name("renderman_inputs.json")
 
 

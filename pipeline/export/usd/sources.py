@@ -24,6 +24,18 @@ from .live import live_stack
 from .lobes import DEFAULTS, canonical
 from .network import ExportError, Image, Source, source_from_params, untargeted
 
+__all__ = [
+    "CHANNEL_OUTPUTS",
+    "SUPPORTED",
+    "baked_source",
+    "colour_space_of_bake",
+    "default_colorspace",
+    "referable",
+    "referenced_image",
+    "source_for",
+    "weights_source",
+]
+
 SUPPORTED = tuple(m for m in registry.PRESET_MODELS if m != "openpbr")
 """Models with name tables (a layered Pixar blend: see weights_source); an ``openpbr``
 preset (an import kept as itself) is proofed, not re-exported."""

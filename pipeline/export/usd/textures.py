@@ -23,6 +23,19 @@ from lookdev.pipeline.exr import colour_space_of, write_exr
 from .names import Slot
 from .network import ExportError, Image
 
+__all__ = [
+    "MTLX_ADDRESS",
+    "OUTPUTS",
+    "USD_WRAP",
+    "affine",
+    "converted",
+    "fallback4",
+    "output_of",
+    "preview_color_space",
+    "usd_color_space",
+    "write_image",
+]
+
 USD_WRAP = {"periodic": "repeat", "clamp": "clamp", "black": "black", "mirror": "mirror"}
 """TextureInput ``wrap`` → UsdUVTexture ``wrapS``/``wrapT`` (UsdPreviewSurface spec)."""
 MTLX_ADDRESS = {"periodic": "periodic", "clamp": "clamp", "black": "constant", "mirror": "mirror"}

@@ -27,6 +27,16 @@ from pathlib import Path
 
 from .network import ExportError
 
+__all__ = [
+    "ALLOWED",
+    "FOREIGN_ID_PREFIXES",
+    "PREVIEW_SURFACE_RANGES",
+    "Report",
+    "input_range",
+    "known_inputs",
+    "validate_usd",
+]
+
 ALLOWED = "MissingShaderIdInRegistry"
 FOREIGN_ID_PREFIXES = ("ND_", "Pxr")
 PREVIEW_SURFACE_RANGES: dict[str, tuple[float, float]] = {

@@ -35,6 +35,34 @@ from .network import (
     prim_name,
 )
 
+__all__ = [
+    "BUILDERS",
+    "COLOUR_SPACE_API",
+    "COLOUR_SPACE_ATTR",
+    "DCC_LOSS",
+    "ExportResult",
+    "MTLX_CONFIG_API",
+    "ROOT",
+    "SWITCH",
+    "Staging",
+    "USD_SUFFIXES",
+    "add_switch",
+    "author",
+    "check_folder",
+    "check_images",
+    "check_writable",
+    "dcc_loss_note",
+    "export_usd",
+    "images_of",
+    "loss_doc",
+    "losses_of",
+    "material_spec",
+    "new_layer",
+    "relative_asset",
+    "usd_value",
+    "value_types",
+]
+
 BUILDERS = {"universal": preview.build, "mtlx": mtlx.build, "ri": ri.build}
 MTLX_CONFIG_API = "MaterialXConfigAPI"
 COLOUR_SPACE_API = "ColorSpaceAPI"

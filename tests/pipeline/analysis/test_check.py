@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from _lambert import LambertParams
+from _lambert import LambertParams, LambertPrepared
 
 from lookdev.materials import registry
 from lookdev.materials.bsdf import Model
@@ -16,7 +16,9 @@ from lookdev.pipeline.analysis import stability, stability_cases
 
 # -- a model broken on purpose, three ways ---------------------------------------------------
 def _prepare(xp, params, **maps):
-    return {"rho": xp.color(maps.get("base_color", params.base_color)), "lobes": ("diffuse",)}
+    return LambertPrepared(
+        lobes=("diffuse",), rho=xp.color(maps.get("base_color", params.base_color))
+    )
 
 
 def _eval(xp, prepared, wi, wo):
@@ -26,7 +28,7 @@ def _eval(xp, prepared, wi, wo):
     grazing_nan = wi[2] / wi[2]
     overflow = xp.exp(100.0 * (1.0 - 3.0 * wi[2])) * 1e-40
     f = 1.2 / math.pi * grazing_nan * (1.0 + overflow)
-    return prepared["rho"] * xp.select(upper, f, 0.0)
+    return prepared.rho * xp.select(upper, f, 0.0)
 
 
 def _pdf(xp, prepared, wi, wo):

@@ -186,7 +186,7 @@ def test_interpolation_in_s_is_exact_where_the_blend_says(mode):
     worst = 0.0
     for cos_view in (1.0, 0.9, 0.6, 0.3, 0.05, 0.0):
         direct = _weights_at(top_first, alphas, cos_view, mode)
-        interp = pixar_scatter.at_view(xp, prep["ends"], np.array([cos_view]))
+        interp = pixar_scatter.at_view(xp, prep.ends, np.array([cos_view]))
         for lobe, part in direct.items():
             name = pixar_scatter.PREFIX[lobe]
             got = np.stack([np.ravel(interp[name + "N"]), np.ravel(interp[name + "G"])])

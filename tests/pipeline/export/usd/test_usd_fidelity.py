@@ -4,6 +4,7 @@ layered Pixar presets, subsurface units, frosted glass and the tangent-space nor
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -31,10 +32,11 @@ from lookdev.pipeline.export.usd.writer import DCC_LOSS, FULLY, dcc_loss_note  #
 
 def _prepare(xp, params):
     """The prepared values as plain RGB (channel-first colours are (3, 1))."""
-    return {
-        k: np.ravel(v) if isinstance(v, np.ndarray) else v
-        for k, v in MODEL.prepare(xp, params).items()
-    }
+    pr = MODEL.prepare(xp, params)
+    arrays = {f.name: getattr(pr, f.name) for f in dataclasses.fields(pr)}
+    return dataclasses.replace(
+        pr, **{k: np.ravel(v) for k, v in arrays.items() if isinstance(v, np.ndarray)}
+    )
 
 
 def test_preview_brdf_follows_the_spec_at_its_edges():
@@ -42,13 +44,13 @@ def test_preview_brdf_follows_the_spec_at_its_edges():
     F90 white; a white furnace keeps a white rough dielectric near 1 at normal view."""
     gold = PreviewParams(diffuse_color=(1.0, 0.78, 0.34), metallic=1.0, roughness=0.5)
     p = _prepare(NumpyOps(), gold)
-    np.testing.assert_allclose(p["f0"], [1.0, 0.78, 0.34])
-    np.testing.assert_allclose(p["f90"], [1.0, 0.78, 0.34])
-    np.testing.assert_allclose(p["diffuse"], 0.0)
+    np.testing.assert_allclose(p.f0, [1.0, 0.78, 0.34])
+    np.testing.assert_allclose(p.f90, [1.0, 0.78, 0.34])
+    np.testing.assert_allclose(p.diffuse, 0.0)
     plastic = PreviewParams(diffuse_color=(0.5, 0.5, 0.5), metallic=0.0, ior=1.5)
     p = _prepare(NumpyOps(), plastic)
-    np.testing.assert_allclose(p["f0"], ior_to_f0(1.5))
-    np.testing.assert_allclose(p["f90"], 1.0)
+    np.testing.assert_allclose(p.f0, ior_to_f0(1.5))
+    np.testing.assert_allclose(p.f90, 1.0)
     white = PreviewParams(diffuse_color=(1.0, 1.0, 1.0), roughness=0.5)
     a = albedo_monte_carlo(MODEL, white, [0.0], n_samples=20000)
     assert a.albedo[0, 0] == pytest.approx(1.0, abs=0.02)
@@ -152,7 +154,7 @@ def test_layered_pixar_metal_keeps_its_reflectance_in_the_metallic_workflow():
         NumpyOps(),
         PreviewParams(diffuse_color=tuple(base), metallic=float(m), ior=1.5),
     )
-    seen_after = np.asarray(prepared["f0"])
+    seen_after = np.asarray(prepared.f0)
     seen_before = 0.04 * f0  # specular tint on a DCC's dielectric F0
     np.testing.assert_allclose(seen_after, f0, rtol=1e-6)
     assert (seen_after / seen_before).min() == pytest.approx(25.0)
