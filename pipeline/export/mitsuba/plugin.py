@@ -87,6 +87,7 @@ def _plugin_class(variant: str) -> type:
             constant = not (inputs.textures or inputs.force_all_lobes or inputs.live)
             self._constant_prepared = prepared if constant else None
             self.comps = cm.components_of(model, self.params, prepared, inputs.textures)
+            self.lobes = self.comps.lobes  # what a test or a user asks of a loaded BSDF
             self.m_components = list(self.comps.m_components)
             self.m_flags = self.comps.m_flags
 
