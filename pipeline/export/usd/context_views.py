@@ -4,7 +4,7 @@ A context is measured by reading the network the writer builds, the way a render
 reads it: the written values, the surface's own defaults where an input is not written,
 a map's centre texel where an input is connected, and the model of that surface:
 
-- ``UsdPreviewSurface`` (universal; the ``mtlx`` surface of a layered Pixar blend):
+- ``UsdPreviewSurface`` (universal):
   :mod:`lookdev.materials.preview_surface`;
 - ``ND_open_pbr_surface_surfaceshader``: :mod:`lookdev.materials.openpbr`;
 - ``ND_disney_principled`` and ``PxrDisneyBsdf``: Burley's model

@@ -365,19 +365,23 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
 def model_of(networks: list[Network]) -> str:
     """The model of a Material without lookdev's ``customData`` (a DCC re-saved it), from
     its networks: RenderMan's ``PxrSurface`` at lookdev's ri surface prim is lookdev's
-    Pixar model (its layered form when the MaterialX network is a UsdPreviewSurface);
+    Pixar model (its layered form when the MaterialX surface is marked a blend);
     anything else is read as Disney (``PxrDisneyBsdf``, ``ND_disney_principled``, and a
     foreign OpenPBR or Standard Surface). Without a ri network an OpenPBR surface does not
     tell lookdev's Pixar export from a Disney one or another tool's, and reads as Disney."""
     from . import ri
 
-    ids = {
-        net.context: next((n.id for n in net.nodes if n.name == net.terminal.node), "")
+    from .mtlx import BLEND_KEY
+
+    surfaces = {
+        net.context: next((n for n in net.nodes if n.name == net.terminal.node), None)
         for net in networks
     }
+    ids = {context: node.id if node else "" for context, node in surfaces.items()}
     names = {net.context: net.terminal.node for net in networks}
     if ids.get("ri") == SURFACE_IDS[("ri", "pixar")] and names.get("ri") == ri.SURFACE:
-        layered = ids.get("mtlx") == SURFACE_IDS[("mtlx", "pixar_weights")]
+        mtlx = surfaces.get("mtlx")
+        layered = mtlx is not None and mtlx.custom.get(BLEND_KEY) == "pixar_weights"
         return "pixar_weights" if layered else "pixar"
     return "disney"
 
