@@ -5,7 +5,6 @@ layered Pixar presets, subsurface units, frosted glass and the tangent-space nor
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
 import numpy as np
@@ -156,10 +155,9 @@ def test_frosted_glass_is_a_named_loss_in_materialx(tmp_path):
 
 def test_layered_pixar_mtlx_is_openpbr_with_a_world_space_normal():
     from lookdev.pipeline.export.usd import mtlx
+    from lookdev.pipeline.export.usd.lobes import DEFAULTS
     from lookdev.pipeline.export.usd.network import Connection, Image, Network, Node, Source
     from lookdev.pipeline.export.usd.reader import model_of
-
-    from lookdev.pipeline.export.usd.lobes import DEFAULTS
 
     values = {**DEFAULTS["pixar_weights"], "preview_base": (0.5, 0.2, 0.1)}
     source = Source("s", "pixar_weights", values, normal_map=Image(Path("n.exr")))
