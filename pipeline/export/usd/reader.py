@@ -46,6 +46,7 @@ from .network import (
     MaterialSpec,
     Network,
     Node,
+    plain_value,
     same_or_eq,
 )
 from .pixar import ior_to_normal_fresnel
@@ -304,6 +305,7 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
         )
     by_context = {net.context: net for net in spec.networks}
     spelling = spec.custom.get("spelling") or "ior"
+    translated = None  # a foreign surface read into Burley's parameters
     for context in READABLE[model]:
         net = by_context.get(context)
         foreign = _foreign(net) if model == "disney" else None
@@ -317,6 +319,7 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
             result.contexts.append(context)
             continue
         if foreign is not None:
+            translated = foreign
             units = spec.custom.get("meters_per_unit", 1.0)
             if _read_foreign(foreign, net, units, values, result):
                 spelling = "specular"
@@ -358,6 +361,8 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
         values.update({k: spec.custom[k] for k in CARRIED if k in spec.custom})
     _to_preset_space(values, space, result)
     result.params = _preset_params(values, model, spelling)
+    if translated is not None:
+        _translation_loss(translated, space, result)
     settle_maps(result)
     return result
 
@@ -370,7 +375,6 @@ def model_of(networks: list[Network]) -> str:
     foreign OpenPBR or Standard Surface). Without a ri network an OpenPBR surface does not
     tell lookdev's Pixar export from a Disney one or another tool's, and reads as Disney."""
     from . import ri
-
     from .mtlx import BLEND_KEY
 
     surfaces = {
@@ -437,6 +441,43 @@ def _foreign(net: Network | None) -> Node | None:
         return None
     node = next((n for n in net.nodes if n.name == net.terminal.node), None)
     return node if node is not None and node.id in FOREIGN_SURFACES else None
+
+
+def _translation_loss(surface: Node, space: str, result: Imported) -> None:
+    """The measured albedo loss of an OpenPBR surface read as Burley's ``result.params``
+    (:func:`.fidelity.translation_loss`), in the surface's own colour space: the preset's
+    colours are taken back into it (out of Rec.709's gamut an ACEScg colour is clipped
+    in the preset, a loss the figure then includes). A surface with connected inputs is
+    not measured: the per-texel look is not one material."""
+    from lookdev.materials import colour
+    from lookdev.materials.params import DisneyParams
+
+    from .fidelity import translation_loss
+    from .openpbr_import import OPENPBR_IDS, params_from_values
+
+    if surface.id not in OPENPBR_IDS:
+        return  # Standard Surface and glTF: lookdev has no model of them to measure
+    values = {k: plain_value(v) for k, (_, v) in surface.inputs.items()}
+    values.pop("geometry_normal", None)
+    if any(isinstance(v, Connection) for v in values.values()):
+        return
+    try:
+        openpbr, _ = params_from_values(values)
+    except LookdevError:  # out of the specification's range: named where it is read
+        return
+    disney = DisneyParams.parse(result.params).model_dump()
+    try:
+        source = colour.canonical(space) if space else None
+    except colour.ColourError:  # kept as is by the import (named there)
+        source = None
+    if source is not None and source != colour.canonical(colour.PRESET_LINEAR):
+        for key, value in disney.items():
+            if isinstance(value, tuple) and len(value) == 3:  # linear: a scale's split too
+                back = colour.convert(value, colour.PRESET_LINEAR, source)
+                disney[key] = tuple(float(x) for x in back)
+    line = translation_loss(openpbr, DisneyParams.model_construct(**disney))
+    if line:
+        result.loss.append(f"mtlx: {line}")
 
 
 def _read_foreign(surface: Node, net: Network, units: float, values, result: Imported) -> bool:
@@ -590,3 +631,34 @@ def _preset_params(values: dict[str, Any], model: str, spelling: str) -> dict:
     if not same_or_eq(value, reference):
         params[key] = round32(value)
     return params
+
+
+def import_as_openpbr(path: Path) -> dict[str, Any]:
+    """Material name → :class:`~.reader.Imported` of model ``openpbr`` for every material
+    of the USD file ``path`` whose ``mtlx`` surface is an OpenPBR Surface lookdev did not
+    map from a Disney material (those keep their record or their Disney reading)."""
+    from pxr import Usd
+
+    from .openpbr_import import OPENPBR_IDS, params_from_values
+
+    stage = Usd.Stage.Open(str(path))
+    out = {}
+    for spec in read_networks(stage):
+        net = next((n for n in spec.networks if n.context == "mtlx"), None)
+        if net is None:
+            continue
+        surface = next((n for n in net.nodes if n.name == net.terminal.node), None)
+        if surface is None or surface.id not in OPENPBR_IDS or mapped_from_disney(surface):
+            continue
+        values, notes = {}, []
+        for name, (_, value) in surface.inputs.items():
+            value = plain_value(value)
+            if isinstance(value, Connection):
+                notes.append(f"mtlx: {name} is a connected network (not imported): its default")
+                continue
+            values[name] = tuple(value) if isinstance(value, tuple | list) else value
+        values.pop("geometry_normal", None)
+        params, more = params_from_values(values, f"{path}: material {spec.name!r}")
+        data = params.model_dump(exclude_defaults=True)
+        out[spec.name] = Imported(spec.name, "openpbr", data, contexts=["mtlx"], loss=notes + more)
+    return out
