@@ -39,7 +39,7 @@ NOTES = {
     'layering via MaterialX"): the live mix chains of this network render unlayered there',
     "storm": "Storm renders this context; it ignores material bindings of purpose `full` "
     "only, and lookdev binds all-purpose",
-    "medium": "the source sends light into a scattering interior (its volume colours it "
+    "medium": "Burley's solid sends light into a scattering interior (its volume colours it "
     "there): its surface albedo counts that light as it enters, where OpenPBR's reduction "
     "and the other surfaces reflect a colour at the surface; the figures compare the two",
 }

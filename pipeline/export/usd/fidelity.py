@@ -279,7 +279,7 @@ def translation_loss(openpbr: Any, disney: Any) -> str:
         f"{fid.worst_at}; tolerance {TRANSLATION_TOLERANCE:g}), from the terms that do "
         f"not carry over exactly: {', '.join(terms) or 'none named'}"
     )
-    return f"{line} ({NOTES['medium']})" if lobes.get("scatter") else line
+    return f"{line}; {NOTES['medium']}" if lobes.get("scatter") else line
 
 
 def _source_params(hub: Any) -> tuple[Any, dict[str, Any]]:

@@ -158,7 +158,7 @@ def _print(rows: list[dict]) -> None:
     far = [r for r in rows if r["import_loss"]]
     print(f"\nimports naming a measured translation loss: {len(far)} of {len(rows)}")
     for r in sorted(far, key=lambda r: -r["import_rms"])[:10]:
-        terms = r["import_loss"].split("exactly: ")[-1].split(" (")[0]
+        terms = r["import_loss"].split("exactly: ")[-1].split("; ")[0]
         print(f"  {r['material']}: {terms} ({r['import_rms']:.3f})")
     for r in sorted(rows, key=lambda r: -r["rms"])[:10]:
         print(
