@@ -26,7 +26,7 @@ def usd_(
     """Export N materials into one stage: Sdf-level authoring vs the naive Usd API.
 
     Both author identical networks (UsdPreviewSurface, MaterialX and RenderMan contexts)
-    in the same run, in interleaved rounds (fast, naive, floor, end to end); each ratio
+    in the same run, in interleaved rounds (fast, naive, the two floors, end to end); each ratio
     is taken within its round and reported as the median over rounds with its min-max
     spread, as is the end-to-end materials per second (target ≥ 5×).
     """
@@ -53,4 +53,10 @@ def usd_(
         f"{'met' if ratio >= 5 else 'missed'}); creating the same specs empty, which no "
         f"Python authoring can beat, is {bound:.2f}× it; the fast path takes "
         f"{above_floor:.1f}× that floor to also set values, connections and metadata"
+    )
+    console.print(
+        f"the writer's own usd-core calls replayed with nothing computed are "
+        f"{result['ratio_bound_set']:.2f}× the naive reference: the most any writer making "
+        f"them could reach; the fast path takes "
+        f"{result['fast_s'] / result['floor_set_s']:.2f}× their time"
     )

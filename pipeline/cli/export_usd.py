@@ -343,7 +343,7 @@ def import_usd(
     refused: list[str] = []
     found = read(file.expanduser(), skipped, refused)
     if openpbr is ImportOpenPBR.itself:
-        from lookdev.pipeline.export.usd.openpbr_import import import_as_openpbr
+        from lookdev.pipeline.export.usd.reader import import_as_openpbr
 
         itself = import_as_openpbr(file.expanduser())
         found = [itself.get(m.name, m) for m in found]

@@ -4,7 +4,7 @@ A context is measured by reading the network the writer builds, the way a render
 reads it: the written values, the surface's own defaults where an input is not written,
 a map's centre texel where an input is connected, and the model of that surface:
 
-- ``UsdPreviewSurface`` (universal; the ``mtlx`` surface of a layered Pixar blend):
+- ``UsdPreviewSurface`` (universal):
   :mod:`lookdev.materials.preview_surface`;
 - ``ND_open_pbr_surface_surfaceshader``: :mod:`lookdev.materials.openpbr`;
 - ``ND_disney_principled`` and ``PxrDisneyBsdf``: Burley's model
@@ -39,7 +39,7 @@ NOTES = {
     'layering via MaterialX"): the live mix chains of this network render unlayered there',
     "storm": "Storm renders this context; it ignores material bindings of purpose `full` "
     "only, and lookdev binds all-purpose",
-    "medium": "the source sends light into a scattering interior (its volume colours it "
+    "medium": "Burley's solid sends light into a scattering interior (its volume colours it "
     "there): its surface albedo counts that light as it enters, where OpenPBR's reduction "
     "and the other surfaces reflect a colour at the surface; the figures compare the two",
 }

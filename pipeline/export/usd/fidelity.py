@@ -33,7 +33,7 @@ from lookdev.materials.preview_surface import MODEL as PREVIEW
 from lookdev.materials.preview_surface import PreviewParams
 from lookdev.pipeline.blend.result import BlendedMaterial
 
-from .context_views import preview_params, views
+from .context_views import NOTES, preview_params, views
 from .names import table_for
 from .network import Connection, Source, plain_value
 from .preview import build
@@ -49,6 +49,7 @@ __all__ = [
     "fidelity",
     "source_measured",
     "measure",
+    "translation_loss",
     "preview_hub",
     "preview_params",
     "sphere_albedo",
@@ -305,6 +306,38 @@ def context_fidelity(
             continue
         out.append(compared(source.name, src, measure(view.model, view.params, {}), **about))
     return out
+
+
+TRANSLATION_TOLERANCE = 0.02
+"""Albedo RMS above which an OpenPBR → Disney import names its measured loss: twice the
+Monte Carlo error of :data:`SAMPLES` samples a view (≈ 0.005 RMS for two estimates)."""
+
+
+def translation_loss(openpbr: Any, disney: Any) -> str:
+    """The loss line of an OpenPBR material imported as Burley's (``disney``, its
+    :class:`~lookdev.materials.params.DisneyParams`) when their directional albedos
+    differ by more than :data:`TRANSLATION_TOLERANCE` RMS, else ``""``: the measured RMS
+    and worst difference, and the terms of :data:`.openpbr_map.LOSSES` the two models do
+    not share for these values (the mapping's losses, read the other way)."""
+    from lookdev.materials import registry
+
+    from .lobes import active_lobes, canonical
+    from .openpbr_map import losses_of
+
+    src = measure(registry.model_named("openpbr"), openpbr, {})
+    fid = compared("", src, measure(registry.model_named("disney"), disney, {}))
+    if not fid.rms > TRANSLATION_TOLERANCE:
+        return ""
+    values = canonical(disney)
+    lobes = active_lobes(values)
+    terms = [loss.name for loss in losses_of(values, lobes)]
+    line = (
+        f"OpenPBR → Burley: the translated material's directional albedo differs from "
+        f"the OpenPBR source by RMS {fid.rms:.3f} (worst {fid.worst:+.3f} at "
+        f"{fid.worst_at}; tolerance {TRANSLATION_TOLERANCE:g}), from the terms that do "
+        f"not carry over exactly: {', '.join(terms) or 'none named'}"
+    )
+    return f"{line}; {NOTES['medium']}" if lobes.get("scatter") else line
 
 
 def _source_params(hub: Any) -> tuple[Any, dict[str, Any]]:

@@ -58,6 +58,9 @@ __all__ = [
 ]
 
 SURFACE = "mtlx_surface"
+BLEND_KEY = "blend"
+"""The surface's customData marking a layered Pixar blend's OpenPBR (its lobe weights
+composited: no preset to import)."""
 MX_TYPES = {
     "float": "float",
     "color3f": "color3",
@@ -153,10 +156,8 @@ def build(source: Source, meters_per_unit: float = 1.0, surface: str = "openpbr"
         extra = [e for e in extra if e]
     if source.normal_map is not None and source.model == "disney":
         extra.append(f"{node_id} has no normal input: the normal map is not applied")
-    elif source.normal_map is not None and source.model in TANGENT_NORMAL_MODELS:
-        inputs[NORMAL_INPUT[source.model]] = _tangent_normal(nodes, source.normal_map)
     elif source.normal_map is not None:
-        inputs[NORMAL_INPUT[source.model]] = _normal(nodes, source.normal_map)
+        inputs["geometry_normal"] = _normal(nodes, source.normal_map)
     mapped = mapped_params("mtlx", source.model)
     if source.model == "disney" and source.lobes["sheen"]:
         mapped |= _sheen(source.live_values, extra)
@@ -165,6 +166,8 @@ def build(source: Source, meters_per_unit: float = 1.0, surface: str = "openpbr"
         displacement = _displacement(nodes, source.height)
     note = loss_note(source, node_id, mapped, "; ".join(extra))
     surface = Node(SURFACE, node_id, inputs, {"out": "token"}, {"loss": note})
+    if source.model == "pixar_weights":  # an OpenPBR does not tell a blend from a preset
+        surface.custom[BLEND_KEY] = source.model
     if source.model == "disney" and local_subsurface(source):
         surface.custom["subsurface_radius"] = LOCAL
     return Network("mtlx", Connection(SURFACE, "out"), [surface, *nodes], displacement)
@@ -183,15 +186,12 @@ def _displacement(nodes: list[Node], image: Image) -> Connection:
     return Connection(node.name, "out")
 
 
-NORMAL_INPUT = {"pixar": "geometry_normal", "pixar_weights": "normal"}
-TANGENT_NORMAL_MODELS = ("pixar_weights",)
-"""Models whose MaterialX surface (``ND_UsdPreviewSurface_surfaceshader``) takes a
-tangent-space normal in −1..1 and applies ``normalmap`` in its own graph; OpenPBR's
-``geometry_normal`` takes a world-space normal (``ND_normalmap_float``'s output)."""
 EXTRA_LOSS = {
-    "pixar_weights": "UsdPreviewSurface node in its metallic workflow: one highlight lobe "
-    "(energy-weighted roughness, F0 and diffuse solved for base colour and metallic), "
-    "no transmitted lobes",
+    "pixar_weights": "OpenPBR in its metallic workflow: one highlight lobe (the blend's "
+    "energy-weighted roughness, Schlick's edge, not its grazing weights), its F0 and "
+    "diffuse solved per texel for base_color and base_metalness; no transmitted lobes; "
+    "Smits' layers are composited into the maps it reads (his layering is not a mask mix "
+    "of surfaces): a repainted mask needs a re-export",
     "pixar": "OpenPBR has one specular lobe: Smits' specular and reflection lobes share "
     "their energy-weighted roughness (the lobe carrying more light sets the width; the "
     "other's own width is lost); no transmitted diffuse; lobe scales fold into colours "
@@ -271,33 +271,6 @@ def _normal(nodes: list[Node], image: Image) -> tuple[str, Any]:
         )
     )
     return "vector3f", Connection("mtlx_normal_map", "out")
-
-
-def _tangent_normal(nodes: list[Node], image: Image) -> tuple[str, Any]:
-    """The map decoded to a tangent-space vector, 2·texel − 1, without ``normalmap``:
-    the surface's graph applies it (feeding its world-space output applied it twice)."""
-    nodes.append(
-        Node(
-            "mtlx_normal_image", "ND_image_vector3", {"file": ("asset", image)}, {"out": "vector3f"}
-        )
-    )
-    nodes.append(
-        Node(
-            "mtlx_normal_scaled",
-            "ND_multiply_vector3FA",
-            {"in1": ("vector3f", Connection("mtlx_normal_image", "out")), "in2": ("float", 2.0)},
-            {"out": "vector3f"},
-        )
-    )
-    nodes.append(
-        Node(
-            "mtlx_normal_tangent",
-            "ND_subtract_vector3FA",
-            {"in1": ("vector3f", Connection("mtlx_normal_scaled", "out")), "in2": ("float", 1.0)},
-            {"out": "vector3f"},
-        )
-    )
-    return "vector3f", Connection("mtlx_normal_tangent", "out")
 
 
 def _live_or_baked(source: Source):

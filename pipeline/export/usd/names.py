@@ -290,6 +290,17 @@ PREVIEW_WEIGHTS: tuple[Slot, ...] = (
     Slot("eta", "ior", "float"),
 )
 
+# OpenPBR takes the same solved quantities: its metallic workflow mixes a dielectric of
+# ``specular_ior`` and a metal of F0 ``base_color`` by ``base_metalness``, one specular
+# lobe. Smits' composite is a layered scattering sum, not a mask mix of surfaces, so the
+# mtlx network reads the composited weights' maps (no live mix of per-layer surfaces).
+OPENPBR_WEIGHTS: tuple[Slot, ...] = (
+    Slot("preview_base", "base_color", "color3f"),
+    Slot("preview_metallic", "base_metalness", "float"),
+    Slot("highlight_roughness", "specular_roughness", "float", lobe="highlights"),
+    Slot("eta", "specular_ior", "float"),
+)
+
 TABLES: dict[tuple[str, str], tuple[Slot, ...]] = {
     ("universal", "disney"): PREVIEW_DISNEY,
     ("mtlx", "disney"): MTLX_DISNEY,
@@ -298,8 +309,7 @@ TABLES: dict[tuple[str, str], tuple[Slot, ...]] = {
     ("mtlx", "pixar"): MTLX_PIXAR,
     ("ri", "pixar"): RI_PIXAR,
     ("universal", "pixar_weights"): PREVIEW_WEIGHTS,
-    # MaterialX has the same surface as a node: no re-mapping of blended weights needed.
-    ("mtlx", "pixar_weights"): PREVIEW_WEIGHTS,
+    ("mtlx", "pixar_weights"): OPENPBR_WEIGHTS,
     ("ri", "pixar_weights"): RI_PIXAR,
 }
 """(context, model) → the table of that target."""
@@ -312,7 +322,7 @@ SURFACE_IDS: dict[tuple[str, str], str] = {
     ("mtlx", "pixar"): "ND_open_pbr_surface_surfaceshader",
     ("ri", "pixar"): "PxrSurface",
     ("universal", "pixar_weights"): "UsdPreviewSurface",
-    ("mtlx", "pixar_weights"): "ND_UsdPreviewSurface_surfaceshader",
+    ("mtlx", "pixar_weights"): "ND_open_pbr_surface_surfaceshader",
     ("ri", "pixar_weights"): "PxrSurface",
 }
 """(context, model) → the surface shader's ``info:id``."""

@@ -4,7 +4,8 @@
 The OpenPBR input names are the model's parameter names, so reading is a copy of the
 authored values over the specification's defaults; what cannot be a constant (a
 connected input, an unknown name) is returned as a note, never dropped silently. Used for
-``lookdev import usd`` (an OpenPBR shader in a UsdShade network, read by :mod:`.reader`)
+``lookdev import usd`` (an OpenPBR shader in a UsdShade network, read by
+:func:`.reader.import_as_openpbr`)
 and for standalone ``.mtlx`` documents such as the specification's example materials.
 """
 
@@ -19,7 +20,6 @@ from .network import ExportError
 
 __all__ = [
     "OPENPBR_IDS",
-    "import_as_openpbr",
     "openpbr_preset",
     "params_from_values",
     "read_mtlx",
@@ -91,36 +91,3 @@ def openpbr_preset(name: str, params: OpenPBRParams, description: str = "") -> d
     if description:
         preset["description"] = description
     return preset
-
-
-def import_as_openpbr(path: Path) -> dict[str, Any]:
-    """Material name → :class:`~.reader.Imported` of model ``openpbr`` for every material
-    of the USD file ``path`` whose ``mtlx`` surface is an OpenPBR Surface lookdev did not
-    map from a Disney material (those keep their record or their Disney reading)."""
-    from pxr import Usd
-
-    from .mtlx_openpbr import mapped_from_disney
-    from .network import Connection, plain_value
-    from .reader import Imported, read_networks
-
-    stage = Usd.Stage.Open(str(path))
-    out = {}
-    for spec in read_networks(stage):
-        net = next((n for n in spec.networks if n.context == "mtlx"), None)
-        if net is None:
-            continue
-        surface = next((n for n in net.nodes if n.name == net.terminal.node), None)
-        if surface is None or surface.id not in OPENPBR_IDS or mapped_from_disney(surface):
-            continue
-        values, notes = {}, []
-        for name, (_, value) in surface.inputs.items():
-            value = plain_value(value)
-            if isinstance(value, Connection):
-                notes.append(f"mtlx: {name} is a connected network (not imported): its default")
-                continue
-            values[name] = tuple(value) if isinstance(value, tuple | list) else value
-        values.pop("geometry_normal", None)
-        params, more = params_from_values(values, f"{path}: material {spec.name!r}")
-        data = params.model_dump(exclude_defaults=True)
-        out[spec.name] = Imported(spec.name, "openpbr", data, contexts=["mtlx"], loss=notes + more)
-    return out

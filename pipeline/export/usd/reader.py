@@ -46,6 +46,7 @@ from .network import (
     MaterialSpec,
     Network,
     Node,
+    plain_value,
     same_or_eq,
 )
 from .pixar import ior_to_normal_fresnel
@@ -322,6 +323,7 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
         )
     by_context = {net.context: net for net in spec.networks}
     spelling = spec.custom.get("spelling") or "ior"
+    translated = None  # a foreign surface read into Burley's parameters
     for context in READABLE[model]:
         net = by_context.get(context)
         foreign = _foreign(net) if model == "disney" else None
@@ -335,6 +337,7 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
             result.contexts.append(context)
             continue
         if foreign is not None:
+            translated = foreign
             units = spec.custom.get("meters_per_unit", 1.0)
             if _read_foreign(foreign, net, units, values, result):
                 spelling = "specular"
@@ -376,6 +379,8 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
         values.update({k: spec.custom[k] for k in CARRIED if k in spec.custom})
     _to_preset_space(values, space, result)
     result.params = _preset_params(values, model, spelling)
+    if translated is not None:
+        _translation_loss(translated, space, result)
     settle_maps(result)
     return result
 
@@ -383,19 +388,22 @@ def _imported(spec: MaterialSpec, space: str = "") -> Imported | None:
 def model_of(networks: list[Network]) -> str:
     """The model of a Material without lookdev's ``customData`` (a DCC re-saved it), from
     its networks: RenderMan's ``PxrSurface`` at lookdev's ri surface prim is lookdev's
-    Pixar model (its layered form when the MaterialX network is a UsdPreviewSurface);
+    Pixar model (its layered form when the MaterialX surface is marked a blend);
     anything else is read as Disney (``PxrDisneyBsdf``, ``ND_disney_principled``, and a
     foreign OpenPBR or Standard Surface). Without a ri network an OpenPBR surface does not
     tell lookdev's Pixar export from a Disney one or another tool's, and reads as Disney."""
     from . import ri
+    from .mtlx import BLEND_KEY
 
-    ids = {
-        net.context: next((n.id for n in net.nodes if n.name == net.terminal.node), "")
+    surfaces = {
+        net.context: next((n for n in net.nodes if n.name == net.terminal.node), None)
         for net in networks
     }
+    ids = {context: node.id if node else "" for context, node in surfaces.items()}
     names = {net.context: net.terminal.node for net in networks}
     if ids.get("ri") == SURFACE_IDS[("ri", "pixar")] and names.get("ri") == ri.SURFACE:
-        layered = ids.get("mtlx") == SURFACE_IDS[("mtlx", "pixar_weights")]
+        mtlx = surfaces.get("mtlx")
+        layered = mtlx is not None and mtlx.custom.get(BLEND_KEY) == "pixar_weights"
         return "pixar_weights" if layered else "pixar"
     return "disney"
 
@@ -451,6 +459,43 @@ def _foreign(net: Network | None) -> Node | None:
         return None
     node = next((n for n in net.nodes if n.name == net.terminal.node), None)
     return node if node is not None and node.id in FOREIGN_SURFACES else None
+
+
+def _translation_loss(surface: Node, space: str, result: Imported) -> None:
+    """The measured albedo loss of an OpenPBR surface read as Burley's ``result.params``
+    (:func:`.fidelity.translation_loss`), in the surface's own colour space: the preset's
+    colours are taken back into it (out of Rec.709's gamut an ACEScg colour is clipped
+    in the preset, a loss the figure then includes). A surface with connected inputs is
+    not measured: the per-texel look is not one material."""
+    from lookdev.materials import colour
+    from lookdev.materials.params import DisneyParams
+
+    from .fidelity import translation_loss
+    from .openpbr_import import OPENPBR_IDS, params_from_values
+
+    if surface.id not in OPENPBR_IDS:
+        return  # Standard Surface and glTF: lookdev has no model of them to measure
+    values = {k: plain_value(v) for k, (_, v) in surface.inputs.items()}
+    values.pop("geometry_normal", None)
+    if any(isinstance(v, Connection) for v in values.values()):
+        return
+    try:
+        openpbr, _ = params_from_values(values)
+    except LookdevError:  # out of the specification's range: named where it is read
+        return
+    disney = DisneyParams.parse(result.params).model_dump()
+    try:
+        source = colour.canonical(space) if space else None
+    except colour.ColourError:  # kept as is by the import (named there)
+        source = None
+    if source is not None and source != colour.canonical(colour.PRESET_LINEAR):
+        for key, value in disney.items():
+            if isinstance(value, tuple) and len(value) == 3:  # linear: a scale's split too
+                back = colour.convert(value, colour.PRESET_LINEAR, source)
+                disney[key] = tuple(float(x) for x in back)
+    line = translation_loss(openpbr, DisneyParams.model_construct(**disney))
+    if line:
+        result.loss.append(f"mtlx: {line}")
 
 
 def _read_foreign(surface: Node, net: Network, units: float, values, result: Imported) -> bool:
@@ -604,3 +649,34 @@ def _preset_params(values: dict[str, Any], model: str, spelling: str) -> dict:
     if not same_or_eq(value, reference):
         params[key] = round32(value)
     return params
+
+
+def import_as_openpbr(path: Path) -> dict[str, Any]:
+    """Material name → :class:`~.reader.Imported` of model ``openpbr`` for every material
+    of the USD file ``path`` whose ``mtlx`` surface is an OpenPBR Surface lookdev did not
+    map from a Disney material (those keep their record or their Disney reading)."""
+    from pxr import Usd
+
+    from .openpbr_import import OPENPBR_IDS, params_from_values
+
+    stage = Usd.Stage.Open(str(path))
+    out = {}
+    for spec in read_networks(stage):
+        net = next((n for n in spec.networks if n.context == "mtlx"), None)
+        if net is None:
+            continue
+        surface = next((n for n in net.nodes if n.name == net.terminal.node), None)
+        if surface is None or surface.id not in OPENPBR_IDS or mapped_from_disney(surface):
+            continue
+        values, notes = {}, []
+        for name, (_, value) in surface.inputs.items():
+            value = plain_value(value)
+            if isinstance(value, Connection):
+                notes.append(f"mtlx: {name} is a connected network (not imported): its default")
+                continue
+            values[name] = tuple(value) if isinstance(value, tuple | list) else value
+        values.pop("geometry_normal", None)
+        params, more = params_from_values(values, f"{path}: material {spec.name!r}")
+        data = params.model_dump(exclude_defaults=True)
+        out[spec.name] = Imported(spec.name, "openpbr", data, contexts=["mtlx"], loss=notes + more)
+    return out

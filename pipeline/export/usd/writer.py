@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import os
 import tempfile
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -31,6 +32,8 @@ from .network import (
     Image,
     Interface,
     MaterialSpec,
+    Network,
+    Node,
     Source,
     prim_name,
 )
@@ -138,18 +141,29 @@ def value_types() -> dict[str, Any]:
 
 def usd_value(kind: str, value: Any, base: Path) -> Any:
     """A Python value as USD stores it; asset paths relative to ``base`` (a folder)."""
+    return converter(kind, base)(value)
+
+
+_VECTORS = {
+    **dict.fromkeys(("color3f", "float3", "normal3f", "vector3f"), Gf.Vec3f),
+    "float2": Gf.Vec2f,
+    **dict.fromkeys(("float4", "color4f"), Gf.Vec4f),
+}
+
+
+def converter(kind: str, base: Path) -> Callable[[Any], Any]:
+    """The function turning a value of ``kind`` into what USD stores (asset paths
+    relative to the folder ``base``): made once per kind, applied per value."""
     if kind == "asset":
-        path = value.path if isinstance(value, Image) else Path(value)
-        return Sdf.AssetPath(relative_asset(path, base))
-    if kind in ("color3f", "float3", "normal3f", "vector3f"):
-        return Gf.Vec3f(*value)
-    if kind == "float2":
-        return Gf.Vec2f(*value)
-    if kind in ("float4", "color4f"):
-        return Gf.Vec4f(*value)
+        return lambda value: Sdf.AssetPath(
+            relative_asset(value.path if isinstance(value, Image) else Path(value), base)
+        )
+    if kind in _VECTORS:
+        vector = _VECTORS[kind]
+        return lambda value: vector(*value)
     if kind == "float":
-        return float(value)
-    return value
+        return float
+    return lambda value: value
 
 
 def relative_asset(path: Path, base: Path) -> str:
@@ -175,81 +189,125 @@ def new_layer(default_prim: str = "Materials", meters_per_unit: float = 1.0):
 
 def author(layer, specs: list[MaterialSpec], base: Path) -> list[str]:
     """Author ``specs`` under ``/Materials`` of ``layer``; returns their prim paths."""
-    types = value_types()
-    paths = []
     with Sdf.ChangeBlock():
         scope = layer.GetPrimAtPath("/Materials") or Sdf.CreatePrimInLayer(layer, "/Materials")
         scope.specifier = Sdf.SpecifierDef
         scope.typeName = "Scope"
-        for spec in specs:
-            paths.append(str(_author_material(layer, scope, spec, base, types)))
-    return paths
+        write = _Author(layer, base)
+        return [str(write.material(scope, spec)) for spec in specs]
 
 
-# Attributes are made by Sdf.JustCreatePrimAttributeInLayer and set through the layer,
-# not by constructing Sdf.AttributeSpec objects (≈ 3 µs an attribute instead of ≈ 6),
-# and connections are assigned as a list instead of appended through the list proxy
-# (≈ 2 µs instead of ≈ 4.5): usd-core 0.26, measured in lookdev bench usd.
+# Per attribute, authoring is a few usd-core calls; what Python adds around them is most
+# of the time, so _Author does no work twice: the names of properties, the converters of
+# values, the colour space's name (an OCIO lookup) and the MaterialX version are taken
+# once per call of author(), not per material or attribute. Attributes are made by
+# Sdf.JustCreatePrimAttributeInLayer and set through the layer, not by constructing
+# Sdf.AttributeSpec objects (≈ 3 µs an attribute instead of ≈ 6), and connections are
+# assigned as a list instead of appended through the list proxy (≈ 2 µs instead of
+# ≈ 4.5): usd-core 0.26, measured in lookdev bench usd.
 
 
-def _author_material(layer, scope, spec: MaterialSpec, base: Path, types: dict[str, Any]):
-    prim = Sdf.PrimSpec(scope, prim_name(spec.name), Sdf.SpecifierDef, "Material")
-    prim.customData = {"lookdev": dict(spec.custom)}
-    prim.documentation = loss_doc(spec)
-    path = prim.path
-    _dcc_loss(layer, spec, path, types)
-    # Every colour value and map of the material is in the working space: UsdColorSpaceAPI
-    # names it by USD's canonical name (lin_rec709_scene, lin_ap1_scene) for the material
-    # and everything under it; textures that differ say so on their own inputs.
-    schemas = [COLOUR_SPACE_API]
-    space = path.AppendProperty(COLOUR_SPACE_ATTR)
-    _attribute(layer, space, types["token"], Sdf.VariabilityUniform).default = colour.interop_id()
-    if any(net.context == "mtlx" for net in spec.networks):
-        # UsdMtlx reads the MaterialX version of the networks from MaterialXConfigAPI.
-        schemas.append(MTLX_CONFIG_API)
-        version = path.AppendProperty("config:mtlx:version")
-        _attribute(
-            layer, version, types["string"], Sdf.VariabilityUniform
-        ).default = mtlx.mtlx_version()
-    prim.SetInfo("apiSchemas", Sdf.TokenListOp.Create(prependedItems=schemas))
-    for name, (kind, value) in spec.interface().items():
-        attr = _attribute(layer, path.AppendProperty(f"inputs:{name}"), types[kind])
-        attr.default = usd_value(kind, value, base)
-    for net in spec.networks:
-        output = path.AppendProperty(f"outputs:{CONTEXT_OUTPUT[net.context]}")
-        _attribute(layer, output, types["token"]).connectionPathList.explicitItems = [
+class _Author:
+    """Authors materials into one layer (see :func:`author`), reusing what every material
+    shares: value types, converters, property names."""
+
+    def __init__(self, layer, base: Path):
+        self.layer = layer
+        self.base = base
+        self.types = value_types()
+        self.space = colour.interop_id()
+        self.version = mtlx.mtlx_version()
+        self.inputs = _Names("inputs:")
+        self.outputs = _Names("outputs:")
+        self.convert = {kind: converter(kind, base) for kind in self.types}
+
+    def attribute(self, path, kind: str, variability=Sdf.VariabilityVarying):
+        """A new attribute spec of type ``kind`` at ``path`` (its prim exists)."""
+        Sdf.JustCreatePrimAttributeInLayer(self.layer, path, self.types[kind], variability)
+        return self.layer.GetAttributeAtPath(path)
+
+    def material(self, scope, spec: MaterialSpec):
+        """Author one material under ``scope``; returns its path."""
+        layer, types, convert, inputs = self.layer, self.types, self.convert, self.inputs
+        prim = Sdf.PrimSpec(scope, prim_name(spec.name), Sdf.SpecifierDef, "Material")
+        prim.customData = {"lookdev": dict(spec.custom)}
+        prim.documentation = loss_doc(spec)
+        path = prim.path
+        _dcc_loss(layer, spec, path, types)
+        # Every colour value and map of the material is in the working space:
+        # UsdColorSpaceAPI names it by USD's canonical name (lin_rec709_scene,
+        # lin_ap1_scene) for the material and everything under it; textures that differ
+        # say so on their own inputs.
+        schemas = [COLOUR_SPACE_API]
+        space = path.AppendProperty(COLOUR_SPACE_ATTR)
+        self.attribute(space, "token", Sdf.VariabilityUniform).default = self.space
+        if any(net.context == "mtlx" for net in spec.networks):
+            # UsdMtlx reads the MaterialX version of the networks from MaterialXConfigAPI.
+            schemas.append(MTLX_CONFIG_API)
+            version = path.AppendProperty("config:mtlx:version")
+            self.attribute(version, "string", Sdf.VariabilityUniform).default = self.version
+        prim.SetInfo("apiSchemas", Sdf.TokenListOp.Create(prependedItems=schemas))
+        interface = {}
+        for name, (kind, value) in spec.interface().items():
+            where = interface[name] = path.AppendProperty(inputs[name])
+            self.attribute(where, kind).default = convert[kind](value)
+        for net in spec.networks:
+            self.outputs_of(path, net)
+            for node in net.nodes:
+                self.shader(prim, path, node, interface)
+        return path
+
+    def outputs_of(self, path, net: Network) -> None:
+        """The Material's terminal outputs of ``net``, connected to its shaders."""
+        output = path.AppendProperty(self.outputs[CONTEXT_OUTPUT[net.context]])
+        self.attribute(output, "token").connectionPathList.explicitItems = [
             _output_path(path, net.terminal)
         ]
         if net.displacement is not None:
-            output = path.AppendProperty(f"outputs:{DISPLACEMENT_OUTPUT[net.context]}")
-            _attribute(layer, output, types["token"]).connectionPathList.explicitItems = [
+            output = path.AppendProperty(self.outputs[DISPLACEMENT_OUTPUT[net.context]])
+            self.attribute(output, "token").connectionPathList.explicitItems = [
                 _output_path(path, net.displacement)
             ]
-        for node in net.nodes:
-            shader = Sdf.PrimSpec(prim, node.name, Sdf.SpecifierDef, "Shader")
-            if any(node.custom.values()):
-                shader.customData = {"lookdev": {k: v for k, v in node.custom.items() if v}}
-            at = shader.path.AppendProperty
-            ident = at("info:id")
-            _attribute(layer, ident, types["token"], Sdf.VariabilityUniform).default = node.id
-            for name, (kind, value) in node.inputs.items():
-                attr = _attribute(layer, at(f"inputs:{name}"), types[kind])
-                if isinstance(value, Connection):
-                    attr.connectionPathList.explicitItems = [_output_path(path, value)]
-                elif isinstance(value, Interface):
-                    # Connected to the Material's interface (which wins); the value
-                    # stays here too for readers that do not follow connections.
-                    attr.connectionPathList.explicitItems = [
-                        path.AppendProperty(f"inputs:{value.name}")
-                    ]
-                    attr.default = usd_value(kind, value.value, base)
-                else:
-                    attr.default = usd_value(kind, value, base)
-                if name in node.color_spaces:
-                    attr.SetInfo("colorSpace", node.color_spaces[name])
-            for name, kind in node.outputs.items():
-                Sdf.JustCreatePrimAttributeInLayer(layer, at(f"outputs:{name}"), types[kind])
-    return path
+
+    def shader(self, prim, path, node: Node, interface: dict[str, Any]) -> None:
+        """One shader of a network under the Material ``prim`` (at ``path``)."""
+        layer, types, convert, inputs = self.layer, self.types, self.convert, self.inputs
+        shader = Sdf.PrimSpec(prim, node.name, Sdf.SpecifierDef, "Shader")
+        if any(node.custom.values()):
+            shader.customData = {"lookdev": {k: v for k, v in node.custom.items() if v}}
+        at = shader.path.AppendProperty
+        ident = at("info:id")
+        self.attribute(ident, "token", Sdf.VariabilityUniform).default = node.id
+        spaces = node.color_spaces
+        for name, (kind, value) in node.inputs.items():
+            where = at(inputs[name])
+            Sdf.JustCreatePrimAttributeInLayer(layer, where, types[kind])
+            attr = layer.GetAttributeAtPath(where)
+            if type(value) is Connection:
+                attr.connectionPathList.explicitItems = [_output_path(path, value)]
+            elif type(value) is Interface:
+                # Connected to the Material's interface (which wins); the value stays
+                # here too for readers that do not follow connections.
+                attr.connectionPathList.explicitItems = [interface[value.name]]
+                attr.default = convert[kind](value.value)
+            else:
+                attr.default = convert[kind](value)
+            if spaces and name in spaces:
+                attr.SetInfo("colorSpace", spaces[name])
+        for name, kind in node.outputs.items():
+            Sdf.JustCreatePrimAttributeInLayer(layer, at(self.outputs[name]), types[kind])
+
+
+class _Names(dict):
+    """``prefix + name`` for every name asked, each made once."""
+
+    def __init__(self, prefix: str):
+        super().__init__()
+        self.prefix = prefix
+
+    def __missing__(self, name: str) -> str:
+        self[name] = out = self.prefix + name
+        return out
 
 
 DCC_LOSS = "userProperties:lookdev:loss"
@@ -291,12 +349,6 @@ def _dcc_loss(layer, spec: MaterialSpec, path, types: dict[str, Any]) -> None:
     # Custom (not a schema property): Blender imports only custom attributes.
     Sdf.JustCreatePrimAttributeInLayer(layer, where, types["string"], Sdf.VariabilityVarying, True)
     layer.GetAttributeAtPath(where).default = note
-
-
-def _attribute(layer, path, type_name, variability=Sdf.VariabilityVarying):
-    """A new attribute spec at ``path`` (its prim exists), for setting a value on."""
-    Sdf.JustCreatePrimAttributeInLayer(layer, path, type_name, variability)
-    return layer.GetAttributeAtPath(path)
 
 
 def _output_path(material_path, conn: Connection):

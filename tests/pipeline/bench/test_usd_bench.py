@@ -78,3 +78,14 @@ def test_bench_usd_reports_the_floor_and_its_bound(cli):
     assert data["ratio_bound"] == pytest.approx(data["naive_s"] / data["floor_empty_specs_s"])
     people = cli("bench", "usd", "-n", "5", "--repeat", "1")
     assert "target ≥ 5×" in people.out and "that floor" in people.out
+
+
+def test_the_second_floor_writes_the_fast_paths_layer_byte_for_byte():
+    """The set floor is only a bound on the writer's calls if it makes the same layer."""
+    from pathlib import Path
+
+    from lookdev.pipeline.bench.usd import author_fast, author_recorded, bench_specs, recorded
+
+    layer = author_fast(bench_specs(12), Path.cwd())
+    again = author_recorded(recorded(layer))
+    assert again.ExportToString() == layer.ExportToString()

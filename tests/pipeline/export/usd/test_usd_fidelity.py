@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import math
 from pathlib import Path
 
 import numpy as np
@@ -195,22 +194,25 @@ def test_frosted_glass_is_a_named_loss_in_materialx(tmp_path):
     assert "renders clear" not in result.losses["glass_clear"].get("mtlx", "")
 
 
-def test_layered_pixar_normal_map_is_not_applied_twice():
+def test_layered_pixar_mtlx_is_openpbr_with_a_world_space_normal():
     from lookdev.pipeline.export.usd import mtlx
-    from lookdev.pipeline.export.usd.network import Image, Source
+    from lookdev.pipeline.export.usd.lobes import DEFAULTS
+    from lookdev.pipeline.export.usd.network import Connection, Image, Network, Node, Source
+    from lookdev.pipeline.export.usd.reader import model_of
 
-    source = Source("s", "pixar_weights", {}, normal_map=Image(Path("n.exr")))
-    nodes = []
-    kind, conn = mtlx._tangent_normal(nodes, source.normal_map)
-    assert [n.id for n in nodes] == [
-        "ND_image_vector3",
-        "ND_multiply_vector3FA",
-        "ND_subtract_vector3FA",
-    ]
-    assert "ND_normalmap_float" not in {n.id for n in nodes}  # the surface's graph applies it
-    assert math.isclose(nodes[1].inputs["in2"][1], 2.0) and math.isclose(
-        nodes[2].inputs["in2"][1], 1.0
-    )
+    values = {**DEFAULTS["pixar_weights"], "preview_base": (0.5, 0.2, 0.1)}
+    source = Source("s", "pixar_weights", values, normal_map=Image(Path("n.exr")))
+    net = mtlx.build(source)
+    assert net.nodes[0].id == "ND_open_pbr_surface_surfaceshader"
+    assert net.nodes[0].custom[mtlx.BLEND_KEY] == "pixar_weights"
+    kind, conn = net.nodes[0].inputs["geometry_normal"]
+    ids = {n.name: n.id for n in net.nodes}
+    assert ids[conn.node] == "ND_normalmap_float"  # OpenPBR takes the normal in world space
+    assert "composited" in net.nodes[0].custom["loss"]
+    ri = Network("ri", Connection("ri_surface", "out"), [Node("ri_surface", "PxrSurface", {})])
+    assert model_of([net, ri]) == "pixar_weights"
+    net.nodes[0].custom.pop(mtlx.BLEND_KEY)
+    assert model_of([net, ri]) == "pixar"
 
 
 def test_the_universal_proof_renders_the_preview_surface_s_own_brdf():
