@@ -122,7 +122,8 @@ def routes(d: Any) -> list[Route]:
         else:
             path = await asyncio.to_thread(d.session.save_new, _name(body.get("name")))
         d.broadcast({"type": "state", "version": d.session.version})
-        return JSONResponse({"saved": str(path), "name": d.session.name})
+        copied = d.session.save_messages
+        return JSONResponse({"saved": str(path), "name": d.session.name, "copied": copied})
 
     async def plot(request: Request) -> Response:
         view = request.path_params["view"]
