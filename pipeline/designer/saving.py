@@ -99,7 +99,7 @@ def save_new(session: Any, name: str, folder: Path | None) -> tuple[Path, list[s
         )
     root = _root_of(library, target)
     return _with_copies(
-        doc, target, root, lambda d: library.save(_built(d, target, name), folder=target)
+        library, doc, target, root, lambda d: library.save(_built(d, target, name), folder=target)
     )
 
 
@@ -116,10 +116,17 @@ def _root_of(library: Any, folder: Path) -> Path:
 
 
 def _with_copies(
-    doc: dict[str, Any], folder: Path, root: Path, save: Callable[[dict[str, Any]], Path]
+    library: Any,
+    doc: dict[str, Any],
+    folder: Path,
+    root: Path,
+    save: Callable[[dict[str, Any]], Path],
 ) -> tuple[Path, list[str]]:
     """``save(doc)`` with each file ``doc`` names outside ``root`` copied into ``folder``
     first; the copies made are removed again if the save fails."""
+    builtin = library.builtin
+    if builtin is not None and folder.resolve().is_relative_to(builtin.resolve()):
+        return save(doc), []  # Library.save refuses it with its own line: nothing copied
     created: list[Path] = []
     messages: list[str] = []
     try:
@@ -186,13 +193,7 @@ def save_over(session: Any) -> tuple[Path, list[str]]:
             where=str(path),
         )
     library = session.library
-    plain = Path(os.path.abspath(path))
-    root = next((f for f in library.user_folders if plain.is_relative_to(os.path.abspath(f))), None)
-    if root is None:
-        if library.builtin is not None and path.resolve().is_relative_to(library.builtin.resolve()):
-            # Library.save refuses it with its own message, before anything is copied
-            library.save(build_preset(session.doc, where=str(path)), folder=library.builtin)
-        root = path.parent
+    root = _root_of(library, path.parent)
     build_preset(session.doc, where=str(path))  # the schema's refusal before any copy
 
     def save(doc: dict[str, Any]) -> Path:
@@ -202,7 +203,7 @@ def save_over(session: Any) -> tuple[Path, list[str]]:
             raise LibraryError(f"saved to {written}, not over {path}", where=str(root))
         return written
 
-    return _with_copies(session.doc, path.parent, root, save)
+    return _with_copies(library, session.doc, path.parent, root, save)
 
 
 def _moved(doc: dict[str, Any], old: Path, new: Path) -> dict[str, Any]:
