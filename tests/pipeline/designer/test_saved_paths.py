@@ -167,3 +167,35 @@ def test_the_save_response_says_what_was_copied(client, designer):
     r = client.post(f"/{t}/api/save", json={"mode": "new", "name": "from_page"})
     assert r.status_code == 200, r.text
     assert r.json()["copied"] == ["copied rough.png into the library as rough.png"]
+
+
+def test_an_image_of_another_library_is_copied_into_the_one_saved_to(user_library, tmp_path):
+    from lookdev.pipeline.designer.guard import Roots
+    from lookdev.pipeline.designer.session import Session
+
+    other = tmp_path / "shared"
+    image = _png(other / "rough.png", 70)
+    library = Library([user_library, other], use_env=False)
+    s = Session(library, "gold", roots=Roots({"library0": user_library, "library1": other}))
+    s.edit(
+        {"op": "set", "target": None, "field": "roughness", "value": _map("library1", "rough.png")}
+    )
+    path = s.save_new("borrowed")
+    assert path.parent == user_library
+    written = tomllib.loads(path.read_text())["params"]["roughness"]["texture"]
+    assert written == "rough.png" and (user_library / written).read_bytes() == image.read_bytes()
+    assert Library([user_library], use_env=False).load("borrowed").textures
+
+
+def test_save_over_from_the_page_says_what_was_copied(client, designer, user_library):
+    _png(designer.folder / "spots.png", 30)
+    t = designer.token
+    assert (
+        client.post(f"/{t}/api/save", json={"mode": "new", "name": "mine"}).json()["copied"] == []
+    )
+    op = {"op": "set", "target": None, "field": "roughness", "value": _map("session", "spots.png")}
+    assert client.post(f"/{t}/api/edit", json=op).status_code == 200
+    r = client.post(f"/{t}/api/save", json={"mode": "over"})
+    assert r.status_code == 200, r.text
+    assert r.json()["copied"] == ["copied spots.png into the library as spots.png"]
+    assert (user_library / "spots.png").is_file()
