@@ -117,12 +117,17 @@ def routes(d: Any) -> list[Route]:
 
     async def save(request: Request) -> Response:
         body = await _body(request)
-        if body.get("mode") == "over":
-            path = await asyncio.to_thread(d.session.save_over)
-        else:
-            path = await asyncio.to_thread(d.session.save_new, _name(body.get("name")))
+        over = body.get("mode") == "over"
+        name = None if over else _name(body.get("name"))
+
+        def run() -> tuple[Any, list[str]]:
+            with d.session.lock:  # this save's messages, not a later one's
+                path = d.session.save_over() if over else d.session.save_new(name)
+                return path, list(d.session.save_messages)
+
+        path, copied = await asyncio.to_thread(run)
         d.broadcast({"type": "state", "version": d.session.version})
-        return JSONResponse({"saved": str(path), "name": d.session.name})
+        return JSONResponse({"saved": str(path), "name": d.session.name, "copied": copied})
 
     async def plot(request: Request) -> Response:
         view = request.path_params["view"]

@@ -53,6 +53,9 @@ class Session:
         self._blends: OrderedDict[str, Any] = OrderedDict()
         self._images: dict = {}
         self.blend_log: list[tuple[str, float]] = []
+        self.save_messages: list[str] = []
+        """What the last save copied into the library (files that would have been left
+        outside it), one line each, for the page to show."""
         self.open(preset or "plastic_glossy")
 
     # -- opening ---------------------------------------------------------------------------
@@ -268,7 +271,7 @@ class Session:
     def save_new(self, name: str, folder: Path | None = None) -> Path:
         """Save as a new preset extending the one opened, writing only what changed."""
         with self.lock:
-            path = saving.save_new(self, name, folder)
+            path, self.save_messages = saving.save_new(self, name, folder)
             self.path, self.stamp = path, saving.stamp(path)
             self.doc = preset_document(read_preset(path))
             self.original = copy.deepcopy(self.doc)
@@ -279,8 +282,9 @@ class Session:
     def save_over(self) -> Path:
         """Write the document over the file it came from, if nobody changed that file."""
         with self.lock:
-            path = saving.save_over(self)
+            path, self.save_messages = saving.save_over(self)
             self.stamp = saving.stamp(path)
+            self.doc = preset_document(read_preset(path))  # copies brought in: their paths
             self.original = copy.deepcopy(self.doc)
             self.version += 1
             return path

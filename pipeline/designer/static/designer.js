@@ -584,14 +584,14 @@ function setup() {
   $("save-new").onclick = async () => {
     try {
       const r = await api("api/save", { mode: "new", name: $("save-name").value.trim() });
-      say(`saved ${r.name} to ${r.saved}`);
+      say([`saved ${r.name} to ${r.saved}`, ...r.copied].join("; "));
       await refresh();
     } catch (e) { say(e.message, true); }
   };
   $("save-over").onclick = async () => {
     try {
       const r = await api("api/save", { mode: "over" });
-      say(`saved ${r.saved}`);
+      say([`saved ${r.saved}`, ...r.copied].join("; "));
       await refresh();
     } catch (e) { say(e.message, true); }
   };
