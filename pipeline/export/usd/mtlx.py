@@ -44,9 +44,7 @@ from .textures import MTLX_ADDRESS, affine, converted, output_of
 __all__ = [
     "EXTRA_LOSS",
     "MX_TYPES",
-    "NORMAL_INPUT",
     "SURFACE",
-    "TANGENT_NORMAL_MODELS",
     "build",
     "document",
     "fixed_transmission_roughness",
