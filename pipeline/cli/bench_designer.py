@@ -11,7 +11,7 @@ from .common import console, err_console, print_json, table
 
 __all__ = ["ITEMS", "designer_"]
 
-ITEMS = ("designer", "rotation", "converge", "truth", "compare")
+ITEMS = ("designer", "client", "rotation", "converge", "truth", "compare")
 
 
 def designer_(
@@ -69,6 +69,11 @@ def designer_(
     if "designer_edit" in result:
         r = result["designer_edit"]
         rows.append(["designer edit → frame, median s", r["median_s"], r["median_cpu_s"], "≤ 0.15"])
+    if "client_edit" in result:
+        r = result["client_edit"]
+        rows.append(
+            ["edit via the server → page, median s", r["median_s"], r["median_cpu_s"], "≤ 0.15"]
+        )
     if "ibl_rotation" in result:
         r = result["ibl_rotation"]
         rows.append(

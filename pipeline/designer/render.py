@@ -57,6 +57,9 @@ class Renderer:
         self._stop = False
         self.error: str | None = None
         self.view: dict[str, Any] = {"raw": False, "ab": False, "exposure": 0.0}
+        self.version = 0
+        """The session's version of the material on screen: every frame carries it, so a
+        page (or a benchmark) knows which edit a frame shows."""
         self._thread = threading.Thread(target=self._run, name="designer-render", daemon=True)
         self._thread.start()
 
@@ -107,6 +110,7 @@ class Renderer:
         return [state["A"]] + ([state["B"]] if self.view["ab"] else [])
 
     def _apply(self, pending: dict[str, Any], views: dict[str, Any], state: dict) -> None:
+        self.version = pending.get("version", self.version)
         for key, name in (("material", "A"), ("reference", "B")):
             if key in pending:
                 if name not in views:
@@ -147,6 +151,7 @@ class Renderer:
         s.update(converged=bool(frame.converged), fresh=False)
         meta = {
             "view": key,
+            "version": self.version,
             "spp": int(frame.spp),
             "mode": frame.mode,
             "denoised": bool(shown.denoised),

@@ -176,12 +176,16 @@ class Designer:
                 self.renderer = Renderer(
                     self._viewport, self._publish, watching=lambda: bool(self.clients)
                 )
-                self.renderer.post(material=self.session.hub(), ibl=self.ibl)
+                self.renderer.post(
+                    material=self.session.hub(), ibl=self.ibl, version=self.session.version
+                )
 
     def material_changed(self) -> None:
         """After an edit: the new blend to the viewport, the news to every tab."""
         if self.renderer is not None:
-            self.renderer.post(material=self.session.hub())
+            with self.session.lock:  # the version of this blend, not of a later edit
+                hub, version = self.session.hub(), self.session.version
+            self.renderer.post(material=hub, version=version)
             if self.renderer.view.get("ab"):
                 self.renderer.post(reference=self._reference())
         self.broadcast({"type": "state", "version": self.session.version})

@@ -4,6 +4,7 @@ themselves are measured, not tested)."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -28,3 +29,12 @@ def test_an_unknown_item_is_one_line_and_exit_2(cli):
     result = cli("bench", "designer", "--item", "nope")
     assert result.code == 2
     assert "nope" in result.err and len(result.err.strip().splitlines()) == 1
+
+
+@pytest.mark.render
+def test_an_edit_through_the_server_reaches_the_page():
+    from lookdev.pipeline.bench.designer import client_edit
+
+    result = client_edit((32, 18), edits=3)
+    assert result["count"] == 3
+    assert 0 < result["median_s"] <= result["p90_s"]

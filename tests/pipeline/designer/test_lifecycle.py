@@ -150,3 +150,14 @@ def test_two_tabs_connecting_at_once_start_one_renderer(designer):
         t.join()
     started = {t for t in threading.enumerate() if t.name == "designer-render"} - before
     assert len(started) == 1
+
+
+def test_frames_say_which_edit_they_show(client, designer):
+    t = designer.token
+    with client.websocket_connect(f"ws://127.0.0.1:{designer.port}/{t}/ws") as ws:
+        assert _frame(ws)["version"] == designer.session.version
+        op = {"op": "set", "target": None, "field": "roughness", "value": 0.7}
+        version = client.post(f"/{t}/api/edit", json=op).json()["version"]
+        while (seen := _frame(ws)["version"]) < version:
+            assert seen < version
+        assert seen == version
