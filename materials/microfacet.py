@@ -113,7 +113,8 @@ def gtr_d(xp: Any, gamma: Any, a2: Any, cos2_h: Any, sin2_h: Any) -> Any:
 
     Taking sin²θh separately (from the half vector's x, y) keeps the peak accurate: at
     α = 10⁻³ the denominator is 10⁻⁶ and 1 − cos² would lose it in float32.
-    γ = 1 (the clearcoat) multiplies c by the power directly; any other γ forms
+    γ = 1 (the clearcoat) is c/(α² cos² + sin²) directly (one division, no exp or log in
+    the kernel: the denominator is ≥ α² ≥ 10⁻⁶ wherever h ≠ 0); any other γ forms
     D = exp(log c − γ log(α² cos² + sin²)) (:func:`log_exprel`), because at large γ the
     normalisation c → 0 and the power → ∞ overflow separately in float32 (γ = 10, α = 10⁻³:
     c ≈ 10⁻⁵³, power 10⁶⁰) while their product is finite.
@@ -122,7 +123,7 @@ def gtr_d(xp: Any, gamma: Any, a2: Any, cos2_h: Any, sin2_h: Any) -> Any:
     if isinstance(gamma, float) and gamma == 1.0:
         c = gtr_norm(xp, gamma, a2)
         c = float(c) if isinstance(a2, float) else c  # a constant must not promote float32
-        return c * xp.exp(-gamma * xp.log(base))
+        return c / base
     if isinstance(a2, float) and isinstance(gamma, float):
         log_c = _log_gtr_norm(gamma, a2)  # a Python float: must not promote float32 arrays
     else:
