@@ -58,7 +58,8 @@ INTERFACE = ("specular", "spec_trans")
 
 def pick(xp: Any, front: Any, outside: Any, inside: Any) -> Any:
     """``outside`` where front is 1, ``inside`` where it is 0 (exactly: x·1 + y·0)."""
-    return outside if front is None else outside * front + inside * (1.0 - front)
+    same = isinstance(outside, float) and isinstance(inside, float) and outside == inside
+    return outside if front is None or same else outside * front + inside * (1.0 - front)
 
 
 def times(x: Any, front: Any) -> Any:

@@ -59,6 +59,7 @@ __all__ = [
     "g1_over_cos",
     "g1_pair_over_cos",
     "ggx_d",
+    "ggx_d_denominator",
     "ggx_roughness_like_gtr",
     "gtr_d",
     "gtr_half_max_sin2",
@@ -267,11 +268,17 @@ def ggx_d(xp: Any, h: Any, ax: Any, ay: Any, n2: Any = None) -> Any:
     ``h`` need not be normalised: D is evaluated at h/|h| (the ratio is homogeneous);
     ``n2`` = |h|² when the caller knows it (1 for a unit h).
     """
+    if n2 is None:
+        n2 = h[0] * h[0] + h[1] * h[1] + h[2] * h[2]
+    return (n2 * n2) / ggx_d_denominator(xp, h, ax, ay)  # h = 0 gives 0
+
+
+def ggx_d_denominator(xp: Any, h: Any, ax: Any, ay: Any) -> Any:
+    """1/D of :func:`ggx_d` at a unit ``h``, π αx αy (…)², for a caller that divides by
+    D's denominator and its own at once (one division instead of two)."""
     hx, hy, hz = h[0] / ax, h[1] / ay, h[2]
     s = hx * hx + hy * hy + hz * hz
-    if n2 is None:
-        n2 = h[0] * h[0] + h[1] * h[1] + hz * hz
-    return (n2 * n2) / ((math.pi * ax * ay) * xp.maximum(s * s, xp.tiny))  # h = 0 gives 0
+    return (math.pi * ax * ay) * xp.maximum(s * s, xp.tiny)
 
 
 def sample_ggx(xp: Any, ax: Any, ay: Any, u1: Any, u2: Any) -> Any:
@@ -392,8 +399,11 @@ def dielectric_btdf(
     if g is None:
         qi, qo = projected_roughness(wi, ax, ay), projected_roughness(wo, ax, ay)
         g = g1_pair_over_cos(xp, -wi[2], qi, wo[2], qo)
-    f = (1.0 - fr.dielectric(xp, oh, eta, inv_eta)) * ggx_d(xp, h, ax, ay) * g
-    return xp.select(ok, f * xp.abs(ih * oh) * (inv_eta * inv_eta) / denom2, 0.0)
+    f = (1.0 - fr.dielectric(xp, oh, eta, inv_eta)) * g * xp.abs(ih * oh) * (inv_eta * inv_eta)
+    # h is a unit vector, so D = 1/denominator, and that denominator is ≥ 0.01·π αx αy
+    # (α ≤ 3.2): where ``ok``, h ≠ 0 and denom² = |wi η + wo|²/η² > 0, so one division
+    # by the product serves both.
+    return xp.select(ok, f / (denom2 * ggx_d_denominator(xp, h, ax, ay)), 0.0)
 
 
 def reflect(xp: Any, w: Any, h: Any) -> Any:
