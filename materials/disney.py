@@ -195,15 +195,16 @@ def _reflection_terms(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any)
     scale = _base_scale(xp, pr, ci, co)
     terms = []
     if "specular" in lobes and "specular" not in pr.delta:
-        d = specular_d(xp, pr, h, h2)
         if pr.ggx:
             qi, qo = projected(pr, wi, zi2), projected(pr, wo, zo2)
-            # With glass, |cos θi| (= ci where the lobe is kept): its BTDF shares all of G.
+            # With glass, |cos θi| (= ci where the lobe is kept): its BTDF shares G's roots.
             zi = xp.abs(wi[2]) if "spec_trans" in lobes else ci
-            g = mf.g1_pair_over_cos(xp, zi, qi, co, qo, zi2, zo2)
+            g_den = mf.g1_pair_denominator(xp, zi, qi, co, qo, zi2, zo2)
+            # specular_d's GGX and G over one division.
+            dg = _masked(xp, up, 0.25 * mf.ggx_dg_over_cos(xp, h, h2, pr.ax, pr.ay, g_den))
         else:
             g = v_cavity_over_cos(xp, h, h2, ci, co)
-        dg = _masked(xp, up, 0.25 * d * g) if pr.ggx else xp.select(up, 0.25 * d * g, 0.0)
+            dg = xp.select(up, 0.25 * specular_d(xp, pr, h, h2) * g, 0.0)
         a, b, c = pr.spec_a, pr.spec_b, pr.spec_c
         dg_out = times(dg, front)
         spec_scale = scale

@@ -112,8 +112,8 @@ def transmission(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any, pdf:
 def smith(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any) -> Any:
     """G1(wi) G1(wo)/(|cos θi| cos θo) of the solid glass (wi below, wo up), written as
     the specular reflection writes its own (:func:`.disney._reflection_terms`: the same z²
-    and :func:`projected`, |cos θi| for wi): where the two α agree the kernel computes G
-    once for both."""
+    and :func:`projected`, |cos θi| for wi): where the two α agree the kernel takes G's
+    square roots once for both."""
     zi2, zo2 = wi[2] * wi[2], wo[2] * wo[2]
     qi, qo = projected(pr, wi, zi2, transmitted=True), projected(pr, wo, zo2, transmitted=True)
     return mf.g1_pair_over_cos(xp, xp.abs(wi[2]), qi, xp.maximum(wo[2], 0.0), qo, zi2, zo2)

@@ -57,9 +57,11 @@ __all__ = [
     "dielectric_btdf",
     "exprel",
     "g1_over_cos",
+    "g1_pair_denominator",
     "g1_pair_over_cos",
     "ggx_d",
     "ggx_d_denominator",
+    "ggx_dg_over_cos",
     "ggx_roughness_like_gtr",
     "gtr_d",
     "gtr_half_max_sin2",
@@ -274,8 +276,8 @@ def ggx_d(xp: Any, h: Any, ax: Any, ay: Any, n2: Any = None) -> Any:
 
 
 def ggx_d_denominator(xp: Any, h: Any, ax: Any, ay: Any) -> Any:
-    """1/D of :func:`ggx_d` at a unit ``h``, π αx αy (…)², for a caller that divides by
-    D's denominator and its own at once (one division instead of two)."""
+    """|h|⁴/D of :func:`ggx_d` (1/D at a unit ``h``), π αx αy (…)², for a caller that
+    divides by D's denominator and its own at once (one division instead of two)."""
     hx, hy, hz = h[0] / ax, h[1] / ay, h[2]
     s = hx * hx + hy * hy + hz * hz
     return (math.pi * ax * ay) * xp.maximum(s * s, xp.tiny)
@@ -310,20 +312,39 @@ def g1_over_cos(xp: Any, z: Any, q: Any, z2: Any = None) -> Any:
     The form a microfacet BRDF needs (G1(wi) G1(wo) / (4 cos θi cos θo)): finite as
     z → 0, where G1 and cos θ both vanish.
     """
+    return 2.0 / _g1_denominator(xp, z, q, z2)
+
+
+def _g1_denominator(xp: Any, z: Any, q: Any, z2: Any = None) -> Any:
     z2 = z * z if z2 is None else z2
     # For z ≥ 0 and α ≥ ALPHA_MIN the denominator is ≥ 10⁻³ or ≥ 2z; the floor 10⁻⁶ only
     # keeps masked-out directions (z = 0, q = 0) finite.
-    return 2.0 / xp.maximum(z + xp.sqrt(z2 + q), 1e-6)
+    return xp.maximum(z + xp.sqrt(z2 + q), 1e-6)
+
+
+def g1_pair_denominator(xp: Any, zi: Any, qi: Any, zo: Any, qo: Any, zi2=None, zo2=None):
+    """dᵢ dₒ with G1(wi) G1(wo)/(cos θi cos θo) = 4/(dᵢ dₒ) (:func:`g1_over_cos`)."""
+    return _g1_denominator(xp, zi, qi, zi2) * _g1_denominator(xp, zo, qo, zo2)
 
 
 def g1_pair_over_cos(xp: Any, zi: Any, qi: Any, zo: Any, qo: Any, zi2=None, zo2=None) -> Any:
     """G1(wi) G1(wo)/(cos θi cos θo) = :func:`g1_over_cos` of both directions, as
     4/(dᵢ dₒ): one division instead of two (each d ≥ 10⁻⁶, so the product stays normal)."""
-    zi2 = zi * zi if zi2 is None else zi2
-    zo2 = zo * zo if zo2 is None else zo2
-    di = xp.maximum(zi + xp.sqrt(zi2 + qi), 1e-6)
-    do = xp.maximum(zo + xp.sqrt(zo2 + qo), 1e-6)
-    return 4.0 / (di * do)
+    return 4.0 / g1_pair_denominator(xp, zi, qi, zo, qo, zi2, zo2)
+
+
+_SCALE = 2.0**64  # a power of two: scaling by it rounds nothing
+
+
+def ggx_dg_over_cos(xp: Any, h: Any, n2: Any, ax: Any, ay: Any, g_den: Any) -> Any:
+    """D(h) G1(wi) G1(wo)/(cos θi cos θo) of :func:`ggx_d` (h unnormalised, |h|² = ``n2``)
+    and ``g_den`` (:func:`g1_pair_denominator`), with one division instead of two.
+
+    For a reflection pair (h_z > 0) D's denominator is ≥ π αx αy (0.1 n2)², which at a
+    grazing pair with α = 10⁻³ is 10⁻³⁶, and d_i d_o ≥ 10⁻⁶: their product would fall
+    below float32's normal range, so numerator and denominator are both scaled by 2⁶⁴
+    (the largest product, ≈ 10⁹, stays far from overflow)."""
+    return ((4.0 * _SCALE) * (n2 * n2)) / ((ggx_d_denominator(xp, h, ax, ay) * _SCALE) * g_den)
 
 
 # -- visible normals (Heitz 2018) ------------------------------------------------------------
