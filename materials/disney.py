@@ -60,7 +60,9 @@ from .arrays import NumpyOps
 from .bsdf import Model, density, draw, evaluate
 from .disney_interface import (
     INTERFACE,
+    etap,
     interface_pdf,
+    inv_etap,
     pick,
     projected,
     sample_interface,
@@ -186,18 +188,23 @@ def _reflection_terms(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any)
     cos2_d = 0.25 * h2
     cos_d = xp.sqrt(cos2_d)
     w = fr.schlick_weight(xp, cos_d)
-    zi2, zo2 = ci * ci, co * co
+    # z² of the directions themselves (= the clamped cosines' squares wherever a lobe is
+    # kept): the glass's BTDF takes the same Smith terms (:func:`.disney_interface.smith`),
+    # so the kernel computes their square roots once for both sides.
+    zi2, zo2 = wi[2] * wi[2], wo[2] * wo[2]
     scale = _base_scale(xp, pr, ci, co)
     terms = []
     if "specular" in lobes and "specular" not in pr.delta:
-        d = specular_d(xp, pr, h, h2)
         if pr.ggx:
-            g = mf.g1_over_cos(xp, ci, projected(pr, wi, zi2), zi2) * mf.g1_over_cos(
-                xp, co, projected(pr, wo, zo2), zo2
-            )
+            qi, qo = projected(pr, wi, zi2), projected(pr, wo, zo2)
+            # With glass, |cos θi| (= ci where the lobe is kept): its BTDF shares G's roots.
+            zi = xp.abs(wi[2]) if "spec_trans" in lobes else ci
+            g_den = mf.g1_pair_denominator(xp, zi, qi, co, qo, zi2, zo2)
+            # specular_d's GGX and G over one division.
+            dg = _masked(xp, up, 0.25 * mf.ggx_dg_over_cos(xp, h, h2, pr.ax, pr.ay, g_den))
         else:
             g = v_cavity_over_cos(xp, h, h2, ci, co)
-        dg = _masked(xp, up, 0.25 * d * g) if pr.ggx else xp.select(up, 0.25 * d * g, 0.0)
+            dg = xp.select(up, 0.25 * specular_d(xp, pr, h, h2) * g, 0.0)
         a, b, c = pr.spec_a, pr.spec_b, pr.spec_c
         dg_out = times(dg, front)
         spec_scale = scale
@@ -206,10 +213,11 @@ def _reflection_terms(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any)
             # on this lobe alone (the layers under it keep ``scale``).
             ms = _energy_factor(xp, pr, co, front)
             spec_scale = ms if isinstance(scale, float) else scale * ms
-        terms += [(a * spec_scale, dg_out), ((b - a) * spec_scale, dg_out * w)]
+        if not (xp.known_zero(a) and xp.known_zero(b)):  # no Schlick part: white glass
+            terms += [(a * spec_scale, dg_out), ((b - a) * spec_scale, dg_out * w)]
         if not xp.known_zero(c):
             # The glass reflects the exact Fresnel on either side; inside, nothing else does.
-            f_exact = fr.dielectric(xp, cos_d, pick(xp, front, pr.eta, 1.0 / pr.eta))
+            f_exact = fr.dielectric(xp, cos_d, etap(xp, pr, front), inv_etap(xp, pr, front))
             k = f_exact * dg * pick(xp, front, c, pr.glass)
             terms.append((None if isinstance(spec_scale, float) else spec_scale, k))
     if "diffuse" in lobes:
@@ -230,9 +238,7 @@ def _reflection_terms(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any)
         sin2_h = (h[0] * h[0] + h[1] * h[1]) * inv_h2  # not 1 − cos²: the α = 10⁻³ peak
         d = mf.gtr_d(xp, 1.0, pr.clearcoat_a2, h[2] * h[2] * inv_h2, sin2_h)
         a2 = mf.CLEARCOAT_G_ALPHA * mf.CLEARCOAT_G_ALPHA
-        g = mf.g1_over_cos(xp, ci, a2 * (1.0 - zi2), zi2) * mf.g1_over_cos(
-            xp, co, a2 * (1.0 - zo2), zo2
-        )
+        g = mf.g1_pair_over_cos(xp, ci, a2 * (1.0 - zi2), co, a2 * (1.0 - zo2), zi2, zo2)
         f = fr.schlick(xp, CLEARCOAT_F0, cos_d)
         # Burley's clearcoat keeps the 1/(4 cos cos) that Schutte and Mitsuba leave out.
         k = times((0.25 * pr.clearcoat) * f * d * g, front)
@@ -423,7 +429,7 @@ def guide_core(xp: Any, pr: DisneyPrepared, wo: Any) -> Any:
         if not xp.known_zero(metallic):
             out = times(metallic * pr.base, front)
     if "spec_trans" in lobes:
-        f = fr.dielectric(xp, wo_[2], pick(xp, front, pr.eta, 1.0 / pr.eta))
+        f = fr.dielectric(xp, wo_[2], etap(xp, pr, front), inv_etap(xp, pr, front))
         out = _add(out, pr.glass * (f + (1.0 - f) * pr.trans_color))
     return out
 

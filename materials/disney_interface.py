@@ -41,9 +41,11 @@ __all__ = [
     "delta_reflectance",
     "delta_transmittance",
     "interface_pdf",
+    "inv_etap",
     "pick",
     "projected",
     "sample_interface",
+    "smith",
     "specular_d",
     "split",
     "transmission",
@@ -56,7 +58,8 @@ INTERFACE = ("specular", "spec_trans")
 
 def pick(xp: Any, front: Any, outside: Any, inside: Any) -> Any:
     """``outside`` where front is 1, ``inside`` where it is 0 (exactly: x·1 + y·0)."""
-    return outside if front is None else outside * front + inside * (1.0 - front)
+    same = isinstance(outside, float) and isinstance(inside, float) and outside == inside
+    return outside if front is None or same else outside * front + inside * (1.0 - front)
 
 
 def times(x: Any, front: Any) -> Any:
@@ -84,6 +87,11 @@ def etap(xp: Any, pr: DisneyPrepared, front: Any) -> Any:
     return pick(xp, front, pr.eta, 1.0 / pr.eta)
 
 
+def inv_etap(xp: Any, pr: DisneyPrepared, front: Any) -> Any:
+    """1/:func:`etap`, picked from the two constants: no per-element division."""
+    return pick(xp, front, 1.0 / pr.eta, pr.eta)
+
+
 def transmission(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any, pdf: bool) -> Any:
     """f (without weight and colour) of the glossy transmission, or its lobe pdf; wi below."""
     ax, ay = pr.tax, pr.tay
@@ -94,9 +102,21 @@ def transmission(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any, pdf:
         oh = xp.dot(wo, h)
         if pdf:
             return mf.visible_ggx_pdf(xp, wo, h, ax, ay) / xp.maximum(4.0 * oh, xp.tiny)
-        g = mf.g1_over_cos(xp, wm[2], _qt(pr, wm)) * mf.g1_over_cos(xp, wo[2], _qt(pr, wo))
+        g = mf.g1_pair_over_cos(xp, wm[2], _qt(pr, wm), wo[2], _qt(pr, wo))
         return (1.0 - fr.dielectric(xp, oh, pr.eta)) * mf.ggx_d(xp, h, ax, ay) * g * 0.25
-    return mf.dielectric_btdf(xp, wi, wo, etap(xp, pr, front), ax, ay, pdf)
+    e, inv = etap(xp, pr, front), inv_etap(xp, pr, front)
+    g = None if pdf else smith(xp, pr, wi, wo)
+    return mf.dielectric_btdf(xp, wi, wo, e, ax, ay, pdf, inv_eta=inv, g=g)
+
+
+def smith(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any) -> Any:
+    """G1(wi) G1(wo)/(|cos θi| cos θo) of the solid glass (wi below, wo up), written as
+    the specular reflection writes its own (:func:`.disney._reflection_terms`: the same z²
+    and :func:`projected`, |cos θi| for wi): where the two α agree the kernel takes G's
+    square roots once for both."""
+    zi2, zo2 = wi[2] * wi[2], wo[2] * wo[2]
+    qi, qo = projected(pr, wi, zi2, transmitted=True), projected(pr, wo, zo2, transmitted=True)
+    return mf.g1_pair_over_cos(xp, xp.abs(wi[2]), qi, xp.maximum(wo[2], 0.0), qo, zi2, zo2)
 
 
 def specular_d(xp: Any, pr: DisneyPrepared, h: Any, h2: Any) -> Any:
@@ -152,7 +172,7 @@ def split(xp: Any, pr: DisneyPrepared, cos: Any, front: Any) -> tuple[Any, Any]:
     has_r, has_t, _, _ = _has(pr)
     if not has_t:
         return 1.0, 0.0
-    f = fr.dielectric(xp, cos, etap(xp, pr, front))
+    f = fr.dielectric(xp, cos, etap(xp, pr, front), inv_etap(xp, pr, front))
     t = pr.glass * (1.0 - f)
     if not has_r:
         r = 0.0
@@ -179,7 +199,7 @@ def delta_reflectance(xp: Any, pr: DisneyPrepared, co: Any, front: Any, scale: A
     a, b = pr.spec_a, pr.spec_b
     col = times(a + (b - a) * fr.schlick_weight(xp, co), front)
     if not xp.known_zero(pr.spec_c):
-        f = fr.dielectric(xp, co, etap(xp, pr, front))
+        f = fr.dielectric(xp, co, etap(xp, pr, front), inv_etap(xp, pr, front))
         col = col + pick(xp, front, pr.spec_c, pr.glass) * f
     return col * scale
 
@@ -192,10 +212,10 @@ def delta_transmittance(xp: Any, pr: DisneyPrepared, co: Any, front: Any) -> Any
     has no 1/η²: Snell pairs have one Fresnel, and radiance/η² is what is conserved,
     so the η² of the radiance form is all that differs (Mitsuba's ``dielectric``).
     """
-    e = etap(xp, pr, front)
-    t = pr.glass * (1.0 - fr.dielectric(xp, co, e))
+    inv = inv_etap(xp, pr, front)
+    t = pr.glass * (1.0 - fr.dielectric(xp, co, etap(xp, pr, front), inv))
     if not pr.thin and not pr.adjoint:
-        t = t / (e * e)
+        t = t * (inv * inv)
     return pr.trans_color * t
 
 
@@ -299,7 +319,8 @@ def interface_pdf(
             e = etap(xp, pr, front)
             ht = mf.transmission_half(xp, wi, wo, e)
             p_t = split(xp, pr, xp.dot(wo, ht), front)[1]
-            pt = mf.dielectric_btdf(xp, wi, wo, e, pr.tax, pr.tay, True, h=ht)
+            inv = inv_etap(xp, pr, front)
+            pt = mf.dielectric_btdf(xp, wi, wo, e, pr.tax, pr.tay, True, h=ht, inv_eta=inv)
         else:
             pt = transmission(xp, pr, wi, wo, front, pdf=True)
         p = p + xp.select(down, p_t * pt, 0.0)

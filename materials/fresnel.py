@@ -132,18 +132,26 @@ def schlick(xp: Any, f0: Any, cos: Any) -> Any:
     return f0 + (1.0 - f0) * schlick_weight(xp, cos)
 
 
-def dielectric(xp: Any, cos_i: Any, eta: Any) -> Any:
+def dielectric(xp: Any, cos_i: Any, eta: Any, inv_eta: Any = None) -> Any:
     """Unpolarised Fresnel reflectance of a smooth dielectric interface (pbrt-v4 eq. 9.6).
 
     ``cos_i`` is the cosine of the incident direction with the (micro-)normal on the side
     it arrives from (its sign is ignored); ``eta`` = η_t/η_i, the IOR of the far side over
-    that of the near side. Returns 1 under total internal reflection.
+    that of the near side. Returns 1 under total internal reflection. ``inv_eta`` = 1/η
+    when the caller has it as cheaply as η (a per-side pick of two constants): a kernel
+    then multiplies instead of dividing by a per-element η.
     """
+    if inv_eta is None:
+        inv_eta = 1.0 / eta
     c_i = xp.minimum(xp.abs(cos_i), 1.0)
-    sin2_t = (1.0 - c_i * c_i) / (eta * eta)
+    sin2_t = (1.0 - c_i * c_i) * (inv_eta * inv_eta)
     c_t = xp.safe_sqrt(1.0 - sin2_t)
-    # Both denominators vanish only at grazing incidence with η = 1, which is TIR here.
-    r_par = (eta * c_i - c_t) / xp.maximum(eta * c_i + c_t, xp.tiny)
-    r_perp = (c_i - eta * c_t) / xp.maximum(c_i + eta * c_t, xp.tiny)
-    f = 0.5 * (r_par * r_par + r_perp * r_perp)
+    # Both denominators vanish only at grazing incidence with η = 1, which is TIR here;
+    # elsewhere each is ≥ c_t ≥ 2.4·10⁻⁴ (float32) and at most 2η, so r_par² + r_perp² is
+    # taken over one common denominator: one division instead of two.
+    d_par = xp.maximum(eta * c_i + c_t, xp.tiny)
+    d_perp = xp.maximum(c_i + eta * c_t, xp.tiny)
+    n_par, n_perp = (eta * c_i - c_t) * d_perp, (c_i - eta * c_t) * d_par
+    d = d_par * d_perp
+    f = 0.5 * (n_par * n_par + n_perp * n_perp) / xp.maximum(d * d, xp.tiny)
     return xp.select(sin2_t >= 1.0, 1.0, f)

@@ -57,7 +57,11 @@ __all__ = [
     "dielectric_btdf",
     "exprel",
     "g1_over_cos",
+    "g1_pair_denominator",
+    "g1_pair_over_cos",
     "ggx_d",
+    "ggx_d_denominator",
+    "ggx_dg_over_cos",
     "ggx_roughness_like_gtr",
     "gtr_d",
     "gtr_half_max_sin2",
@@ -112,7 +116,8 @@ def gtr_d(xp: Any, gamma: Any, a2: Any, cos2_h: Any, sin2_h: Any) -> Any:
 
     Taking sin²θh separately (from the half vector's x, y) keeps the peak accurate: at
     α = 10⁻³ the denominator is 10⁻⁶ and 1 − cos² would lose it in float32.
-    γ = 1 (the clearcoat) multiplies c by the power directly; any other γ forms
+    γ = 1 (the clearcoat) is c/(α² cos² + sin²) directly (one division, no exp or log in
+    the kernel: the denominator is ≥ α² ≥ 10⁻⁶ wherever h ≠ 0); any other γ forms
     D = exp(log c − γ log(α² cos² + sin²)) (:func:`log_exprel`), because at large γ the
     normalisation c → 0 and the power → ∞ overflow separately in float32 (γ = 10, α = 10⁻³:
     c ≈ 10⁻⁵³, power 10⁶⁰) while their product is finite.
@@ -121,7 +126,7 @@ def gtr_d(xp: Any, gamma: Any, a2: Any, cos2_h: Any, sin2_h: Any) -> Any:
     if isinstance(gamma, float) and gamma == 1.0:
         c = gtr_norm(xp, gamma, a2)
         c = float(c) if isinstance(a2, float) else c  # a constant must not promote float32
-        return c * xp.exp(-gamma * xp.log(base))
+        return c / base
     if isinstance(a2, float) and isinstance(gamma, float):
         log_c = _log_gtr_norm(gamma, a2)  # a Python float: must not promote float32 arrays
     else:
@@ -265,11 +270,17 @@ def ggx_d(xp: Any, h: Any, ax: Any, ay: Any, n2: Any = None) -> Any:
     ``h`` need not be normalised: D is evaluated at h/|h| (the ratio is homogeneous);
     ``n2`` = |h|² when the caller knows it (1 for a unit h).
     """
+    if n2 is None:
+        n2 = h[0] * h[0] + h[1] * h[1] + h[2] * h[2]
+    return (n2 * n2) / ggx_d_denominator(xp, h, ax, ay)  # h = 0 gives 0
+
+
+def ggx_d_denominator(xp: Any, h: Any, ax: Any, ay: Any) -> Any:
+    """|h|⁴/D of :func:`ggx_d` (1/D at a unit ``h``), π αx αy (…)², for a caller that
+    divides by D's denominator and its own at once (one division instead of two)."""
     hx, hy, hz = h[0] / ax, h[1] / ay, h[2]
     s = hx * hx + hy * hy + hz * hz
-    if n2 is None:
-        n2 = h[0] * h[0] + h[1] * h[1] + hz * hz
-    return (n2 * n2) / ((math.pi * ax * ay) * xp.maximum(s * s, xp.tiny))  # h = 0 gives 0
+    return (math.pi * ax * ay) * xp.maximum(s * s, xp.tiny)
 
 
 def sample_ggx(xp: Any, ax: Any, ay: Any, u1: Any, u2: Any) -> Any:
@@ -301,10 +312,39 @@ def g1_over_cos(xp: Any, z: Any, q: Any, z2: Any = None) -> Any:
     The form a microfacet BRDF needs (G1(wi) G1(wo) / (4 cos θi cos θo)): finite as
     z → 0, where G1 and cos θ both vanish.
     """
+    return 2.0 / _g1_denominator(xp, z, q, z2)
+
+
+def _g1_denominator(xp: Any, z: Any, q: Any, z2: Any = None) -> Any:
     z2 = z * z if z2 is None else z2
     # For z ≥ 0 and α ≥ ALPHA_MIN the denominator is ≥ 10⁻³ or ≥ 2z; the floor 10⁻⁶ only
     # keeps masked-out directions (z = 0, q = 0) finite.
-    return 2.0 / xp.maximum(z + xp.sqrt(z2 + q), 1e-6)
+    return xp.maximum(z + xp.sqrt(z2 + q), 1e-6)
+
+
+def g1_pair_denominator(xp: Any, zi: Any, qi: Any, zo: Any, qo: Any, zi2=None, zo2=None):
+    """dᵢ dₒ with G1(wi) G1(wo)/(cos θi cos θo) = 4/(dᵢ dₒ) (:func:`g1_over_cos`)."""
+    return _g1_denominator(xp, zi, qi, zi2) * _g1_denominator(xp, zo, qo, zo2)
+
+
+def g1_pair_over_cos(xp: Any, zi: Any, qi: Any, zo: Any, qo: Any, zi2=None, zo2=None) -> Any:
+    """G1(wi) G1(wo)/(cos θi cos θo) = :func:`g1_over_cos` of both directions, as
+    4/(dᵢ dₒ): one division instead of two (each d ≥ 10⁻⁶, so the product stays normal)."""
+    return 4.0 / g1_pair_denominator(xp, zi, qi, zo, qo, zi2, zo2)
+
+
+_SCALE = 2.0**64  # a power of two: scaling by it rounds nothing
+
+
+def ggx_dg_over_cos(xp: Any, h: Any, n2: Any, ax: Any, ay: Any, g_den: Any) -> Any:
+    """D(h) G1(wi) G1(wo)/(cos θi cos θo) of :func:`ggx_d` (h unnormalised, |h|² = ``n2``)
+    and ``g_den`` (:func:`g1_pair_denominator`), with one division instead of two.
+
+    For a reflection pair (h_z > 0) D's denominator is ≥ π αx αy (0.1 n2)², which at a
+    grazing pair with α = 10⁻³ is 10⁻³⁶, and d_i d_o ≥ 10⁻⁶: their product would fall
+    below float32's normal range, so numerator and denominator are both scaled by 2⁶⁴
+    (the largest product, ≈ 10⁹, stays far from overflow)."""
+    return ((4.0 * _SCALE) * (n2 * n2)) / ((ggx_d_denominator(xp, h, ax, ay) * _SCALE) * g_den)
 
 
 # -- visible normals (Heitz 2018) ------------------------------------------------------------
@@ -347,7 +387,16 @@ def transmission_half(xp: Any, wi: Any, wo: Any, eta: Any) -> Any:
 
 
 def dielectric_btdf(
-    xp: Any, wi: Any, wo: Any, eta: Any, ax: Any, ay: Any, pdf: bool, h: Any = None
+    xp: Any,
+    wi: Any,
+    wo: Any,
+    eta: Any,
+    ax: Any,
+    ay: Any,
+    pdf: bool,
+    h: Any = None,
+    inv_eta: Any = None,
+    g: Any = None,
 ) -> Any:
     """Rough dielectric transmission (Walter et al. 2007 eq. 21; pbrt-v4 DielectricBxDF).
 
@@ -355,20 +404,27 @@ def dielectric_btdf(
     the last 1/η² for radiance transport. ``wo`` is up (relative IOR 1), ``wi`` below,
     ``eta`` = η_wi/η_wo. With ``pdf``: the density of refracting ``wo`` about a visible
     normal, D_wo(h) |wi·h| / (wi·h + wo·h/η)². Zero where no microfacet connects them.
-    ``h``: :func:`transmission_half` of (wi, wo), when the caller has it already.
+    ``h``: :func:`transmission_half` of (wi, wo), when the caller has it already;
+    ``inv_eta``: 1/η, when the caller has it without a division (:func:`.fresnel.dielectric`);
+    ``g``: G1(wi) G1(wo)/(|cos θi| cos θo) (:func:`g1_pair_over_cos`), when the caller
+    shares its terms with a reflection lobe.
     """
+    inv_eta = 1.0 / eta if inv_eta is None else inv_eta
     h = transmission_half(xp, wi, wo, eta) if h is None else h
     ih, oh = xp.dot(wi, h), xp.dot(wo, h)
     ok = (ih < 0.0) & (oh > 0.0)
-    denom = ih + oh / eta
+    denom = ih + oh * inv_eta
     denom2 = xp.maximum(denom * denom, xp.tiny)
     if pdf:
         return xp.select(ok, visible_ggx_pdf(xp, wo, h, ax, ay) * xp.abs(ih) / denom2, 0.0)
-    g = g1_over_cos(xp, -wi[2], projected_roughness(wi, ax, ay)) * g1_over_cos(
-        xp, wo[2], projected_roughness(wo, ax, ay)
-    )
-    f = (1.0 - fr.dielectric(xp, oh, eta)) * ggx_d(xp, h, ax, ay) * g * xp.abs(ih * oh)
-    return xp.select(ok, f / (denom2 * eta * eta), 0.0)
+    if g is None:
+        qi, qo = projected_roughness(wi, ax, ay), projected_roughness(wo, ax, ay)
+        g = g1_pair_over_cos(xp, -wi[2], qi, wo[2], qo)
+    f = (1.0 - fr.dielectric(xp, oh, eta, inv_eta)) * g * xp.abs(ih * oh) * (inv_eta * inv_eta)
+    # h is a unit vector, so D = 1/denominator, and that denominator is ≥ 0.01·π αx αy
+    # (α ≤ 3.2): where ``ok``, h ≠ 0 and denom² = |wi η + wo|²/η² > 0, so one division
+    # by the product serves both.
+    return xp.select(ok, f / (denom2 * ggx_d_denominator(xp, h, ax, ay)), 0.0)
 
 
 def reflect(xp: Any, w: Any, h: Any) -> Any:
