@@ -276,7 +276,7 @@ def ggx_d(xp: Any, h: Any, ax: Any, ay: Any, n2: Any = None) -> Any:
 
 
 def ggx_d_denominator(xp: Any, h: Any, ax: Any, ay: Any) -> Any:
-    """|h|⁴/D of :func:`ggx_d` (1/D at a unit ``h``), π αx αy (…)², for a caller that
+    """‖h‖⁴/D of :func:`ggx_d` (1/D at a unit ``h``), π αx αy (…)², for a caller that
     divides by D's denominator and its own at once (one division instead of two)."""
     hx, hy, hz = h[0] / ax, h[1] / ay, h[2]
     s = hx * hx + hy * hy + hz * hz
