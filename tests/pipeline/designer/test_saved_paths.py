@@ -21,6 +21,11 @@ def _png(path: Path, value: int) -> Path:
     return path
 
 
+def _roughness_map(root: str, path: str) -> dict:
+    """The edit that drives roughness with the image ``path`` under the picker's ``root``."""
+    return {"op": "set", "target": None, "field": "roughness", "value": _map(root, path)}
+
+
 def _map(root: str, path: str) -> dict:
     return {"texture": {"root": root, "path": path}, "channel": "r", "colorspace": "Raw"}
 
@@ -41,14 +46,7 @@ def test_a_map_picked_on_a_builtin_is_saved_relative_to_the_new_file(designer, u
     image = _png(user_library / "maps" / "rough.png", 90)
     s = designer.session
     assert s.path.parent != user_library  # gold is the built-in preset
-    s.edit(
-        {
-            "op": "set",
-            "target": None,
-            "field": "roughness",
-            "value": _map("library0", "maps/rough.png"),
-        }
-    )
+    s.edit(_roughness_map("library0", "maps/rough.png"))
     path = s.save_new("my_gold")
     written = tomllib.loads(path.read_text())["params"]["roughness"]["texture"]
     assert written == "maps/rough.png"
@@ -60,9 +58,7 @@ def test_a_map_picked_on_a_builtin_is_saved_relative_to_the_new_file(designer, u
 def test_save_as_new_into_a_subfolder_rebases_the_path(designer, user_library, cli):
     image = _png(user_library / "rough.png", 90)
     s = designer.session
-    s.edit(
-        {"op": "set", "target": None, "field": "roughness", "value": _map("library0", "rough.png")}
-    )
+    s.edit(_roughness_map("library0", "rough.png"))
     path = s.save_new("deep_gold", user_library / "metals" / "warm")
     written = tomllib.loads(path.read_text())["params"]["roughness"]["texture"]
     assert written == "../../rough.png"
@@ -73,14 +69,7 @@ def test_save_as_new_into_a_subfolder_rebases_the_path(designer, user_library, c
 def test_a_map_in_the_session_folder_is_copied_beside_the_preset(designer, user_library, cli):
     picked = _png(designer.folder / "exports" / "rough.png", 120)
     s = designer.session
-    s.edit(
-        {
-            "op": "set",
-            "target": None,
-            "field": "roughness",
-            "value": _map("session", "exports/rough.png"),
-        }
-    )
+    s.edit(_roughness_map("session", "exports/rough.png"))
     path = s.save_new("copied_gold")
     written = tomllib.loads(path.read_text())["params"]["roughness"]["texture"]
     copy = _lands(path, written)
@@ -96,9 +85,7 @@ def test_a_copy_never_replaces_another_image(designer, user_library):
     _png(user_library / "rough.png", 10)  # the library's own, different image
     _png(designer.folder / "rough.png", 200)
     s = designer.session
-    s.edit(
-        {"op": "set", "target": None, "field": "roughness", "value": _map("session", "rough.png")}
-    )
+    s.edit(_roughness_map("session", "rough.png"))
     path = s.save_new("second")
     written = tomllib.loads(path.read_text())["params"]["roughness"]["texture"]
     assert written != "rough.png"
@@ -127,16 +114,12 @@ def test_save_over_a_user_preset_in_a_subfolder(designer, user_library, cli):
     session_image = _png(designer.folder / "spots.png", 30)
     s = designer.session
     path = s.save_new("mine", user_library / "sub")
-    s.edit(
-        {"op": "set", "target": None, "field": "roughness", "value": _map("library0", "rough.png")}
-    )
+    s.edit(_roughness_map("library0", "rough.png"))
     assert s.save_over() == path
     written = tomllib.loads(path.read_text())["params"]["roughness"]["texture"]
     assert written == "../rough.png" and _lands(path, written) == Path(os.path.realpath(image))
     _check_resolves(cli, user_library, "mine", image)
-    s.edit(
-        {"op": "set", "target": None, "field": "roughness", "value": _map("session", "spots.png")}
-    )
+    s.edit(_roughness_map("session", "spots.png"))
     s.save_over()
     written = tomllib.loads(path.read_text())["params"]["roughness"]["texture"]
     assert written == "spots.png"
@@ -150,9 +133,7 @@ def test_a_refused_save_leaves_no_copy(designer, user_library):
     s = designer.session
     s.save_new("taken")
     s.open("gold")
-    s.edit(
-        {"op": "set", "target": None, "field": "roughness", "value": _map("session", "rough.png")}
-    )
+    s.edit(_roughness_map("session", "rough.png"))
     with pytest.raises(LibraryError, match="already exists"):
         s.save_new("taken")
     assert list(user_library.glob("*.png")) == []
@@ -161,7 +142,7 @@ def test_a_refused_save_leaves_no_copy(designer, user_library):
 def test_the_save_response_says_what_was_copied(client, designer):
     _png(designer.folder / "rough.png", 120)
     t = designer.token
-    op = {"op": "set", "target": None, "field": "roughness", "value": _map("session", "rough.png")}
+    op = _roughness_map("session", "rough.png")
     r = client.post(f"/{t}/api/edit", json=op)
     assert r.status_code == 200, r.text
     r = client.post(f"/{t}/api/save", json={"mode": "new", "name": "from_page"})
@@ -177,9 +158,7 @@ def test_an_image_of_another_library_is_copied_into_the_one_saved_to(user_librar
     image = _png(other / "rough.png", 70)
     library = Library([user_library, other], use_env=False)
     s = Session(library, "gold", roots=Roots({"library0": user_library, "library1": other}))
-    s.edit(
-        {"op": "set", "target": None, "field": "roughness", "value": _map("library1", "rough.png")}
-    )
+    s.edit(_roughness_map("library1", "rough.png"))
     path = s.save_new("borrowed")
     assert path.parent == user_library
     written = tomllib.loads(path.read_text())["params"]["roughness"]["texture"]
@@ -193,7 +172,7 @@ def test_save_over_from_the_page_says_what_was_copied(client, designer, user_lib
     assert (
         client.post(f"/{t}/api/save", json={"mode": "new", "name": "mine"}).json()["copied"] == []
     )
-    op = {"op": "set", "target": None, "field": "roughness", "value": _map("session", "spots.png")}
+    op = _roughness_map("session", "spots.png")
     assert client.post(f"/{t}/api/edit", json=op).status_code == 200
     r = client.post(f"/{t}/api/save", json={"mode": "over"})
     assert r.status_code == 200, r.text
