@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import contextlib
 import errno
-import hashlib
 import json
 import os
 import re
@@ -357,6 +356,8 @@ def index_file(folder: Path) -> Path:
 
 
 def read_only_index_file(folder: Path) -> Path:
+    import hashlib  # only for a read-only library: a writable one keeps its index inside
+
     key = hashlib.sha256(os.fsencode(os.path.realpath(folder))).hexdigest()[:32]
     return files.cache_root() / "index" / f"{key}.json"
 

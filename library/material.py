@@ -29,7 +29,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from lookdev.materials.layers import CombineMask, ConstantMask, Mask, TextureMask, map_textures
 from lookdev.materials.openpbr_params import OpenPBRParams
 from lookdev.materials.params import DisneyParams
-from lookdev.materials.pixar import PixarParams
+from lookdev.materials.pixar_params import PixarParams
 from lookdev.materials.textures import UDIM_TOKEN, TextureInput, is_texture_input
 
 from .errors import PresetError, PresetNotFoundError, TextureError

@@ -124,6 +124,18 @@ class PresetFile(BaseModel):
         return self
 
 
+def references_files(preset: PresetFile) -> bool:
+    """True when resolving ``preset`` reads a file besides its own: a parent, a layer's
+    preset, a texture set, a height map or a parameter's texture."""
+    return bool(
+        preset.extends is not None
+        or preset.layers
+        or preset.textures is not None
+        or preset.height is not None
+        or any(is_texture_input(v) for v in preset.params.values())
+    )
+
+
 def parse_preset(data: bytes, *, where: str, stem: str | None = None) -> PresetFile:
     """Parse and check one preset file's bytes; every problem is one :class:`PresetError`.
 

@@ -19,9 +19,8 @@ the light and the half vector).
 
 from __future__ import annotations
 
+import math
 from typing import Any
-
-import numpy as np
 
 __all__ = [
     "ETA_MAX",
@@ -52,11 +51,6 @@ The clamp is 17 float32 ulps below 1, so a float32 backend keeps it below 1 as w
 2012 BRDF (0.08·specular, up to 1) is not clamped: only the IOR needs this."""
 
 
-def _np_float(out: Any, given: Any) -> Any:
-    """A Python float where a Python scalar came in, else the array as computed."""
-    return float(out) if np.ndim(out) == 0 and not isinstance(given, np.ndarray) else out
-
-
 def f0_to_ior(f0: Any, xp: Any = None) -> Any:
     """Relative IOR η whose normal-incidence reflectance is ``f0``: η = (1 + √F0)/(1 − √F0).
 
@@ -68,9 +62,18 @@ def f0_to_ior(f0: Any, xp: Any = None) -> Any:
     >>> f0_to_ior(0.0), round(f0_to_ior(0.04), 12), round(f0_to_ior(1.0) / 1e6, 3)
     (1.0, 1.5, 4.0)
     """
-    ops = np if xp is None else xp
-    r = ops.sqrt(ops.minimum(f0, F0_MAX))
-    return _np_float((1.0 + r) / (1.0 - r), f0) if xp is None else (1.0 + r) / (1.0 - r)
+    if xp is None and isinstance(f0, int | float):
+        # a preset's scalar, checked without numpy (math.sqrt is correctly rounded as numpy's is)
+        r = math.sqrt(min(f0, F0_MAX))
+        return (1.0 + r) / (1.0 - r)
+    if xp is not None:
+        r = xp.sqrt(xp.minimum(f0, F0_MAX))
+        return (1.0 + r) / (1.0 - r)
+    import numpy as np
+
+    r = np.sqrt(np.minimum(f0, F0_MAX))
+    out = (1.0 + r) / (1.0 - r)
+    return float(out) if np.ndim(out) == 0 and not isinstance(f0, np.ndarray) else out
 
 
 ETA_MAX = f0_to_ior(F0_MAX)

@@ -33,7 +33,7 @@ holds an imported OpenPBR material as itself."""
 
 PARAMS: dict[str, str] = {
     "disney": "params:DisneyParams",
-    "pixar": "pixar:PixarParams",
+    "pixar": "pixar_params:PixarParams",
     "openpbr": "openpbr_params:OpenPBRParams",
 }
 """Each preset model → ``module:class`` of its parameter schema (the model's

@@ -26,12 +26,14 @@ from __future__ import annotations
 
 import math
 from functools import cache
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
-import numpy as np
 from pydantic import BeforeValidator, Field
 
 from .params import Params, parse_color
+
+if TYPE_CHECKING:
+    import numpy as np
 
 __all__ = [
     "NOT_MODELLED",
@@ -159,6 +161,8 @@ def f82_tint(xp: Any, f0: Any, tint: Any, mu: Any) -> Any:
 
 def _fon(sigma: float, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
     """Fujii's Oren–Nayar f·π/ρ (without the compensation) for unit upper directions."""
+    import numpy as np  # tables only: a preset's check imports no numpy
+
     a = 1.0 / (1.0 + (math.pi / 2.0 - 2.0 / 3.0) * sigma)
     b = sigma * a
     mu_i, mu_o = wi[..., 2], wo[..., 2]
@@ -175,6 +179,8 @@ EON_SIGMA = 17
 def eon_table() -> np.ndarray:
     """Ê_ON(μ, σ) = ∫ f_ON cos θi dωi /ρ on μ nodes ``linspace(0, 1, EON_MU)`` (columns) and
     σ nodes ``linspace(0, 1, EON_SIGMA)`` (rows), by Gauss–Legendre quadrature."""
+    import numpy as np
+
     x, w = np.polynomial.legendre.leggauss(48)
     mu_i = 0.5 * (x + 1.0)
     phi = math.pi * (x + 1.0)
@@ -207,6 +213,8 @@ def eon_albedo(xp: Any, mu: Any, sigma: float) -> Any:
 
 def _eon_average(sigma: float) -> float:
     """⟨Ê_ON⟩ = 2 ∫ Ê_ON(μ) μ dμ (trapezoid on the table's μ nodes)."""
+    import numpy as np
+
     row = np.array([np.interp(sigma, np.linspace(0.0, 1.0, EON_SIGMA), c) for c in eon_table().T])
     mu = np.linspace(0.0, 1.0, EON_MU)
     return float(np.trapezoid(2.0 * row * mu, mu))
@@ -230,6 +238,8 @@ def eon(xp: Any, rho: Any, sigma: float, wi: Any, wo: Any) -> Any:
 @cache
 def fresnel_average(eta: float) -> float:
     """E_F(η) = 2 ∫ F(μ, η) μ dμ of a smooth dielectric seen from outside."""
+    import numpy as np
+
     from . import fresnel
     from .arrays import NumpyOps
 
@@ -255,6 +265,8 @@ def schlick_split_table() -> np.ndarray:
     F0 + (1 − F0)(1 − ωo·h)⁵ reflects F0 (E − B) + B. Rows r = linspace(√ALPHA_MIN, 1),
     columns μ = linspace(0, 1)² (fixed-seed stratified visible-normal sampling, 256 per
     node)."""
+    import numpy as np
+
     from .arrays import NumpyOps
     from .microfacet import ALPHA_MIN, sample_visible_ggx, smith_g1
 

@@ -20,7 +20,6 @@ import math
 import re
 from typing import Annotated, Any, Literal
 
-import numpy as np
 from pydantic import (
     BaseModel,
     BeforeValidator,
@@ -30,7 +29,7 @@ from pydantic import (
     model_validator,
 )
 
-from .colour import PRESET_LINEAR, canonical, convert, decode_hex, settings, working_space
+from .colour_state import PRESET_LINEAR, settings
 from .errors import ParameterError as ParameterError  # re-exported
 from .errors import one_line, register_schema
 from .fresnel import SPECULAR_F0_SCALE, ior_to_specular, specular_to_ior
@@ -57,6 +56,8 @@ def parse_color(value: Any) -> Any:
         m = _HEX.match(value.strip())
         if not m:
             raise ValueError(f"colour {value!r} is neither '#rrggbb' nor [r, g, b]")
+        from .colour import decode_hex  # OCIO decodes it: imported by the presets that need it
+
         return decode_hex(m.group(1))
     if isinstance(value, int | float) and not isinstance(value, bool):
         value = (float(value),) * 3
@@ -73,8 +74,14 @@ def _from_preset_linear(value: Any) -> Any:
     if len(rgb) != 3 or not all(math.isfinite(v) for v in rgb):
         return value
     ws = settings().working_space  # the default: no look-up (this runs for every colour)
-    if ws in ("lin_rec709", PRESET_LINEAR) or canonical(PRESET_LINEAR) == working_space():
+    if ws in ("lin_rec709", PRESET_LINEAR):
         return value  # as written: no float32 round trip
+    import numpy as np  # a conversion's float32 pixels: only for another working space
+
+    from .colour import canonical, convert, working_space
+
+    if canonical(PRESET_LINEAR) == working_space():
+        return value
     out = convert(rgb, PRESET_LINEAR).astype(np.float64)
     # a colour on a range edge stays on it: OCIO's float32 matrix may land an ulp outside
     edge = np.clip(out, 0.0, 1.0)

@@ -21,15 +21,16 @@ from __future__ import annotations
 import math
 import types
 import typing
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
-import numpy as np
 from annotated_types import Ge, Gt, Le
 from pydantic import Field, model_validator
 
-from . import colour
 from .layers import UV, Wrap, check_texture_reference
 from .params import Params
+
+if TYPE_CHECKING:
+    import numpy as np
 
 __all__ = [
     "UDIM_TOKEN",
@@ -112,10 +113,15 @@ def apply_rule(
 ) -> np.ndarray:
     """``clamp(remap(convert(texels))·scale + offset)`` (the module doc's value rule).
 
+    >>> import numpy as np
     >>> t = TextureInput(texture="r.png", range=(0.2, 0.6), scale=0.5)
     >>> apply_rule(t, np.array([[0.4]]), "Raw", (0.0, 1.0)).tolist()
     [[0.25]]
     """
+    import numpy as np  # only when maps are read: a preset's check imports no numpy
+
+    from . import colour
+
     a = np.asarray(texels, dtype=np.float32)
     if a.shape[-1:] == (3,) and not colour.is_data(space):
         a = colour.convert(a, space)

@@ -145,7 +145,7 @@ def show(
     preset = read_preset(path)
     explicit = name.endswith(".toml")
     others = [] if explicit else [p for p in lib.definitions(preset.name) if p != path]
-    material = lib.load_file(path) if resolved else _textures_checked(lib, path)
+    material = lib.load_file(path) if resolved else _textures_checked(lib, preset, path)
     links = lib.read_through(path)
     if as_json:
         doc: dict[str, Any] = {
@@ -183,14 +183,18 @@ def show(
         print_resolved(material)
 
 
-def _textures_checked(lib: Library, path: Path) -> None:
+def _textures_checked(lib: Library, preset: Any, path: Path) -> None:
     """Check the textures a preset drives parameters with (files, tiles, channels, colour
     spaces, ranges) even when it is shown as written: a bad map is one line and exit 2
     here as in `proof` and `export`. Other problems of resolving (a missing parent) are
-    left to --resolved, so a preset can still be shown as written."""
+    left to --resolved, so a preset can still be shown as written. A preset that names
+    neither a texture nor another preset has none to check, and is not resolved."""
     from lookdev.library.errors import TextureError
+    from lookdev.library.preset import references_files
     from lookdev.materials.errors import LookdevError
 
+    if not references_files(preset):
+        return
     try:
         lib.load_file(path)
     except TextureError:

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from rich.table import Table
-
 from .common import console, table
 
 if TYPE_CHECKING:  # listing presets reads headers only: no materials imported for it
+    from rich.table import Table
+
     from lookdev.library import Material
 
 __all__ = ["material_json", "print_resolved", "text_table"]
@@ -16,6 +16,8 @@ __all__ = ["material_json", "print_resolved", "text_table"]
 
 def text_table(title: str, columns: list[str], rows: list[list[str]]) -> Table:
     """A Rich table of text columns: left-aligned, names never wrapped."""
+    from rich.table import Table
+
     t = Table(title=title, title_justify="left")
     for c in columns:
         t.add_column(c, no_wrap=c in ("name", "model"), ratio={"tags": 1, "description": 2}.get(c))

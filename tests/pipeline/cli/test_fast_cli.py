@@ -68,9 +68,19 @@ def test_presets_list_reads_headers_without_the_models_or_pydantic():
 
 def test_presets_show_validates_without_the_models_the_image_reader_or_a_renderer():
     modules = loaded("presets", "show", "gold")
-    unwanted = ("mitsuba", "drjit", "pxr", "matplotlib", "OpenImageIO", "lookdev.pipeline.bench")
-    assert heavy(modules, unwanted + MODEL_MODULES + ("lookdev.materials.registry",)) == []
+    # a preset's check is its schemas: array code, colour conversion and the models'
+    # evaluation come in only for a colour to convert or a map to read
+    unwanted = HEAVY + MODEL_MODULES + ("lookdev.materials.pixar", "lookdev.materials.registry")
+    assert heavy(modules, unwanted + ("lookdev.pipeline.bench", "lookdev.materials.colour")) == []
     assert "lookdev.materials.params" in modules  # it was validated
+    assert heavy(modules, ("rich",)) == []  # piped: the file as plain TOML, no Rich
+    # NAME is a plain str: Typer's pydantic coercion of it would be a no-op (lazy.py)
+    assert "typer._adapters" not in modules
+
+
+def test_presets_show_of_a_textured_preset_still_reads_its_maps():
+    modules = loaded("presets", "show", "rusty_iron")
+    assert "lookdev.library.material" in modules  # resolved, so its maps were checked
 
 
 def test_presets_show_loads_no_renderer_no_usd_and_no_benchmark():
