@@ -125,11 +125,11 @@ def transmission(
 
 
 def smith_denominator(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any) -> Any:
-    """dᵢ dₒ of G1(wi) G1(wo)/(|cos θi| cos θo) = 4/(dᵢ dₒ) of the solid glass (wi below,
+    """dᵢ dₒ of G1(wi) G1(wo)/(−cos θi cos θo) = 4/(dᵢ dₒ) of the solid glass (wi below,
     wo up; :func:`~.microfacet.g1_pair_denominator`), written as the specular reflection
     writes its own (:func:`.disney._reflection_terms`: the same z² and :func:`projected`,
-    |cos θi| for wi): where the two α agree the kernel takes G's square roots once for
-    both, and the BTDF divides by it in its own one division."""
+    the absolute cos θi for wi): where the two α agree the kernel takes G's square roots
+    once for both, and the BTDF divides by it in its own one division."""
     zi2, zo2 = wi[2] * wi[2], wo[2] * wo[2]
     qi, qo = projected(pr, wi, zi2, transmitted=True), projected(pr, wo, zo2, transmitted=True)
     return mf.g1_pair_denominator(xp, xp.abs(wi[2]), qi, xp.maximum(wo[2], 0.0), qo, zi2, zo2)
