@@ -170,12 +170,18 @@ def _masked(xp: Any, cond: Any, x: Any) -> Any:
     return x * cond if isinstance(xp, NumpyOps) else xp.select(cond, x, 0.0)
 
 
-def _reflection_terms(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any) -> list:
-    """(colour or None, scalar) pairs summing to the reflection lobes, masked to wi, wo up.
+def _reflection_terms(
+    xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any, t_cos: Any = None
+) -> tuple[list, Any]:
+    """(colour or None, scalar) pairs summing to the reflection lobes, masked to wi, wo up,
+    and the exact Fresnel term of the glass's reflection (None without one).
 
     Scalars carry every per-direction factor and colours are constants (or per-element
     maps), so each lobe costs one colour product. The half vector is h = wi + wo,
-    unnormalised: |h|² = 4 cos²θd and D is homogeneous in h.
+    unnormalised: |h|² = 4 cos²θd and D is homogeneous in h. ``t_cos``: wo·h of the
+    glass's transmission, where wi is below; the exact Fresnel is then taken there
+    instead of at θd, so that one call serves the lanes of both lobes (a pair either
+    reflects or transmits).
     """
     lobes = pr.lobes
     up = (wi[2] > 0.0) & (wo[2] > 0.0)
@@ -189,11 +195,13 @@ def _reflection_terms(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any)
     cos_d = xp.sqrt(cos2_d)
     w = fr.schlick_weight(xp, cos_d)
     # z² of the directions themselves (= the clamped cosines' squares wherever a lobe is
-    # kept): the glass's BTDF takes the same Smith terms (:func:`.disney_interface.smith`),
-    # so the kernel computes their square roots once for both sides.
+    # kept): the glass's BTDF takes the same Smith terms
+    # (:func:`.disney_interface.smith_denominator`), so the kernel computes their square
+    # roots once for both sides.
     zi2, zo2 = wi[2] * wi[2], wo[2] * wo[2]
     scale = _base_scale(xp, pr, ci, co)
     terms = []
+    f_exact = None
     if "specular" in lobes and "specular" not in pr.delta:
         if pr.ggx:
             qi, qo = projected(pr, wi, zi2), projected(pr, wo, zo2)
@@ -217,7 +225,11 @@ def _reflection_terms(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any)
             terms += [(a * spec_scale, dg_out), ((b - a) * spec_scale, dg_out * w)]
         if not xp.known_zero(c):
             # The glass reflects the exact Fresnel on either side; inside, nothing else does.
-            f_exact = fr.dielectric(xp, cos_d, etap(xp, pr, front), inv_etap(xp, pr, front))
+            # wo·h > 0 too: h is 0/0 at wi = −wo with η = 1, and no NaN may reach the
+            # reflection's masked product (the BTDF is 0 there: it needs wo·h > 0 itself).
+            below = None if t_cos is None else (wi[2] < 0.0) & (t_cos > 0.0)
+            cos = cos_d if below is None else xp.select(below, t_cos, cos_d)
+            f_exact = fr.dielectric(xp, cos, etap(xp, pr, front), inv_etap(xp, pr, front))
             k = f_exact * dg * pick(xp, front, c, pr.glass)
             terms.append((None if isinstance(spec_scale, float) else spec_scale, k))
     if "diffuse" in lobes:
@@ -243,14 +255,20 @@ def _reflection_terms(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any)
         # Burley's clearcoat keeps the 1/(4 cos cos) that Schutte and Mitsuba leave out.
         k = times((0.25 * pr.clearcoat) * f * d * g, front)
         terms.append((None, xp.select(up, k, 0.0)))  # D is 0/0 at wi = −wo: a true select
-    return terms
+    return terms, f_exact
 
 
 # -- the model's four core functions -------------------------------------------------------
 def _eval_oriented(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any) -> Any:
-    terms = _reflection_terms(xp, pr, wi, wo, front)
     lobes = pr.lobes
     glossy_t = "spec_trans" in lobes and "spec_trans" not in pr.delta
+    # A solid glass reflects and transmits with the exact Fresnel at the same η, at θd or
+    # at its refracted microfacet: one call for both (see _reflection_terms).
+    ht = t_cos = None
+    if glossy_t and not pr.thin and "specular" in lobes and "specular" not in pr.delta:
+        ht = mf.transmission_half(xp, wi, wo, etap(xp, pr, front))
+        t_cos = xp.dot(wo, ht)
+    terms, f_exact = _reflection_terms(xp, pr, wi, wo, front, t_cos)
     if "diff_trans" in lobes or glossy_t:
         down = (wi[2] < 0.0) & (wo[2] > 0.0)
         t = pr.diff_trans * INV_PI if "diff_trans" in lobes else 0.0
@@ -261,7 +279,8 @@ def _eval_oriented(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any) ->
             t = t * (1.0 - 0.5 * fr.schlick_weight(xp, -wi[2]))
             t = t * (1.0 - 0.5 * fr.schlick_weight(xp, wo[2]))
         if glossy_t:
-            t = t + pr.glass * transmission(xp, pr, wi, wo, front, pdf=False)
+            f_t = None if t_cos is None else f_exact  # None: no exact reflection to share
+            t = t + pr.glass * transmission(xp, pr, wi, wo, front, False, ht, f_t)
         terms.append((pr.trans_color, xp.select(down, t, 0.0)))
     grey = [s for c, s in terms if c is None]
     f = xp.zeros(wi[2]) * pr.base if not grey else None

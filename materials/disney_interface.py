@@ -45,7 +45,7 @@ __all__ = [
     "pick",
     "projected",
     "sample_interface",
-    "smith",
+    "smith_denominator",
     "specular_d",
     "split",
     "transmission",
@@ -92,8 +92,21 @@ def inv_etap(xp: Any, pr: DisneyPrepared, front: Any) -> Any:
     return pick(xp, front, 1.0 / pr.eta, pr.eta)
 
 
-def transmission(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any, pdf: bool) -> Any:
-    """f (without weight and colour) of the glossy transmission, or its lobe pdf; wi below."""
+def transmission(
+    xp: Any,
+    pr: DisneyPrepared,
+    wi: Any,
+    wo: Any,
+    front: Any,
+    pdf: bool,
+    h: Any = None,
+    fresnel: Any = None,
+) -> Any:
+    """f (without weight and colour) of the glossy transmission, or its lobe pdf; wi below.
+
+    A solid's caller may pass its generalised half vector ``h``
+    (:func:`~.microfacet.transmission_half` at :func:`etap`) and the Fresnel term at it
+    (:func:`~.microfacet.dielectric_btdf`'s ``fresnel``)."""
     ax, ay = pr.tax, pr.tay
     if pr.thin:
         # Schutte: reflection about the rougher thin α, mirrored through the sheet.
@@ -105,18 +118,21 @@ def transmission(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any, front: Any, pdf:
         g = mf.g1_pair_over_cos(xp, wm[2], _qt(pr, wm), wo[2], _qt(pr, wo))
         return (1.0 - fr.dielectric(xp, oh, pr.eta)) * mf.ggx_d(xp, h, ax, ay) * g * 0.25
     e, inv = etap(xp, pr, front), inv_etap(xp, pr, front)
-    g = None if pdf else smith(xp, pr, wi, wo)
-    return mf.dielectric_btdf(xp, wi, wo, e, ax, ay, pdf, inv_eta=inv, g=g)
+    g_den = None if pdf else smith_denominator(xp, pr, wi, wo)
+    return mf.dielectric_btdf(
+        xp, wi, wo, e, ax, ay, pdf, h=h, inv_eta=inv, fresnel=fresnel, g_den=g_den
+    )
 
 
-def smith(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any) -> Any:
-    """G1(wi) G1(wo)/(|cos θi| cos θo) of the solid glass (wi below, wo up), written as
-    the specular reflection writes its own (:func:`.disney._reflection_terms`: the same z²
-    and :func:`projected`, |cos θi| for wi): where the two α agree the kernel takes G's
-    square roots once for both."""
+def smith_denominator(xp: Any, pr: DisneyPrepared, wi: Any, wo: Any) -> Any:
+    """dᵢ dₒ of G1(wi) G1(wo)/(−cos θi cos θo) = 4/(dᵢ dₒ) of the solid glass (wi below,
+    wo up; :func:`~.microfacet.g1_pair_denominator`), written as the specular reflection
+    writes its own (:func:`.disney._reflection_terms`: the same z² and :func:`projected`,
+    the absolute cos θi for wi): where the two α agree the kernel takes G's square roots
+    once for both, and the BTDF divides by it in its own one division."""
     zi2, zo2 = wi[2] * wi[2], wo[2] * wo[2]
     qi, qo = projected(pr, wi, zi2, transmitted=True), projected(pr, wo, zo2, transmitted=True)
-    return mf.g1_pair_over_cos(xp, xp.abs(wi[2]), qi, xp.maximum(wo[2], 0.0), qo, zi2, zo2)
+    return mf.g1_pair_denominator(xp, xp.abs(wi[2]), qi, xp.maximum(wo[2], 0.0), qo, zi2, zo2)
 
 
 def specular_d(xp: Any, pr: DisneyPrepared, h: Any, h2: Any) -> Any:

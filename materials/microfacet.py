@@ -397,6 +397,8 @@ def dielectric_btdf(
     h: Any = None,
     inv_eta: Any = None,
     g: Any = None,
+    fresnel: Any = None,
+    g_den: Any = None,
 ) -> Any:
     """Rough dielectric transmission (Walter et al. 2007 eq. 21; pbrt-v4 DielectricBxDF).
 
@@ -407,7 +409,9 @@ def dielectric_btdf(
     ``h``: :func:`transmission_half` of (wi, wo), when the caller has it already;
     ``inv_eta``: 1/η, when the caller has it without a division (:func:`.fresnel.dielectric`);
     ``g``: G1(wi) G1(wo)/(|cos θi| cos θo) (:func:`g1_pair_over_cos`), when the caller
-    shares its terms with a reflection lobe.
+    shares its terms with a reflection lobe, or ``g_den``, its denominator dᵢ dₒ
+    (:func:`g1_pair_denominator`), which then joins the one division; ``fresnel``:
+    F(wo·h, η) (:func:`.fresnel.dielectric`), when the caller has it (wherever ``ok``).
     """
     inv_eta = 1.0 / eta if inv_eta is None else inv_eta
     h = transmission_half(xp, wi, wo, eta) if h is None else h
@@ -417,14 +421,17 @@ def dielectric_btdf(
     denom2 = xp.maximum(denom * denom, xp.tiny)
     if pdf:
         return xp.select(ok, visible_ggx_pdf(xp, wo, h, ax, ay) * xp.abs(ih) / denom2, 0.0)
-    if g is None:
+    if g is None and g_den is None:
         qi, qo = projected_roughness(wi, ax, ay), projected_roughness(wo, ax, ay)
         g = g1_pair_over_cos(xp, -wi[2], qi, wo[2], qo)
-    f = (1.0 - fr.dielectric(xp, oh, eta, inv_eta)) * g * xp.abs(ih * oh) * (inv_eta * inv_eta)
+    if fresnel is None:
+        fresnel = fr.dielectric(xp, oh, eta, inv_eta)
+    f = (1.0 - fresnel) * (4.0 if g_den is not None else g) * xp.abs(ih * oh) * (inv_eta * inv_eta)
     # h is a unit vector, so D = 1/denominator, and that denominator is ≥ 0.01·π αx αy
     # (α ≤ 3.2): where ``ok``, h ≠ 0 and denom² = |wi η + wo|²/η² > 0, so one division
-    # by the product serves both.
-    return xp.select(ok, f / (denom2 * ggx_d_denominator(xp, h, ax, ay)), 0.0)
+    # by the product serves both (and G's, each of its d ≥ 10⁻⁶: the product stays normal).
+    den = denom2 * ggx_d_denominator(xp, h, ax, ay)
+    return xp.select(ok, f / (den if g_den is None else den * g_den), 0.0)
 
 
 def reflect(xp: Any, w: Any, h: Any) -> Any:

@@ -19,7 +19,10 @@ over :data:`PARAM_SETS` (eight materials that between them switch on every lobe)
   whose pruned constant-parameter form is smaller than ``principled``'s general one;
   target ``ratio_drjit_frozen_to_mitsuba`` ≥ 1.5);
 - ``mitsuba``: the C++ ``principled`` plugin with the nearest parameters (see
-  :func:`principled_dict`; the two models differ where :doc:`/design` says), same pairs.
+  :func:`principled_dict`; the two models differ where :doc:`/design` says), same pairs,
+  traced by its C++ in every call; and ``mitsuba_frozen``, the same call frozen, so that
+  ``ratio_drjit_frozen_to_mitsuba_frozen`` compares replayed kernel with replayed kernel
+  (``frozen_max_rel_diff``: the replays against the traced calls).
 
 Reported: evaluations per second of each, per material too (``by_material``: each form's
 rate and its ratio to ``principled`` on that material), and the throughput ratios
@@ -241,13 +244,28 @@ def _drjit_runner(wi: np.ndarray, wo: np.ndarray, mode: str = "prepared"):
     model = disney.MODEL
     parts = [(_vectors(mi, wi[s]), _vectors(mi, wo[s])) for s in _split(len(wi))]
     dr.eval(parts)
+    each_call = mode == "prepare_each_call"
     runners = []
     for params, (a, b) in zip(PARAM_SETS.values(), parts, strict=True):
         prepared = model.prepare(xp, params)
 
-        def call(a: Any, b: Any, params: Any = params, prepared: Any = prepared) -> Any:
-            pr = model.prepare(xp, params) if mode == "prepare_each_call" else prepared
-            return model.eval(xp, pr, a, b)
+        # Everything the call needs is bound here, none of it in a closure: dr.freeze keys
+        # every replay on its function's closure, and a Model there is walked field by
+        # field down to its lobe table (six records of nine strings, tuples and flags:
+        # ≈ 50 µs a call, measured), Python work of how the harness holds the model, not
+        # of evaluating it; functions and prepared constants bound as defaults cost none.
+        def call(
+            a: Any,
+            b: Any,
+            params: Any = params,
+            prepared: Any = prepared,
+            prepare: Any = model.prepare,
+            evaluate: Any = model.eval,
+            xp: Any = xp,
+            each_call: bool = each_call,
+        ) -> Any:
+            pr = prepare(xp, params) if each_call else prepared
+            return evaluate(xp, pr, a, b)
 
         fn = dr.freeze(call) if mode == "frozen" else call
 
@@ -261,21 +279,34 @@ def _drjit_runner(wi: np.ndarray, wo: np.ndarray, mode: str = "prepared"):
     return runners
 
 
-def _mitsuba_runner(wi: np.ndarray, wo: np.ndarray):
+def _mitsuba_runner(wi: np.ndarray, wo: np.ndarray, frozen: bool = False):
+    """Per-material callables of ``principled``'s ``eval``, traced by its C++ in every
+    call as a plugin's user calls it, or (``frozen``) recorded once by ``dr.freeze`` and
+    replayed like ``drjit_frozen``: the same kernel without the tracing, so that the two
+    frozen forms compare kernel with kernel. The BSDF is the frozen call's argument (its
+    parameters are variables ``dr.freeze`` must see), one frozen function per material
+    (which lobes ``principled`` evaluates is decided when it is loaded, outside what
+    ``dr.freeze`` keys on); the interaction is made inside the call, zeros but for ``wi``.
+    """
     import drjit as dr
     import mitsuba as mi
 
     ctx = mi.BSDFContext()
+
+    def call(bsdf: Any, v: Any, w: Any) -> Any:
+        si = dr.zeros(mi.SurfaceInteraction3f, dr.width(v))
+        si.wi = v
+        return bsdf.eval(ctx, si, w)
+
     runners = []
     for p, s in zip(PARAM_SETS.values(), _split(len(wi)), strict=True):
         bsdf = mi.load_dict(principled_dict(p))
-        si = dr.zeros(mi.SurfaceInteraction3f, s.stop - s.start)
-        si.wi = _vectors(mi, wo[s])
-        w = _vectors(mi, wi[s])
-        dr.eval(si, w)
+        v, w = _vectors(mi, wo[s]), _vectors(mi, wi[s])
+        dr.eval(v, w)
+        fn = dr.freeze(call) if frozen else call
 
-        def run(bsdf: Any = bsdf, si: Any = si, w: Any = w) -> Any:
-            out = bsdf.eval(ctx, si, w)
+        def run(fn: Any = fn, bsdf: Any = bsdf, v: Any = v, w: Any = w) -> Any:
+            out = fn(bsdf, v, w)
             dr.eval(out)
             dr.sync_thread()
             return out
@@ -304,8 +335,8 @@ def run(n: int = 1_000_000, *, repeat: int = 5, progress: Any = None) -> dict[st
     """Every figure of the benchmark (see the module docstring).
 
     The backends are timed in CPU seconds in interleaved rounds (each once per round,
-    best of ``repeat`` rounds kept), so a change in machine load between them skews no
-    ratio;
+    best of ``repeat`` rounds kept, the Dr.Jit and Mitsuba forms in an order that rotates
+    from round to round), so a change in machine load between them skews no ratio;
     the Dr.Jit forms and Mitsuba are timed material by material, so every material's
     ratio is measured too (the totals are the sums of the materials' best times).
     """
@@ -320,6 +351,7 @@ def run(n: int = 1_000_000, *, repeat: int = 5, progress: Any = None) -> dict[st
     }
     split = {f"drjit_{m}": _drjit_runner(wi, wo, m) for m in DRJIT_MODES}
     split["mitsuba"] = _mitsuba_runner(wi, wo)
+    split["mitsuba_frozen"] = _mitsuba_runner(wi, wo, frozen=True)
     first = {name: _timed(fn) for name, fn in runners.items()}
     first |= {name: _timed(_all(fns)) for name, fns in split.items()}
     for fns in split.values():  # a second call: a frozen function records its replay
@@ -331,9 +363,14 @@ def run(n: int = 1_000_000, *, repeat: int = 5, progress: Any = None) -> dict[st
             progress(round_)
         for name, fn in runners.items():
             best[name] = min(best[name], _timed(fn))
+        # The forms' order rotates from round to round: the first call after the numpy
+        # backends pays ≈ 0.13 ms more, whoever makes it (measured), and no form may
+        # always be the one.
+        names = list(split)
+        names = names[round_ % len(names) :] + names[: round_ % len(names)]
         for k in range(len(PARAM_SETS)):
-            for name, fns in split.items():
-                per[name][k] = min(per[name][k], _timed(fns[k]))
+            for name in names:
+                per[name][k] = min(per[name][k], _timed(split[name][k]))
     for name, times in per.items():
         best[name] = sum(times)
     rate = {k: n / v for k, v in best.items()}
@@ -344,6 +381,10 @@ def run(n: int = 1_000_000, *, repeat: int = 5, progress: Any = None) -> dict[st
             f"ratio_{name}_to_mitsuba": per["mitsuba"][k] / per[name][k]
             for name in split
             if name != "mitsuba"
+        }
+        | {
+            "ratio_drjit_frozen_to_mitsuba_frozen": per["mitsuba_frozen"][k]
+            / per["drjit_frozen"][k]
         }
         for k, material in enumerate(PARAM_SETS)
     }
@@ -358,14 +399,21 @@ def run(n: int = 1_000_000, *, repeat: int = 5, progress: Any = None) -> dict[st
         "evals_per_s_drjit_prepare_each_call": rate["drjit_prepare_each_call"],
         "evals_per_s_drjit_frozen": rate["drjit_frozen"],
         "evals_per_s_mitsuba": rate["mitsuba"],
+        "evals_per_s_mitsuba_frozen": rate["mitsuba_frozen"],
         "drjit_first_call_s": first["drjit_prepared"],
         "drjit_frozen_first_call_s": first["drjit_frozen"],
         "mitsuba_first_call_s": first["mitsuba"],
+        "mitsuba_frozen_first_call_s": first["mitsuba_frozen"],
         "numpy_dtype": numpy_dtype,
         "ratio_drjit_to_mitsuba": rate["drjit_prepared"] / rate["mitsuba"],
         "ratio_drjit_prepare_each_call_to_mitsuba": rate["drjit_prepare_each_call"]
         / rate["mitsuba"],
         "ratio_drjit_frozen_to_mitsuba": rate["drjit_frozen"] / rate["mitsuba"],
+        "ratio_drjit_frozen_to_mitsuba_frozen": rate["drjit_frozen"] / rate["mitsuba_frozen"],
+        "frozen_max_rel_diff": max(
+            _max_rel_diff(_all(split[f"{side}_frozen"]), _all(split[unfrozen]))
+            for side, unfrozen in (("drjit", "drjit_prepared"), ("mitsuba", "mitsuba"))
+        ),
         "ratio_numpy_to_mitsuba": rate[f"numpy_{numpy_dtype}"] / rate["mitsuba"],
         "evals_per_s_numpy_every_lobe": rate["numpy_every_lobe"],
         "ratio_pruned_to_every_lobe": rate["numpy_float32"] / rate["numpy_every_lobe"],
@@ -379,3 +427,9 @@ def run(n: int = 1_000_000, *, repeat: int = 5, progress: Any = None) -> dict[st
 
 def _max_diff(a: Any, b: Any) -> float:
     return float(max(np.max(np.abs(x - y)) for x, y in zip(a(), b(), strict=True)))
+
+
+def _max_rel_diff(a: Any, b: Any) -> float:
+    """:func:`relative_difference` of two Dr.Jit runners' outputs, the largest over the
+    materials: a frozen replay must give what the traced call gives."""
+    return max(relative_difference(np.array(x), np.array(y)) for x, y in zip(a(), b(), strict=True))

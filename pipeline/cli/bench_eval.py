@@ -54,8 +54,20 @@ def eval_(
             "",
         ],
         ["Mitsuba principled", result["evals_per_s_mitsuba"], result["mitsuba_first_call_s"], ""],
+        [
+            "Mitsuba principled, frozen",
+            result["evals_per_s_mitsuba_frozen"],
+            result["mitsuba_frozen_first_call_s"],
+            "",
+        ],
         ["ratio Dr.Jit / Mitsuba", result["ratio_drjit_to_mitsuba"], "", "≥ 0.5"],
         ["ratio Dr.Jit frozen / Mitsuba", result["ratio_drjit_frozen_to_mitsuba"], "", "≥ 1.5"],
+        [
+            "ratio Dr.Jit frozen / Mitsuba frozen",
+            result["ratio_drjit_frozen_to_mitsuba_frozen"],
+            "",
+            "",
+        ],
         [
             f"ratio numpy ({result['numpy_dtype']}) / Mitsuba",
             result["ratio_numpy_to_mitsuba"],

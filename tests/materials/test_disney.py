@@ -570,8 +570,14 @@ def test_bench_eval_prints_one_json_object_with_the_ratios(cli, mitsuba):
     assert r.code == 0, r.err
     out = json.loads(r.out)
     assert out["n"] == 8000 and len(out["materials"]) == 8
-    for key in ("ratio_drjit_to_mitsuba", "ratio_numpy_to_mitsuba", "evals_per_s_mitsuba"):
+    for key in (
+        "ratio_drjit_to_mitsuba",
+        "ratio_numpy_to_mitsuba",
+        "evals_per_s_mitsuba",
+        "ratio_drjit_frozen_to_mitsuba_frozen",
+    ):
         assert out[key] > 0 and math.isfinite(out[key])
+    assert out["frozen_max_rel_diff"] < 1e-5  # a frozen replay computes the traced call
     assert out["numpy_dtype"] in ("float32", "float64")
     assert out["every_lobe_max_abs_diff"] < 1e-6  # pruning changes the cost, not the values
 
