@@ -328,7 +328,7 @@ def author_naive(specs: list[MaterialSpec], base: Path):
     """
     from pxr import Sdf, Usd, UsdGeom, UsdShade
 
-    stage = Usd.Stage.CreateInMemory()
+    stage = Usd.Stage.Open(new_layer())  # the layer metadata the writer's layer starts with
     stage.SetDefaultPrim(UsdGeom.Scope.Define(stage, "/Materials").GetPrim())
     UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
     UsdGeom.SetStageMetersPerUnit(stage, 1.0)
@@ -340,14 +340,14 @@ def author_naive(specs: list[MaterialSpec], base: Path):
         material.GetPrim().SetDocumentation(loss_doc(spec))
         schemas = [COLOUR_SPACE_API]
         material.GetPrim().CreateAttribute(
-            COLOUR_SPACE_ATTR, types["token"], True, Sdf.VariabilityUniform
+            COLOUR_SPACE_ATTR, types["token"], False, Sdf.VariabilityUniform
         ).Set(colour.interop_id())
         mtlx = any(net.context == "mtlx" for net in spec.networks)
         schemas += [MTLX_CONFIG_API] if mtlx else []
         material.GetPrim().SetMetadata("apiSchemas", Sdf.TokenListOp.Create(prependedItems=schemas))
         if mtlx:
             material.GetPrim().CreateAttribute(
-                "config:mtlx:version", types["string"], True, Sdf.VariabilityUniform
+                "config:mtlx:version", types["string"], False, Sdf.VariabilityUniform
             ).Set(mtlx_version())
         note = dcc_loss_note(spec)
         if note is not None:
