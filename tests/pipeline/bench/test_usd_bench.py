@@ -44,6 +44,7 @@ def test_the_floor_creates_exactly_the_specs_the_exporter_authors():
         author_fast,
         author_floor,
         bench_specs,
+        per_material,
         spec_paths,
     )
 
@@ -60,7 +61,7 @@ def test_the_floor_creates_exactly_the_specs_the_exporter_authors():
         return found
 
     fast = author_fast(specs, Path.cwd())
-    floor = author_floor(*spec_paths(specs))
+    floor = author_floor(per_material(*spec_paths(specs)))
     assert every_path(floor) == every_path(fast)
     fast_types = {
         str(p): str(fast.GetAttributeAtPath(p).typeName) for p, _, _ in spec_paths(specs)[1]
