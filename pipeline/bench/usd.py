@@ -111,11 +111,12 @@ def _one_thread(fn):
     from pxr import Work
 
     def run():
+        before = Work.GetConcurrencyLimit()
         Work.SetConcurrencyLimit(1)
         try:
             return fn()
         finally:
-            Work.SetMaximumConcurrencyLimit()
+            Work.SetConcurrencyLimit(before)
 
     return run
 

@@ -199,7 +199,7 @@ def author(layer, specs: list[MaterialSpec], base: Path) -> list[str]:
 
     One ``Sdf.ChangeBlock`` per material, not one around them all: a block's change list
     holds an entry for every spec it made, and one block over 1,000 materials (≈ 50,000
-    entries) took ≈ 1.3× the CPU time of a block each (usd-core 0.26, lookdev bench
+    entries) took 1.2–1.3× the CPU time of a block each (usd-core 0.26, lookdev bench
     usd). The layers written are new, with no stage composed on them, so no block's
     notices recompose anything.
     """
