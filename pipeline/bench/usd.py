@@ -10,9 +10,9 @@ all three render contexts) into an in-memory stage:
   no change block, so every edit notifies and recomposes.
 
 Reported: materials per second of each, ``ratio_fast_to_naive`` (target ≥ 5), the time
-to build the networks (shared by both, not in either figure), whether the two layers hold
-identical specs (``same_layers``), and the whole export as a user runs it (networks,
-authoring, the .usda written): ``end_to_end_materials_per_s``.
+to build the networks (shared by both, not in either figure), whether the two layers are
+the same ``.usda`` text byte for byte (``same_layers``), and the whole export as a user
+runs it (networks, authoring, the .usda written): ``end_to_end_materials_per_s``.
 
 Stability: on a shared machine one timing of each path gave ratios from 1.6× to 3.8×. So
 the paths are timed in *interleaved rounds* (each round: fast, naive, floor, end to end,
@@ -22,16 +22,25 @@ that changes between rounds moves both sides of a ratio together.
 
 Also a floor: the same prim and attribute specs created *empty* (no values, types or
 connections set beyond the attribute's type) with usd-core's cheapest calls,
-``Sdf.JustCreatePrimInLayer`` / ``Sdf.JustCreatePrimAttributeInLayer``, in one change
-block, paths built outside the clock. No authoring from Python can beat it, so
-``ratio_bound = naive_s / floor_s`` is the most any such path could reach over the naive
-reference.
+``Sdf.JustCreatePrimInLayer`` / ``Sdf.JustCreatePrimAttributeInLayer``, a change block
+per material as the writer has, paths built outside the clock. No authoring from Python
+can beat it, so ``ratio_bound = naive_s / floor_s`` is the most any such path could
+reach over the naive reference.
 
 And a second floor, ``floor_set_s``: every value, connection and metadata field the fast
 path writes, read back from its layer outside the clock and written again with the same
-usd-core calls (:func:`author_recorded`), nothing computed in between: what the writer's
-own calls cost, so ``ratio_bound_set = naive_s / floor_set_s`` is the most any writer
-making them could reach, and ``fast_s / floor_set_s`` what lookdev's Python adds.
+usd-core calls in the same change blocks (:func:`author_recorded`), nothing computed in
+between: what the writer's own calls cost, so ``ratio_bound_set = naive_s /
+floor_set_s`` is the most any writer making them could reach, and ``fast_s /
+floor_set_s`` what lookdev's Python adds.
+
+Wall and CPU seconds: the ratios above are of wall time (``perf_counter``), as a user
+waits. The naive path's recompositions run on usd-core's worker threads, so its CPU
+seconds (``time.process_time``, every thread of the process) exceed its wall seconds on
+an idle machine and approach them on a loaded one; ``ratio_fast_to_naive_cpu`` is the
+ratio of CPU seconds. ``naive_one_thread_s`` is the naive path with usd-core limited to
+one worker thread (``Work.SetConcurrencyLimit(1)``), the fast path's condition (it uses
+none): ``ratio_fast_to_naive_one_thread``.
 """
 
 from __future__ import annotations
@@ -78,19 +87,38 @@ __all__ = [
     "author_fast",
     "author_floor",
     "author_naive",
+    "author_recorded",
     "bench_sources",
     "bench_specs",
     "end_to_end",
+    "per_material",
+    "recorded",
     "run",
     "spec_paths",
 ]
 
 
-def _timed(fn) -> float:
+def _timed(fn) -> tuple[float, float]:
+    """Wall and CPU (every thread of the process) seconds of ``fn()``."""
     gc.collect()
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     fn()
-    return time.perf_counter() - t0
+    return time.perf_counter() - t0, time.process_time() - c0
+
+
+def _one_thread(fn):
+    """``fn`` run with usd-core's work dispatcher limited to one thread."""
+    from pxr import Work
+
+    def run():
+        before = Work.GetConcurrencyLimit()
+        Work.SetConcurrencyLimit(1)
+        try:
+            return fn()
+        finally:
+            Work.SetConcurrencyLimit(before)
+
+    return run
 
 
 def _spread(values: list[float]) -> dict[str, float]:
@@ -107,15 +135,17 @@ def run(count: int, *, repeat: int = 5) -> dict[str, Any]:
     specs = bench_specs(count)
     build_s = time.perf_counter() - t0
     base = Path.cwd()
-    prims, attributes = spec_paths(specs)
+    groups = per_material(*spec_paths(specs))
     recording = recorded(author_fast(specs, base))
-    names = ("fast", "naive", "floor", "floor_set", "end_to_end")
+    names = ("fast", "naive", "naive_one_thread", "floor", "floor_set", "end_to_end")
     rounds: dict[str, list[float]] = {k: [] for k in names}
+    cpu: dict[str, list[float]] = {k: [] for k in names}
     with tempfile.TemporaryDirectory(prefix="lookdev-bench-usd-") as tmp:
         jobs = {
             "fast": lambda: author_fast(specs, base),
             "naive": lambda: author_naive(specs, base),
-            "floor": lambda: author_floor(prims, attributes),
+            "naive_one_thread": _one_thread(lambda: author_naive(specs, base)),
+            "floor": lambda: author_floor(groups),
             "floor_set": lambda: author_recorded(recording),
             "end_to_end": lambda: end_to_end(count, Path(tmp)),
         }
@@ -123,7 +153,9 @@ def run(count: int, *, repeat: int = 5) -> dict[str, Any]:
             job()
         for _ in range(max(1, repeat)):
             for name, job in jobs.items():
-                rounds[name].append(_timed(job))
+                wall, seconds = _timed(job)
+                rounds[name].append(wall)
+                cpu[name].append(seconds)
     fast = rounds["fast"]
     ratios = [n / f for n, f in zip(rounds["naive"], fast, strict=True)]
     bounds = [n / f for n, f in zip(rounds["naive"], rounds["floor"], strict=True)]
@@ -134,7 +166,9 @@ def run(count: int, *, repeat: int = 5) -> dict[str, Any]:
     floor_s = statistics.median(rounds["floor"])
     end_to_end_s = statistics.median(rounds["end_to_end"])
     naive_stage = author_naive(specs, base)  # keeps its root layer alive
-    same = _specs_of(author_fast(specs, base)) == _specs_of(naive_stage.GetRootLayer())
+    same = _text(author_fast(specs, base)) == _text(naive_stage.GetRootLayer())
+    cpu_ratios = [n / f for n, f in zip(cpu["naive"], cpu["fast"], strict=True)]
+    one_ratios = [n / f for n, f in zip(rounds["naive_one_thread"], fast, strict=True)]
     ratio = _spread(ratios)
     rate = _spread(rates)
     return {
@@ -150,12 +184,17 @@ def run(count: int, *, repeat: int = 5) -> dict[str, Any]:
         "ratio_fast_to_naive": ratio["median"],
         "ratio_fast_to_naive_min": ratio["min"],
         "ratio_fast_to_naive_max": ratio["max"],
+        "fast_cpu_s": statistics.median(cpu["fast"]),
+        "naive_cpu_s": statistics.median(cpu["naive"]),
+        "ratio_fast_to_naive_cpu": _spread(cpu_ratios)["median"],
+        "naive_one_thread_s": statistics.median(rounds["naive_one_thread"]),
+        "ratio_fast_to_naive_one_thread": _spread(one_ratios)["median"],
         "floor_empty_specs_s": floor_s,
         "ratio_bound": _spread(bounds)["median"],
         "floor_set_s": statistics.median(rounds["floor_set"]),
         "ratio_bound_set": _spread(set_bounds)["median"],
-        "floor_set_same_layers": _specs_of(author_recorded(recording))
-        == _specs_of(author_fast(specs, base)),
+        "floor_set_same_layers": _text(author_recorded(recording))
+        == _text(author_fast(specs, base)),
         "same_layers": same,
         "end_to_end_s": end_to_end_s,
         "end_to_end_materials_per_s": rate["median"],
@@ -244,16 +283,32 @@ def spec_paths(specs: list[MaterialSpec]) -> tuple[list[Any], list[tuple[Any, An
     return prims, attributes
 
 
-def author_floor(prims: list[Any], attributes: list[tuple[Any, Any, Any]]):
-    """The specs at ``prims`` and ``attributes`` created empty: the floor (module doc)."""
+def per_material(prims: list[Any], attributes: list[tuple[Any, ...]]) -> list[tuple[list, list]]:
+    """``prims`` and ``attributes`` (paths, or rows with the path first, as
+    :func:`spec_paths` and :func:`recorded` give them) grouped by the material they belong to, in
+    order; the first group is the scope's."""
+    groups: dict[Any, tuple[list, list]] = {}
+    for rows, at in ((prims, 0), (attributes, 1)):
+        for row in rows:
+            path = row[0] if isinstance(row, tuple) else row
+            prefixes = path.GetPrefixes()
+            key = prefixes[1] if len(prefixes) > 1 else prefixes[0]
+            groups.setdefault(key, ([], []))[at].append(row)
+    return list(groups.values())
+
+
+def author_floor(groups: list[tuple[list[Any], list[tuple[Any, Any, Any]]]]):
+    """The specs of ``groups`` (:func:`per_material` of :func:`spec_paths`) created empty,
+    a change block a material: the floor (module doc)."""
     from pxr import Sdf
 
     layer = Sdf.Layer.CreateAnonymous(".usda")
-    with Sdf.ChangeBlock():
-        for path in prims:
-            Sdf.JustCreatePrimInLayer(layer, path)
-        for path, type_name, variability in attributes:
-            Sdf.JustCreatePrimAttributeInLayer(layer, path, type_name, variability)
+    for prims, attributes in groups:
+        with Sdf.ChangeBlock():
+            for path in prims:
+                Sdf.JustCreatePrimInLayer(layer, path)
+            for path, type_name, variability in attributes:
+                Sdf.JustCreatePrimAttributeInLayer(layer, path, type_name, variability)
     return layer
 
 
@@ -261,10 +316,11 @@ PRIM_FIELDS = ("customData", "documentation", "apiSchemas")
 """The prim metadata the writer sets beyond specifier and type."""
 
 
-def recorded(layer) -> tuple[list[tuple], list[tuple]]:
-    """What :func:`author` wrote into ``layer``, spec by spec, parents first: prims as
-    (path, type, {field: value}), attributes as (path, type, variability, custom,
-    default or None, connections, colour space or None)."""
+def recorded(layer) -> list[tuple[list[tuple], list[tuple]]]:
+    """What :func:`author` wrote into ``layer``, spec by spec, parents first, grouped by
+    material (:func:`per_material`): prims as (path, type, {field: value}), attributes as
+    (path, type, variability, custom, default or None, connections or None, colour
+    space or None)."""
     from pxr import Sdf
 
     prims, attributes = [], []
@@ -280,44 +336,45 @@ def recorded(layer) -> tuple[list[tuple], list[tuple]]:
             space = spec.GetInfo("colorSpace") if spec.HasInfo("colorSpace") else None
             default = spec.default if spec.HasDefaultValue() else None
             attributes.append(
-                (path, spec.typeName, spec.variability, spec.custom, default, links, space)
+                (path, spec.typeName, spec.variability, spec.custom, default, links or None, space)
             )
 
     layer.Traverse(Sdf.Path("/Materials"), visit)
     prims.sort(key=lambda p: p[0].pathElementCount)
-    return prims, attributes
+    return per_material(prims, attributes)
 
 
-def author_recorded(recording: tuple[list[tuple], list[tuple]]):
-    """The recorded specs written again with the writer's calls, in one change block
-    (the second floor, module doc)."""
+def author_recorded(recording: list[tuple[list[tuple], list[tuple]]]):
+    """The recorded specs written again with the writer's calls, a change block a
+    material (the second floor, module doc)."""
     from pxr import Sdf
 
-    prims, attributes = recording
     layer = new_layer()  # as author_fast's, so the layers are byte for byte the same
-    with Sdf.ChangeBlock():
-        made = {}
-        for path, type_name, info in prims:
-            parent = made.get(path.GetParentPath())
-            if parent is None:
-                spec = Sdf.CreatePrimInLayer(layer, path)
-                spec.specifier, spec.typeName = Sdf.SpecifierDef, type_name
-            else:
-                spec = Sdf.PrimSpec(parent, path.name, Sdf.SpecifierDef, type_name)
-            for key, value in info.items():
-                spec.SetInfo(key, value)
-            made[path] = spec
-        for path, type_name, variability, custom, default, links, space in attributes:
-            Sdf.JustCreatePrimAttributeInLayer(layer, path, type_name, variability, custom)
-            if default is None and not links and space is None:
-                continue
-            attr = layer.GetAttributeAtPath(path)
-            if links:
-                attr.connectionPathList.explicitItems = links
-            if default is not None:
-                attr.default = default
-            if space is not None:
-                attr.SetInfo("colorSpace", space)
+    made = {}
+    just, create = Sdf.JustCreatePrimAttributeInLayer, Sdf.CreatePrimAttributeInLayer
+    for prims, attributes in recording:
+        with Sdf.ChangeBlock():
+            for path, type_name, info in prims:
+                parent = made.get(path.GetParentPath())
+                if parent is None:
+                    spec = Sdf.CreatePrimInLayer(layer, path)
+                    spec.specifier, spec.typeName = Sdf.SpecifierDef, type_name
+                else:
+                    spec = Sdf.PrimSpec(parent, path.name, Sdf.SpecifierDef, type_name)
+                for key, value in info.items():
+                    spec.SetInfo(key, value)
+                made[path] = spec
+            for path, type_name, variability, custom, default, links, space in attributes:
+                if default is None and links is None and space is None:
+                    just(layer, path, type_name, variability, custom)
+                    continue
+                attr = create(layer, path, type_name, variability, custom)
+                if links is not None:
+                    attr.connectionPathList.explicitItems = links
+                if default is not None:
+                    attr.default = default
+                if space is not None:
+                    attr.SetInfo("colorSpace", space)
     return layer
 
 
@@ -328,7 +385,7 @@ def author_naive(specs: list[MaterialSpec], base: Path):
     """
     from pxr import Sdf, Usd, UsdGeom, UsdShade
 
-    stage = Usd.Stage.CreateInMemory()
+    stage = Usd.Stage.Open(new_layer())  # the layer metadata the writer's layer starts with
     stage.SetDefaultPrim(UsdGeom.Scope.Define(stage, "/Materials").GetPrim())
     UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
     UsdGeom.SetStageMetersPerUnit(stage, 1.0)
@@ -340,14 +397,14 @@ def author_naive(specs: list[MaterialSpec], base: Path):
         material.GetPrim().SetDocumentation(loss_doc(spec))
         schemas = [COLOUR_SPACE_API]
         material.GetPrim().CreateAttribute(
-            COLOUR_SPACE_ATTR, types["token"], True, Sdf.VariabilityUniform
+            COLOUR_SPACE_ATTR, types["token"], False, Sdf.VariabilityUniform
         ).Set(colour.interop_id())
         mtlx = any(net.context == "mtlx" for net in spec.networks)
         schemas += [MTLX_CONFIG_API] if mtlx else []
         material.GetPrim().SetMetadata("apiSchemas", Sdf.TokenListOp.Create(prependedItems=schemas))
         if mtlx:
             material.GetPrim().CreateAttribute(
-                "config:mtlx:version", types["string"], True, Sdf.VariabilityUniform
+                "config:mtlx:version", types["string"], False, Sdf.VariabilityUniform
             ).Set(mtlx_version())
         note = dcc_loss_note(spec)
         if note is not None:
@@ -391,18 +448,6 @@ def author_naive(specs: list[MaterialSpec], base: Path):
     return stage
 
 
-def _specs_of(layer) -> set[tuple[str, str, str]]:
-    """Every (prim, property, value or connections) of ``layer``: a layout-free digest."""
-    out = set()
-
-    def visit(path) -> None:
-        spec = layer.GetObjectAtPath(path)
-        if path.IsPropertyPath():
-            targets = getattr(spec, "connectionPathList", None)
-            links = (
-                str(list(targets.explicitItems) + list(targets.prependedItems)) if targets else ""
-            )
-            out.add((str(path), str(spec.typeName), f"{spec.default}|{links}"))
-
-    layer.Traverse(layer.pseudoRoot.path, visit)
-    return out
+def _text(layer) -> str:
+    """The layer as ``.usda`` text: two layers are the same when these are, byte for byte."""
+    return layer.ExportToString()

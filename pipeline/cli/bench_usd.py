@@ -60,3 +60,8 @@ def usd_(
         f"them could reach; the fast path takes "
         f"{result['fast_s'] / result['floor_set_s']:.2f}× their time"
     )
+    console.print(
+        f"in CPU seconds (the naive path's usd-core worker threads counted) "
+        f"{result['ratio_fast_to_naive_cpu']:.2f}×; against the naive path limited to one "
+        f"worker thread {result['ratio_fast_to_naive_one_thread']:.2f}×"
+    )

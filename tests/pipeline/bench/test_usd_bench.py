@@ -44,6 +44,7 @@ def test_the_floor_creates_exactly_the_specs_the_exporter_authors():
         author_fast,
         author_floor,
         bench_specs,
+        per_material,
         spec_paths,
     )
 
@@ -60,7 +61,7 @@ def test_the_floor_creates_exactly_the_specs_the_exporter_authors():
         return found
 
     fast = author_fast(specs, Path.cwd())
-    floor = author_floor(*spec_paths(specs))
+    floor = author_floor(per_material(*spec_paths(specs)))
     assert every_path(floor) == every_path(fast)
     fast_types = {
         str(p): str(fast.GetAttributeAtPath(p).typeName) for p, _, _ in spec_paths(specs)[1]
@@ -89,3 +90,17 @@ def test_the_second_floor_writes_the_fast_paths_layer_byte_for_byte():
     layer = author_fast(bench_specs(12), Path.cwd())
     again = author_recorded(recorded(layer))
     assert again.ExportToString() == layer.ExportToString()
+
+
+def test_bench_usd_reports_cpu_seconds_and_the_naive_path_on_one_thread(cli):
+    """The naive path's recompositions use usd-core's worker threads: CPU seconds and the
+    one-thread run are reported beside the wall-time ratio, and the limit is put back."""
+    from pxr import Work
+
+    before = Work.GetConcurrencyLimit()
+    data = json.loads(cli("bench", "usd", "-n", "10", "--repeat", "1", "--json").out)
+    assert Work.GetConcurrencyLimit() == before
+    cpu = data["naive_cpu_s"] / data["fast_cpu_s"]
+    assert data["ratio_fast_to_naive_cpu"] == pytest.approx(cpu)
+    one = data["naive_one_thread_s"] / data["fast_s"]
+    assert data["ratio_fast_to_naive_one_thread"] == pytest.approx(one)
