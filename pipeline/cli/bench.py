@@ -59,6 +59,9 @@ COMMANDS = {
     "subsurface": Lazy(
         ".bench_subsurface:subsurface_", "Path-traced subsurface: thick slabs, furnace, rims, cost."
     ),
+    "targets": Lazy(
+        ".bench_targets:targets_", "The main job's noise target against its CPU and frames met."
+    ),
     "usd": Lazy(
         ".bench_usd:usd_", "N materials into one stage: Sdf-level authoring vs the Usd API."
     ),
