@@ -651,13 +651,16 @@ def _preset_params(values: dict[str, Any], model: str, spelling: str) -> dict:
     return params
 
 
-def import_as_openpbr(path: Path) -> dict[str, Any]:
+def import_as_openpbr(path: Path, refused: list[str] | None = None) -> dict[str, Any]:
     """Material name → :class:`~.reader.Imported` of model ``openpbr`` for every material
     of the USD file ``path`` whose ``mtlx`` surface is an OpenPBR Surface lookdev did not
-    map from a Disney material (those keep their record or their Disney reading)."""
+    map from a Disney material (those keep their record or their Disney reading), or a
+    Standard Surface, read as OpenPBR by MaterialX's translation
+    (:func:`.openpbr_import.openpbr_values`). A material whose values OpenPBR's ranges
+    reject is left out; its refusal line (:func:`refusal`) is appended to ``refused``."""
     from pxr import Usd
 
-    from .openpbr_import import OPENPBR_IDS, params_from_values
+    from .openpbr_import import AS_OPENPBR_IDS, openpbr_values, params_from_values
 
     stage = Usd.Stage.Open(str(path))
     out = {}
@@ -666,17 +669,15 @@ def import_as_openpbr(path: Path) -> dict[str, Any]:
         if net is None:
             continue
         surface = next((n for n in net.nodes if n.name == net.terminal.node), None)
-        if surface is None or surface.id not in OPENPBR_IDS or mapped_from_disney(surface):
+        if surface is None or surface.id not in AS_OPENPBR_IDS or mapped_from_disney(surface):
             continue
-        values, notes = {}, []
-        for name, (_, value) in surface.inputs.items():
-            value = plain_value(value)
-            if isinstance(value, Connection):
-                notes.append(f"mtlx: {name} is a connected network (not imported): its default")
-                continue
-            values[name] = tuple(value) if isinstance(value, tuple | list) else value
-        values.pop("geometry_normal", None)
-        params, more = params_from_values(values, f"{path}: material {spec.name!r}")
+        values, notes = openpbr_values(surface)
+        try:
+            params, more = params_from_values(values, f"{path}: material {spec.name!r}")
+        except LookdevError as exc:
+            if refused is not None:
+                refused.append(refusal(spec.custom.get(PRIM_KEY, spec.name), exc))
+            continue
         data = params.model_dump(exclude_defaults=True)
         out[spec.name] = Imported(spec.name, "openpbr", data, contexts=["mtlx"], loss=notes + more)
     return out

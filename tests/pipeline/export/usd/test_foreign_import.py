@@ -26,6 +26,23 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[3]))
 from _mtlx_usd import wrap  # noqa: E402
 
 DATA = Path(__file__).resolve().parents[3] / "data" / "foreign"
+EXAMPLES = DATA / "materialx" / "resources" / "Materials" / "Examples"
+MATERIALX_FILES = [
+    EXAMPLES / path
+    for path in (
+        "DisneyPrincipled/disney_principled_gold.mtlx",
+        "GltfPbr/gltf_pbr_glass.mtlx",
+        "OpenPbr/open_pbr_glass.mtlx",
+        "SimpleHair/simple_hair_default.mtlx",
+        "StandardSurface/standard_surface_glass.mtlx",
+        "StandardSurface/standard_surface_glass_tinted.mtlx",
+        "StandardSurface/standard_surface_gold.mtlx",
+        "StandardSurface/standard_surface_velvet.mtlx",
+        "UsdPreviewSurface/usd_preview_surface_gold.mtlx",
+    )
+]
+"""One example of each MaterialX surface and the Standard Surface cases these tests name
+(the whole shipped set goes through ``test_import_corpus``)."""
 
 
 def _import(cli, stage: Path, out: Path, *extra: str):
@@ -45,7 +62,7 @@ def examples(tmp_path_factory):
     """The shipped MaterialX and OpenPBR examples, in one USD file each."""
     folder = tmp_path_factory.mktemp("foreign")
     mx = folder / "materialx.usda"
-    wrap(sorted((DATA / "materialx").glob("*.mtlx")), mx)
+    wrap(MATERIALX_FILES, mx)
     opbr = folder / "openpbr.usda"
     wrap(sorted((DATA / "openpbr").glob("*.mtlx")), opbr)
     return mx, opbr
