@@ -285,3 +285,18 @@ def test_imported_standard_surface_glass_renders_as_clear_glass(cli, tmp_path, e
     black.write_text(text)
     assert _render_mean(path, tmp_path) == pytest.approx(clear, rel=0.02)
     assert _render_mean(str(black), tmp_path) < 0.7 * clear
+
+
+def test_standard_surface_imports_as_openpbr_with_the_flag(cli, tmp_path):
+    files = sorted((EXAMPLES / "StandardSurface").glob("*.mtlx"))
+    wrap(files, tmp_path / "standard.usda")
+    result, doc = _import(cli, tmp_path / "standard.usda", tmp_path / "out", "--openpbr", "itself")
+    assert result.code == 0, result.err
+    assert len(doc["written"]) == len(files) == 15
+    assert {m["model"] for m in doc["materials"]} == {"openpbr"}
+    by = {m["name"]: m for m in doc["materials"]}
+    # MaterialX's translation folds a metal's coat colour into its base colour
+    assert by["Copper"]["params"]["base_color"] == pytest.approx((0.96468, 0.376263, 0.258183))
+    assert by["Copper"]["params"].get("coat_weight", 0.0) == 0.0
+    assert any("MaterialX's translation" in line for line in by["Copper"]["loss"])
+    _loads_and_blends(doc["written"])
