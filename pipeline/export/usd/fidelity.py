@@ -334,7 +334,7 @@ def translation_loss(openpbr: Any, disney: Any, source: str = "OpenPBR") -> str:
     terms = [loss.name for loss in losses_of(values, lobes)]
     line = (
         f"{source} → Burley: the translated material's directional albedo differs from "
-        f"the {source} source by RMS {fid.rms:.3f} (worst {fid.worst:+.3f} at "
+        f"the OpenPBR source by RMS {fid.rms:.3f} (worst {fid.worst:+.3f} at "
         f"{fid.worst_at}; tolerance {TRANSLATION_TOLERANCE:g}), from the terms that do "
         f"not carry over exactly: {', '.join(terms) or 'none named'}"
     )
