@@ -1,14 +1,15 @@
 """Standard Surface read as OpenPBR Surface by MaterialX's own translation.
 
-MaterialX 1.39 ships the translation graph ``NG_standard_surface_to_open_pbr_surface``
-(``libraries/bxdf/translation/standard_surface_to_open_pbr.mtlx``, node definition
-``ND_standard_surface_to_open_pbr_surface``). lookdev does not restate its mapping: MaterialX's
-``ShaderTranslator`` puts the translation node in front of an ``open_pbr_surface``
-exactly as it does for a renderer, and the graph behind the translation node's outputs is
-then evaluated on the material's constants, node by node, by the semantics of MaterialX's
-standard library nodes (:data:`OPS`; MaterialX Specification, "Standard Nodes"). A node
-the evaluator does not know is an error naming it, never a guess: a MaterialX release that
-changes the graph is read as it is or refused.
+MaterialX 1.39's data library ships the translation graph
+``NG_standard_surface_to_open_pbr_surface`` (node definition
+``ND_standard_surface_to_open_pbr_surface``, among its BxDF translations). lookdev does
+not restate its mapping: MaterialX's ``ShaderTranslator`` puts the translation node in
+front of an ``open_pbr_surface`` exactly as it does for a renderer, and the graph behind
+the translation node's outputs is then evaluated on the material's constants, node by
+node, by the semantics of MaterialX's standard library nodes (:data:`OPS`; MaterialX
+Specification, "Standard Nodes"). A node the evaluator does not know is an error naming
+it, never a guess: a MaterialX release that changes the graph is read as it is or
+refused.
 
 Two departures, both named where they apply:
 

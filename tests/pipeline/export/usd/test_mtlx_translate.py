@@ -1,6 +1,6 @@
 """Standard Surface → OpenPBR by MaterialX's translation graph, evaluated on constants:
 each case below is a line of ``NG_standard_surface_to_open_pbr_surface`` (MaterialX
-1.39, ``libraries/bxdf/translation/standard_surface_to_open_pbr.mtlx``) worked by hand."""
+1.39's data library) worked by hand."""
 
 from __future__ import annotations
 
