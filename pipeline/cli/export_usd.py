@@ -302,7 +302,8 @@ def import_usd(
             "--openpbr",
             help="OpenPBR Surface materials from other tools: 'disney' (translated to "
             "Burley's parameters, losses named) or 'itself' (an openpbr preset holding "
-            "its inputs as they are, proofed by lookdev's OpenPBR model).",
+            "its inputs as they are, proofed by lookdev's OpenPBR model; a Standard "
+            "Surface becomes one by MaterialX's own translation to OpenPBR).",
         ),
     ] = ImportOpenPBR.disney,
     as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
@@ -345,7 +346,12 @@ def import_usd(
     if openpbr is ImportOpenPBR.itself:
         from lookdev.pipeline.export.usd.reader import import_as_openpbr
 
-        itself = import_as_openpbr(file.expanduser())
+        not_openpbr: list[str] = []
+        itself = import_as_openpbr(file.expanduser(), not_openpbr)
+        for m in found:  # OpenPBR's ranges refuse it: it stays Burley's, and says why
+            why = [line for line in not_openpbr if line.startswith(f"{m.prim}:")]
+            if m.name not in itself and why:
+                m.loss.append(f"mtlx: read as Burley's, not as OpenPBR ({why[0]})")
         found = [itself.get(m.name, m) for m in found]
     found = screen(found, refused)
     if not found:

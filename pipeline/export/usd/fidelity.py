@@ -313,12 +313,13 @@ TRANSLATION_TOLERANCE = 0.02
 Monte Carlo error of :data:`SAMPLES` samples a view (≈ 0.005 RMS for two estimates)."""
 
 
-def translation_loss(openpbr: Any, disney: Any) -> str:
+def translation_loss(openpbr: Any, disney: Any, source: str = "OpenPBR") -> str:
     """The loss line of an OpenPBR material imported as Burley's (``disney``, its
     :class:`~lookdev.materials.params.DisneyParams`) when their directional albedos
     differ by more than :data:`TRANSLATION_TOLERANCE` RMS, else ``""``: the measured RMS
     and worst difference, and the terms of :data:`.openpbr_map.LOSSES` the two models do
-    not share for these values (the mapping's losses, read the other way)."""
+    not share for these values (the mapping's losses, read the other way). ``source``
+    names what the OpenPBR parameters came from."""
     from lookdev.materials import registry
 
     from .lobes import active_lobes, canonical
@@ -332,7 +333,7 @@ def translation_loss(openpbr: Any, disney: Any) -> str:
     lobes = active_lobes(values)
     terms = [loss.name for loss in losses_of(values, lobes)]
     line = (
-        f"OpenPBR → Burley: the translated material's directional albedo differs from "
+        f"{source} → Burley: the translated material's directional albedo differs from "
         f"the OpenPBR source by RMS {fid.rms:.3f} (worst {fid.worst:+.3f} at "
         f"{fid.worst_at}; tolerance {TRANSLATION_TOLERANCE:g}), from the terms that do "
         f"not carry over exactly: {', '.join(terms) or 'none named'}"

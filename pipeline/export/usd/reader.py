@@ -462,23 +462,23 @@ def _foreign(net: Network | None) -> Node | None:
 
 
 def _translation_loss(surface: Node, space: str, result: Imported) -> None:
-    """The measured albedo loss of an OpenPBR surface read as Burley's ``result.params``
-    (:func:`.fidelity.translation_loss`), in the surface's own colour space: the preset's
-    colours are taken back into it (out of Rec.709's gamut an ACEScg colour is clipped
-    in the preset, a loss the figure then includes). A surface with connected inputs is
-    not measured: the per-texel look is not one material."""
+    """The measured albedo loss of an OpenPBR surface, or a Standard Surface as MaterialX's
+    translation makes it one (:func:`.openpbr_import.openpbr_values`), read as Burley's
+    ``result.params`` (:func:`.fidelity.translation_loss`), in the surface's own colour
+    space: the preset's colours are taken back into it (out of Rec.709's gamut an ACEScg
+    colour is clipped in the preset, a loss the figure then includes). A surface with
+    connected inputs is not measured: the per-texel look is not one material."""
     from lookdev.materials import colour
     from lookdev.materials.params import DisneyParams
 
     from .fidelity import translation_loss
-    from .openpbr_import import OPENPBR_IDS, params_from_values
+    from .openpbr_import import AS_OPENPBR_IDS, OPENPBR_IDS, openpbr_values, params_from_values
 
-    if surface.id not in OPENPBR_IDS:
-        return  # Standard Surface and glTF: lookdev has no model of them to measure
-    values = {k: plain_value(v) for k, (_, v) in surface.inputs.items()}
-    values.pop("geometry_normal", None)
-    if any(isinstance(v, Connection) for v in values.values()):
+    if surface.id not in AS_OPENPBR_IDS:
+        return  # glTF: lookdev has no model of it to measure
+    if any(isinstance(plain_value(v), Connection) for _, v in surface.inputs.values()):
         return
+    values, _ = openpbr_values(surface)
     try:
         openpbr, _ = params_from_values(values)
     except LookdevError:  # out of the specification's range: named where it is read
@@ -493,9 +493,14 @@ def _translation_loss(surface: Node, space: str, result: Imported) -> None:
             if isinstance(value, tuple) and len(value) == 3:  # linear: a scale's split too
                 back = colour.convert(value, colour.PRESET_LINEAR, source)
                 disney[key] = tuple(float(x) for x in back)
-    line = translation_loss(openpbr, DisneyParams.model_construct(**disney))
+    named = "OpenPBR" if surface.id in OPENPBR_IDS else STANDARD_AS_OPENPBR
+    line = translation_loss(openpbr, DisneyParams.model_construct(**disney), named)
     if line:
         result.loss.append(f"mtlx: {line}")
+
+
+STANDARD_AS_OPENPBR = "Standard Surface (as OpenPBR by MaterialX's translation)"
+"""How a measured loss names a Standard Surface source (:func:`_translation_loss`)."""
 
 
 def _read_foreign(surface: Node, net: Network, units: float, values, result: Imported) -> bool:
@@ -651,13 +656,16 @@ def _preset_params(values: dict[str, Any], model: str, spelling: str) -> dict:
     return params
 
 
-def import_as_openpbr(path: Path) -> dict[str, Any]:
+def import_as_openpbr(path: Path, refused: list[str] | None = None) -> dict[str, Any]:
     """Material name → :class:`~.reader.Imported` of model ``openpbr`` for every material
     of the USD file ``path`` whose ``mtlx`` surface is an OpenPBR Surface lookdev did not
-    map from a Disney material (those keep their record or their Disney reading)."""
+    map from a Disney material (those keep their record or their Disney reading), or a
+    Standard Surface, read as OpenPBR by MaterialX's translation
+    (:func:`.openpbr_import.openpbr_values`). A material whose values OpenPBR's ranges
+    reject is left out; its refusal line (:func:`refusal`) is appended to ``refused``."""
     from pxr import Usd
 
-    from .openpbr_import import OPENPBR_IDS, params_from_values
+    from .openpbr_import import AS_OPENPBR_IDS, openpbr_values, params_from_values
 
     stage = Usd.Stage.Open(str(path))
     out = {}
@@ -666,17 +674,15 @@ def import_as_openpbr(path: Path) -> dict[str, Any]:
         if net is None:
             continue
         surface = next((n for n in net.nodes if n.name == net.terminal.node), None)
-        if surface is None or surface.id not in OPENPBR_IDS or mapped_from_disney(surface):
+        if surface is None or surface.id not in AS_OPENPBR_IDS or mapped_from_disney(surface):
             continue
-        values, notes = {}, []
-        for name, (_, value) in surface.inputs.items():
-            value = plain_value(value)
-            if isinstance(value, Connection):
-                notes.append(f"mtlx: {name} is a connected network (not imported): its default")
-                continue
-            values[name] = tuple(value) if isinstance(value, tuple | list) else value
-        values.pop("geometry_normal", None)
-        params, more = params_from_values(values, f"{path}: material {spec.name!r}")
+        values, notes = openpbr_values(surface)
+        try:
+            params, more = params_from_values(values, f"{path}: material {spec.name!r}")
+        except LookdevError as exc:
+            if refused is not None:
+                refused.append(refusal(spec.custom.get(PRIM_KEY, spec.name), exc))
+            continue
         data = params.model_dump(exclude_defaults=True)
         out[spec.name] = Imported(spec.name, "openpbr", data, contexts=["mtlx"], loss=notes + more)
     return out

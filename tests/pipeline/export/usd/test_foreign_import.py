@@ -26,6 +26,23 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[3]))
 from _mtlx_usd import wrap  # noqa: E402
 
 DATA = Path(__file__).resolve().parents[3] / "data" / "foreign"
+EXAMPLES = DATA / "materialx" / "resources" / "Materials" / "Examples"
+MATERIALX_FILES = [
+    EXAMPLES / path
+    for path in (
+        "DisneyPrincipled/disney_principled_gold.mtlx",
+        "GltfPbr/gltf_pbr_glass.mtlx",
+        "OpenPbr/open_pbr_glass.mtlx",
+        "SimpleHair/simple_hair_default.mtlx",
+        "StandardSurface/standard_surface_glass.mtlx",
+        "StandardSurface/standard_surface_glass_tinted.mtlx",
+        "StandardSurface/standard_surface_gold.mtlx",
+        "StandardSurface/standard_surface_velvet.mtlx",
+        "UsdPreviewSurface/usd_preview_surface_gold.mtlx",
+    )
+]
+"""One example of each MaterialX surface and the Standard Surface cases these tests name
+(the whole shipped set goes through ``test_import_corpus``)."""
 
 
 def _import(cli, stage: Path, out: Path, *extra: str):
@@ -45,7 +62,7 @@ def examples(tmp_path_factory):
     """The shipped MaterialX and OpenPBR examples, in one USD file each."""
     folder = tmp_path_factory.mktemp("foreign")
     mx = folder / "materialx.usda"
-    wrap(sorted((DATA / "materialx").glob("*.mtlx")), mx)
+    wrap(MATERIALX_FILES, mx)
     opbr = folder / "openpbr.usda"
     wrap(sorted((DATA / "openpbr").glob("*.mtlx")), opbr)
     return mx, opbr
@@ -268,3 +285,18 @@ def test_imported_standard_surface_glass_renders_as_clear_glass(cli, tmp_path, e
     black.write_text(text)
     assert _render_mean(path, tmp_path) == pytest.approx(clear, rel=0.02)
     assert _render_mean(str(black), tmp_path) < 0.7 * clear
+
+
+def test_standard_surface_imports_as_openpbr_with_the_flag(cli, tmp_path):
+    files = sorted((EXAMPLES / "StandardSurface").glob("*.mtlx"))
+    wrap(files, tmp_path / "standard.usda")
+    result, doc = _import(cli, tmp_path / "standard.usda", tmp_path / "out", "--openpbr", "itself")
+    assert result.code == 0, result.err
+    assert len(doc["written"]) == len(files) == 15
+    assert {m["model"] for m in doc["materials"]} == {"openpbr"}
+    by = {m["name"]: m for m in doc["materials"]}
+    # MaterialX's translation folds a metal's coat colour into its base colour
+    assert by["Copper"]["params"]["base_color"] == pytest.approx((0.96468, 0.376263, 0.258183))
+    assert by["Copper"]["params"].get("coat_weight", 0.0) == 0.0
+    assert any("MaterialX's translation" in line for line in by["Copper"]["loss"])
+    _loads_and_blends(doc["written"])

@@ -1,11 +1,11 @@
 """The shipped corpus of foreign example materials through a whole round trip: the
-OpenPBR specification's 83 examples and its repository's five, MaterialX's OpenPbr
-(glass) and Standard Surface examples (glass, tinted glass, gold, velvet), each wrapped
-as usdMtlx writes them. Every material imports (OpenPBR ones also as themselves),
-re-exports with OpenPBR as its ``mtlx`` surface, and re-imports to what the first import
-gave; the OpenPBR model's albedo of the re-exported surface is measured against the
-original's (Standard Surface: against the imported Disney material, the only model lookdev
-has of it). Run with ``-s`` for the table of figures."""
+OpenPBR specification's 83 examples and its repository's five, MaterialX's OpenPbr (10)
+and Standard Surface examples (15: the self-contained ones and the grey sphere
+calibration, whose image is small), each wrapped as usdMtlx writes them. Every material
+imports as Burley's parameters and as OpenPBR (itself, or Standard Surface by MaterialX's
+translation graph), re-exports with OpenPBR as its ``mtlx`` surface, and re-imports to
+what the first import gave; the OpenPBR model's albedo of the re-exported surface is
+measured against the OpenPBR original's. Run with ``-s`` for the table of figures."""
 
 from __future__ import annotations
 
@@ -44,16 +44,16 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[3]))
 from _mtlx_usd import wrap  # noqa: E402
 
 DATA = Path(__file__).resolve().parents[3] / "data"
-MATERIALX = DATA / "foreign" / "materialx"
+EXAMPLES = DATA / "foreign" / "materialx" / "resources" / "Materials" / "Examples"
 CORPUS = {
     "openpbr_examples": sorted((DATA / "openpbr_examples").glob("*.mtlx")),
     "openpbr_repository": sorted((DATA / "foreign" / "openpbr").glob("*.mtlx")),
-    "materialx_openpbr": [MATERIALX / "open_pbr_glass.mtlx"],
-    "materialx_standard_surface": sorted(MATERIALX.glob("standard_surface_*.mtlx")),
+    "materialx_openpbr": sorted((EXAMPLES / "OpenPbr").glob("*.mtlx")),
+    "materialx_standard_surface": sorted((EXAMPLES / "StandardSurface").glob("*.mtlx")),
 }
 """One stage per group: material names are unique within each."""
 
-TRANSLATED = "OpenPBR → Burley"
+TRANSLATED = " → Burley: "
 """The words opening an import's measured translation loss (fidelity.translation_loss)."""
 SAMPLES = 1024  # per angle: the albedo's Monte Carlo error is ≈ 0.01 at this count
 
@@ -102,7 +102,9 @@ def rows(tmp_path_factory):
         skipped, refused = [], []
         first = import_usd(stage, skipped, refused)
         assert skipped == [] and refused == [], (skipped, refused)
-        itself = import_as_openpbr(stage)
+        refused_openpbr = []
+        itself = import_as_openpbr(stage, refused_openpbr)
+        assert refused_openpbr == [], refused_openpbr
         spaces = colour_spaces(Usd.Stage.Open(str(stage)))
         sources = [
             source_from_params(f"m{i:03d}", "disney", DisneyParams.parse(m.params))
@@ -131,6 +133,9 @@ def rows(tmp_path_factory):
                     "group": group,
                     "material": a.name,
                     "original": "openpbr" if a.name in itself else "disney import",
+                    "notes": itself[a.name].loss if a.name in itself else [],
+                    "connected": a.name in itself
+                    and any("connected network" in x for x in itself[a.name].loss),
                     "reimport_exact": a.params == b.params,
                     "reimport_close": _close(a.params, b.params),
                     "rms": fid.rms,
@@ -170,8 +175,18 @@ def _print(rows: list[dict]) -> None:
 def test_every_material_of_the_corpus_imports(rows):
     counts = {g: sum(r["group"] == g for r in rows) for g in CORPUS}
     assert counts == {g: len(files) for g, files in CORPUS.items()}  # one material a file
-    assert all(r["original"] == "openpbr" for r in rows if "openpbr" in r["group"])
-    assert all(r["original"] == "disney import" for r in rows if "standard" in r["group"])
+    assert all(r["original"] == "openpbr" for r in rows)  # Standard Surface translated
+
+
+def test_standard_surface_is_read_as_openpbr_by_materialx_translation(rows):
+    from lookdev.pipeline.export.usd.openpbr_import import VIA_TRANSLATION
+
+    standard = [r for r in rows if r["group"] == "materialx_standard_surface"]
+    assert len(standard) == 15
+    assert all(any(VIA_TRANSLATION in x for x in r["notes"]) for r in standard)
+    # the grey sphere calibration's image and the solid marble's procedural are connected
+    connected = sorted(r["material"] for r in standard if r["connected"])
+    assert connected == ["Greysphere_Calibration", "Marble_3D"]
 
 
 def test_the_re_export_imports_back_to_the_first_import(rows):
@@ -188,8 +203,9 @@ def test_the_re_exported_openpbr_surface_is_measured_for_every_material(rows):
 
 
 def test_every_import_beyond_the_tolerance_names_its_measured_loss(rows):
-    measured = [r for r in rows if r["original"] == "openpbr"]
-    assert measured
+    # a surface with a connected input is not one material: not measured at import
+    measured = [r for r in rows if r["original"] == "openpbr" and not r["connected"]]
+    assert len(measured) == len(rows) - 2
     # The note's figure is the import's own measurement (before its values are rounded to
     # float32 and put in the preset's colour space): the same to Monte Carlo precision.
     noise = 0.005
