@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-__all__ = ["TargetSettings", "run", "run_setting"]
+__all__ = ["FIGURE_CASES", "TargetSettings", "figure", "run", "run_setting"]
 
 _ENTRY = "import sys; from lookdev.pipeline.cli import main; main(sys.argv[1:])"
 
@@ -70,10 +70,17 @@ def _frames(out: Path) -> list[dict[str, Any]]:
     return frames
 
 
-def run_setting(s: TargetSettings, target: float | None) -> dict[str, Any]:
-    """One setting's run: CPU and wall seconds, and what its frames did."""
+def _folder(target: float | None) -> str:
+    return "uniform" if target is None else f"target_{target:g}"
+
+
+def run_setting(
+    s: TargetSettings, target: float | None, keep: Path | None = None
+) -> dict[str, Any]:
+    """One setting's run: CPU and wall seconds, and what its frames did; its proofs are
+    kept under ``keep`` when given."""
     with tempfile.TemporaryDirectory(prefix="lookdev-targets-") as tmp:
-        out = Path(tmp) / "proofs"
+        out = (keep or Path(tmp)) / _folder(target)
         start = time.perf_counter()
         proc = subprocess.Popen(
             _proof_argv(s, out, target), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE
@@ -106,12 +113,38 @@ def run_setting(s: TargetSettings, target: float | None) -> dict[str, Any]:
     }
 
 
-def run(s: TargetSettings) -> dict[str, Any]:
-    """The uniform default, then every target of ``s``, one after the other."""
+def run(s: TargetSettings, keep: Path | None = None) -> dict[str, Any]:
+    """The uniform default, then every target of ``s``, one after the other; with
+    ``keep``, the proofs stay there and :func:`figure` is written beside them."""
     from lookdev.pipeline.api.outputs import REPRESENTATIVE
 
     if not s.presets:
         s = TargetSettings(REPRESENTATIVE, s.ibls, s.targets, s.resolution, s.max_spp)
-    rows = [run_setting(s, None)] + [run_setting(s, t) for t in s.targets]
+    rows = [run_setting(s, None, keep)] + [run_setting(s, t, keep) for t in s.targets]
+    if keep is not None:
+        figure(keep, (None, *s.targets), keep / "targets.png")
     load = os.getloadavg() if hasattr(os, "getloadavg") else ()
     return {"settings": s.__dict__, "load_average": [round(x, 2) for x in load], "rows": rows}
+
+
+FIGURE_CASES = (("glass_clear", "sky"), ("gold", "studio"), ("skin", "sky"))
+"""The frames :func:`figure` compares: the sun's glint and caustic, a metal's grain, skin."""
+
+
+def figure(keep: Path, targets: tuple[float | None, ...], out: Path) -> Path:
+    """The shown (denoised) first frame of each of :data:`FIGURE_CASES` that was run, a row
+    each, a column per setting in ``targets`` order, cropped to the sphere and the cup."""
+    import numpy as np
+
+    from lookdev.pipeline.proof.contact import read_rgb, write_png
+
+    rows = []
+    for material, ibl in FIGURE_CASES:
+        paths = [keep / _folder(t) / material / ibl / "frame_000_denoised.png" for t in targets]
+        if all(p.exists() for p in paths):
+            crops = [read_rgb(p) for p in paths]
+            h, w = crops[0].shape[:2]
+            rows.append(np.concatenate([c[h // 6 : h * 5 // 6, : w * 5 // 8] for c in crops], 1))
+    if rows:
+        write_png(np.concatenate(rows, axis=0), out)
+    return out

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Annotated
 
 import typer
@@ -18,6 +19,16 @@ def targets_(
     target: Annotated[
         list[float] | None,
         typer.Option("--target", "-t", help="A per-pixel target to price (repeatable)."),
+    ] = None,
+    output: Annotated[
+        Path | None,
+        typer.Option(
+            "--output",
+            "-o",
+            file_okay=False,
+            help="Keep every setting's proofs here, and targets.png: the shown frames of "
+            "glass × sky, gold × studio and skin × sky, a column per setting.",
+        ),
     ] = None,
     quick: Annotated[bool, typer.Option("--quick", help="One tiny proof (CI, tests).")] = False,
     as_json: JsonOut = False,
@@ -38,7 +49,7 @@ def targets_(
     if target:
         s = targets.TargetSettings(s.presets, s.ibls, tuple(target), s.resolution, s.max_spp)
     with console.status("running the main job's proofs per setting", spinner="dots"):
-        report = targets.run(s)
+        report = targets.run(s, output)
     if as_json:
         print_json(report)
         return

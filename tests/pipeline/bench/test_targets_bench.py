@@ -11,8 +11,13 @@ from lookdev.pipeline.bench import targets
 
 
 @pytest.fixture(scope="module")
-def report():
-    return targets.run(targets.TargetSettings.quick())
+def kept(tmp_path_factory):
+    return tmp_path_factory.mktemp("targets")
+
+
+@pytest.fixture(scope="module")
+def report(kept):
+    return targets.run(targets.TargetSettings.quick(), kept)
 
 
 def test_the_uniform_default_and_each_target_are_run(report):
@@ -30,6 +35,12 @@ def test_a_frame_that_misses_its_target_says_where_it_stopped(report):
     assert uniform["stops"] == {"max_spp": 1} and uniform["mean_spp"] == 4
     (frame,) = uniform["missed"]
     assert frame["material"] == "plastic_glossy" and frame["noise"] > 0.05
+
+
+def test_kept_proofs_are_each_settings_own_batch(report, kept):
+    for folder in ("uniform", "target_0.08"):
+        assert (kept / folder / "manifest.json").is_file()
+    assert not (kept / "targets.png").exists()  # none of the figure's cases was run
 
 
 def test_the_command_prints_one_json_document(cli):
