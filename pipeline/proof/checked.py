@@ -30,9 +30,9 @@ by the inverse of their estimated squared errors (:func:`blend`), so where sampl
 made the raw pixel better than the denoiser's guess, the raw pixel wins: more samples
 never make a shown frame worse (the denoiser's output alone can: OIDN's bias on glass
 grew with samples). The shown pixel's residual is taken as the smaller of the two
-estimates (the errors are correlated, so the blend's would be optimistic). Pixels of
-negative light — a chart patch outside the working space's gamut — are shown raw: OIDN's
-HDR input is [0, ∞) and would clamp them.
+estimates (the errors are correlated, so the blend's would be optimistic). Light below
+zero — a chart patch outside the working space's gamut — is denoised, not clamped, by
+:func:`.denoise.denoise`, so it needs no rule here.
 """
 
 from __future__ import annotations
@@ -94,9 +94,6 @@ def check(
     ) / 2.0 - np.mean(np.square(va - vb), axis=-1) / 2.0
     bias = np.maximum(box_mean(hold - 2.0 * variance, BIAS_WINDOW), 0.0)
     residual = np.sqrt(local_mean(variance, WINDOW) + bias)
-    # Negative light (a chart patch outside the working gamut, the cyan's red) is clamped
-    # by OIDN's HDR input: such pixels are shown raw, their residual the raw one.
-    residual = np.where((image < 0).any(axis=-1), np.inf, residual)
     shown, weight = blend(image, d, raw_error, residual)
     final = np.minimum(raw_error, residual)
     return Checked(shown, d, final, variance, bias, float(weight.mean()))

@@ -35,7 +35,7 @@ is always kept beside the denoised one.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -50,6 +50,7 @@ __all__ = [
     "Denoised",
     "GuideRenderer",
     "Guides",
+    "NEGATIVE_MARGIN",
     "denoise",
     "guide_renderer",
     "oidn",
@@ -60,6 +61,8 @@ GUIDE_SPP = 16
 """Most samples per pixel of the albedo and normal guides; a frame of fewer samples gets
 guides of its own count (first-hit only: ≈ 1/5 of a path sample; their share of a
 denoised frame's time is measured by ``lookdev bench error --item denoise``)."""
+NEGATIVE_MARGIN = 8
+"""Pixels around negative light that its own denoising sees (:func:`denoise`)."""
 AOVS = "albedo:albedo,normal:sh_normal"
 """Mitsuba ``aov`` integrator channels: RGB albedo, then the XYZ shading normal."""
 
@@ -163,11 +166,29 @@ def denoise(image: np.ndarray, guides: Guides | None = None) -> np.ndarray:
     """``image`` (H, W, 3) scene-linear, denoised by OIDN's ``RT`` filter in HDR mode.
 
     With ``guides`` the filter also sees the albedo and normal images; without, only the
-    colour (worse on texture and edges). Negative or non-finite pixels are set to 0 first:
-    OIDN's HDR input is [0, ∞).
+    colour (worse on texture and edges). Non-finite pixels are set to 0 first. OIDN's HDR
+    input is [0, ∞), so light below 0 — a chart patch outside the working space's gamut,
+    such as the ColorChecker's cyan in Rec.709 — is denoised apart, as the positive image
+    of its magnitude over the box that holds it, and subtracted: OIDN is applied to each
+    sign as to light, and the patch keeps its value instead of being clamped to 0.
     """
     pyoidn = oidn()
-    color = np.ascontiguousarray(np.nan_to_num(np.maximum(image, 0.0), posinf=0.0), np.float32)
+    image = np.nan_to_num(np.asarray(image, np.float32), nan=0.0, posinf=0.0, neginf=0.0)
+    out = _oidn(pyoidn, np.maximum(image, 0.0), guides)
+    below = (image < 0).any(axis=-1)
+    if below.any():
+        rows, cols = np.nonzero(below)
+        box = (
+            slice(max(rows.min() - NEGATIVE_MARGIN, 0), rows.max() + NEGATIVE_MARGIN + 1),
+            slice(max(cols.min() - NEGATIVE_MARGIN, 0), cols.max() + NEGATIVE_MARGIN + 1),
+        )
+        part = None if guides is None else replace(guides, albedo=guides.albedo[box],
+                                                   normal=guides.normal[box])  # fmt: skip
+        out[box] -= _oidn(pyoidn, np.maximum(-image[box], 0.0), part)
+    return out
+
+
+def _oidn(pyoidn: Any, color: np.ndarray, guides: Guides | None) -> np.ndarray:
     kwargs = {}
     if guides is not None:
         kwargs = {
@@ -175,9 +196,11 @@ def denoise(image: np.ndarray, guides: Guides | None = None) -> np.ndarray:
             "normal": np.ascontiguousarray(guides.normal, np.float32),
         }
     try:
-        return pyoidn.denoise(color, hdr=True, quality="high", **kwargs)
+        color = np.ascontiguousarray(color, np.float32)
+        out = pyoidn.denoise(color, hdr=True, quality="high", **kwargs)
     except (RuntimeError, ValueError, TypeError) as exc:
         raise DenoiseError(f"Open Image Denoise failed: {exc}") from None
+    return np.array(out, np.float32)
 
 
 # -- proofs ------------------------------------------------------------------------------

@@ -129,7 +129,21 @@ def test_denoise_without_guides_and_with_bad_pixels_stays_finite():
     image[0, 0] = np.nan
     image[1, 1] = -3.0
     out = denoise.denoise(image)
-    assert out.shape == image.shape and np.all(np.isfinite(out)) and out.min() >= 0
+    assert out.shape == image.shape and np.all(np.isfinite(out))
+
+
+def test_light_below_zero_is_denoised_not_clamped():
+    """A chart patch outside the working gamut (the ColorChecker's cyan has negative red
+    in Rec.709) keeps its value: OIDN's HDR input is [0, inf), so it is denoised apart."""
+    rng = np.random.default_rng(5)
+    truth = np.full((64, 96, 3), 0.3, np.float32)
+    truth[20:40, 30:60] = (-0.066, 0.2, 0.35)  # the cyan patch, red below zero
+    noisy = truth * rng.exponential(1.0, truth.shape).astype(np.float32)
+    out = denoise.denoise(noisy)
+    patch = out[24:36, 34:56]
+    assert abs(float(patch[..., 0].mean()) + 0.066) < 0.01  # was clamped to 0
+    assert abs(float(patch[..., 2].mean()) - 0.35) < 0.03
+    assert abs(float(out[:10, :10, 0].mean()) - 0.3) < 0.03  # the positive light as before
 
 
 @pytest.mark.slow
