@@ -40,6 +40,13 @@ class TargetSettings:
     resolution: tuple[int, int] | None = None  # None: the main job's
     max_spp: int | None = None  # None: the per-pixel default cap
 
+    def __post_init__(self) -> None:
+        from lookdev.materials.errors import argument, check_range
+        from lookdev.pipeline.proof.settings import RANGES, ProofError
+
+        for target in self.targets:  # refused here, in one line, not by a child's traceback
+            check_range(target, *RANGES["noise"], field=argument("target"), error=ProofError)
+
     @classmethod
     def quick(cls) -> TargetSettings:
         return cls(("plastic_glossy",), ("studio",), (0.08,), (32, 16), 16)

@@ -48,3 +48,8 @@ def test_the_command_prints_one_json_document(cli):
     assert r.code == 0
     doc = json.loads(r.out)
     assert {row["setting"] for row in doc["rows"]} == {"uniform default", "per pixel, target 0.08"}
+
+
+def test_a_target_out_of_range_is_one_line_before_anything_runs(cli):
+    r = cli("bench", "targets", "--target", "0", "--json")
+    assert r.code == 2 and "--target: 0 is out of range" in r.err and "Traceback" not in r.err
