@@ -35,7 +35,14 @@ import time
 import traceback
 from collections import Counter
 from collections.abc import Callable, Iterator
-from concurrent.futures import FIRST_COMPLETED, Executor, Future, ProcessPoolExecutor, wait
+from concurrent.futures import (
+    FIRST_COMPLETED,
+    Executor,
+    Future,
+    ProcessPoolExecutor,
+    ThreadPoolExecutor,
+    wait,
+)
 from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -182,10 +189,13 @@ def _run_job(job: Job, variant: str) -> dict[str, Any]:
             write_json(doc, folder / MANIFEST)
             rendered += 1
     _remove_strays(folder, doc)
-    doc["contact_sheet"] = file_entry(_sheet(job, doc))
+    sheets = {"contact_sheet": ("png", "contact.png")}
     if job.settings.denoise:
-        sheet = _sheet(job, doc, "denoised_png", "contact_denoised.png")
-        doc["contact_sheet_denoised"] = file_entry(sheet)
+        sheets["contact_sheet_denoised"] = ("denoised_png", "contact_denoised.png")
+    # side by side: OpenImageIO's text and PNG writer release the GIL
+    with ThreadPoolExecutor(len(sheets), thread_name_prefix="proof-sheet") as pool:
+        made = {k: pool.submit(_sheet, job, doc, *args) for k, args in sheets.items()}
+        doc |= {k: file_entry(sheet.result()) for k, sheet in made.items()}
     write_json(doc, folder / MANIFEST)
     return doc | {"rendered": rendered, "skipped": len(done)}
 
