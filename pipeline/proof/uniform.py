@@ -19,8 +19,9 @@ from __future__ import annotations
 import hashlib
 import json
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ThreadPoolExecutor
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -30,7 +31,7 @@ from . import contact, denoise, tonemap
 from .settings import Settings
 from .turntable import Frame, Turntable
 
-__all__ = ["frame_entry", "keep", "render_uniform_frames", "turntable_for"]
+__all__ = ["frame_entry", "keep", "one_behind", "render_uniform_frames", "turntable_for"]
 
 _kept = threading.local()  # per thread: a thread pool running jobs must not share a scene
 
@@ -88,13 +89,23 @@ def render_uniform_frames(
     """Render ``todo`` in whole-frame passes; their manifest entries, files complete."""
     from .passes import render_frame
 
-    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="proof-write") as writer:
-        pending: Future | None = None
+    def frames() -> Iterator[Callable[[], dict[str, Any]]]:
         for frame in todo:
             r = render_frame(table, frame, **s.sampling())
             # at the pose just rendered, before the next frame turns the scene
             aov = guides.render(seed=frame.index, spp=r.spp) if guides is not None else None
-            job = writer.submit(_write, folder, r, aov, s)
+            yield partial(_write, folder, r, aov, s)
+
+    yield from one_behind(frames())
+
+
+def one_behind(tasks: Iterator[Callable[[], Any]]) -> Iterator[Any]:
+    """Each of ``tasks`` run on a second thread while the next one is made (the next
+    frame rendered); their results in order, each once its task is complete."""
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="proof-write") as writer:
+        pending: Future | None = None
+        for task in tasks:
+            job = writer.submit(task)
             if pending is not None:
                 yield pending.result()
             pending = job
