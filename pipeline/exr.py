@@ -54,12 +54,15 @@ def write_exr(
     space: str | None = None,
     *,
     shown: str | os.PathLike | None = None,
+    compression: str = "zip",
 ) -> Path:
     """Write ``pixels`` ((H, W) or (H, W, C)) to exactly ``path`` as a float EXR in ``space``.
 
     ``space``: a colour space of the config (default: the working space; data spaces
-    mark the file as data). Callers that want an atomic file pass a temporary path
-    (``files.atomic_path``); ``shown`` is the name the error line gives instead.
+    mark the file as data). ``compression``: OpenImageIO's name of a lossless OpenEXR
+    compression, with a level after a colon (``"zip:1"``). Callers that want an atomic
+    file pass a temporary path (``files.atomic_path``); ``shown`` is the name the error
+    line gives instead.
     A failure is one :class:`lookdev.library.files.WriteError` line.
     """
     import OpenImageIO as oiio
@@ -74,7 +77,7 @@ def write_exr(
     spec.channelnames = {1: ("Y",), 3: ("R", "G", "B"), 4: ("R", "G", "B", "A")}.get(
         channels, tuple(f"C{i}" for i in range(channels))
     )
-    spec.attribute("compression", "zip")
+    spec.attribute("compression", compression)
     name_colour_space(spec, space)
     out = oiio.ImageOutput.create(str(path))
     ok = out is not None and out.open(str(path), spec)

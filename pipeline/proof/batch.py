@@ -35,7 +35,14 @@ import time
 import traceback
 from collections import Counter
 from collections.abc import Callable, Iterator
-from concurrent.futures import FIRST_COMPLETED, Executor, Future, ProcessPoolExecutor, wait
+from concurrent.futures import (
+    FIRST_COMPLETED,
+    Executor,
+    Future,
+    ProcessPoolExecutor,
+    ThreadPoolExecutor,
+    wait,
+)
 from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -47,7 +54,7 @@ from lookdev.library import files
 from lookdev.materials import colour
 from lookdev.materials.errors import LookdevError
 
-from . import contact, denoise, ibl, rig, tonemap
+from . import contact, denoise, ibl, rig
 from .contact import file_entry
 from .settings import MAX_SAMPLES, MAX_SIDE, MIN_SIDE, ProofError, Settings
 from .turntable import Frame
@@ -182,81 +189,32 @@ def _run_job(job: Job, variant: str) -> dict[str, Any]:
             write_json(doc, folder / MANIFEST)
             rendered += 1
     _remove_strays(folder, doc)
-    doc["contact_sheet"] = file_entry(_sheet(job, doc))
+    sheets = {"contact_sheet": ("png", "contact.png")}
     if job.settings.denoise:
-        sheet = _sheet(job, doc, "denoised_png", "contact_denoised.png")
-        doc["contact_sheet_denoised"] = file_entry(sheet)
+        sheets["contact_sheet_denoised"] = ("denoised_png", "contact_denoised.png")
+    # side by side: OpenImageIO's text and PNG writer release the GIL
+    with ThreadPoolExecutor(len(sheets), thread_name_prefix="proof-sheet") as pool:
+        made = {k: pool.submit(_sheet, job, doc, *args) for k, args in sheets.items()}
+        doc |= {k: file_entry(sheet.result()) for k, sheet in made.items()}
     write_json(doc, folder / MANIFEST)
     return doc | {"rendered": rendered, "skipped": len(done)}
 
 
 def _render(job: Job, todo: list[Frame]) -> Iterator[dict[str, Any]]:
-    """Build the scene once, then render and write each frame; yields manifest entries."""
-    from .passes import render_frame
-    from .turntable import Turntable, material_bsdf, material_interior
+    """Load the scene once (or relight the worker's last one, :func:`.uniform.turntable_for`),
+    then render and write each frame; yields manifest entries."""
+    from .uniform import keep, render_uniform_frames, turntable_for
 
     s = job.settings
-    bsdf, depth = material_bsdf(job.material)
-    table = Turntable(
-        bsdf,
-        job.environment,
-        s.resolution,
-        depth,
-        s.geometry,
-        rig=s.rig,
-        pixel_filter=s.pixel_filter,
-        clamp=s.clamp,
-        interior=material_interior(job.material),
-    )
+    table = turntable_for(job.material, job.environment, s)
     guides = denoise.guide_renderer(table) if s.denoise else None
     if s.per_pixel():
         from .pixelframe import render_pixel_frames
 
         yield from render_pixel_frames(job.folder, table, guides, todo, s)
-        return
-    for frame in todo:
-        r = render_frame(table, frame, **s.sampling())
-        stem = job.folder / f"frame_{frame.index:03d}"
-        exr = contact.write_exr(r.image, stem.with_suffix(".exr"))
-        png = contact.write_png(tonemap.view(r.image, s.exposure), stem.with_suffix(".png"))
-        images = {"raw": exr, "png": png}
-        timings = None
-        if guides is not None:  # at the pose just rendered: the raw frame stays beside
-            written, timings = denoise.write_denoised(
-                guides, r.image, stem, s.exposure, frame.index, r.spp
-            )
-            images |= written
-        entry = frame_entry(r, images, s)
-        if timings is not None:
-            entry["denoise"] = timings
-        yield entry
-
-
-def frame_entry(r: Any, images: dict[str, Path], settings: Settings) -> dict[str, Any]:
-    """A frame's manifest entry (its fields, per frame).
-
-    ``images``: the role of each written file (``raw`` EXR, view-transformed ``png``) →
-    its name in the proof's folder; ``files``: the same roles with size and SHA-256,
-    which a resumed run checks. ``noise`` is the estimated relative RMS noise reached
-    (:mod:`.passes`), ``noise_target`` the target (None for a fixed ``spp``), ``stop``
-    why sampling ended, ``time_s`` the frame's rendering seconds.
-    """
-    return {
-        "index": r.frame.index,
-        "kind": r.frame.kind,
-        "angle": r.frame.angle,
-        "images": {role: path.name for role, path in images.items()},
-        "files": {role: file_entry(path) for role, path in images.items()},
-        "spp": r.spp,
-        "passes": r.passes,
-        "noise": r.noise,
-        "noise_rmse": r.noise_rmse,
-        "noise_target": settings.noise,
-        "stop": r.stop,
-        "time_s": round(r.seconds, 4),
-        "firefly_share": r.firefly_share,
-        "clamp": settings.clamp,
-    }
+    else:
+        yield from render_uniform_frames(job.folder, table, guides, todo, s)
+    keep(table)
 
 
 def _remove_strays(folder: Path, doc: dict[str, Any]) -> None:

@@ -52,9 +52,11 @@ __all__ = [
     "Guides",
     "NEGATIVE_MARGIN",
     "denoise",
+    "denoise_timed",
     "guide_renderer",
     "oidn",
     "write_denoised",
+    "write_guided",
 ]
 
 GUIDE_SPP = 16
@@ -155,11 +157,15 @@ class GuideRenderer:
     def denoise(self, image: np.ndarray, seed: int = 0, spp: int | None = None) -> Denoised:
         """``image`` (rendered at the current pose with ``spp`` samples) denoised with
         freshly rendered guides of as many samples, at most ``self.spp``."""
-        guides = self.render(seed, spp)
-        t0, c0 = time.perf_counter(), time.process_time()
-        out = denoise(image, guides)
-        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-        return Denoised(out, guides.seconds, wall, guides.cpu_seconds, cpu, guides.spp)
+        return denoise_timed(image, self.render(seed, spp))
+
+
+def denoise_timed(image: np.ndarray, guides: Guides) -> Denoised:
+    """``image`` denoised with ``guides`` (:func:`denoise`), with what both cost."""
+    t0, c0 = time.perf_counter(), time.process_time()
+    out = denoise(image, guides)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    return Denoised(out, guides.seconds, wall, guides.cpu_seconds, cpu, guides.spp)
 
 
 def denoise(image: np.ndarray, guides: Guides | None = None) -> np.ndarray:
@@ -223,13 +229,21 @@ def write_denoised(
     seed: int,
     spp: int | None = None,
 ) -> tuple[dict[str, Path], dict[str, float]]:
-    """Denoise a frame (of ``spp`` samples) at the pose it was just rendered in; write
+    """Denoise a frame (of ``spp`` samples) at the pose it was just rendered in, with
+    guides rendered now (:func:`write_guided`)."""
+    return write_guided(guides.render(seed, spp), image, stem, exposure)
+
+
+def write_guided(
+    aov: Guides, image: np.ndarray, stem: Path, exposure: float
+) -> tuple[dict[str, Path], dict[str, float]]:
+    """Denoise a frame with its guides ``aov`` (rendered at its pose); write
     ``<stem>_denoised.exr`` and ``.png`` beside the raw ``<stem>.exr``. Returns the
     written files by manifest role (``denoised``, ``denoised_png``) and the manifest's
     ``denoise`` entry (:meth:`Denoised.timings`)."""
     from . import contact, tonemap
 
-    d = guides.denoise(image, seed=seed, spp=spp)
+    d = denoise_timed(image, aov)
     exr = contact.write_exr(d.image, stem.with_name(stem.name + "_denoised.exr"))
     display = tonemap.view(d.image, exposure)
     png = contact.write_png(display, stem.with_name(stem.name + "_denoised.png"))

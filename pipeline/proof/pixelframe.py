@@ -15,8 +15,8 @@ view(raw)), grey where nothing changed.
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
-from concurrent.futures import Future, ThreadPoolExecutor
+from collections.abc import Callable, Iterator
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -26,6 +26,7 @@ from . import adaptive, checked, contact, denoise, tonemap
 from .passes import estimate, seed_for
 from .settings import Settings
 from .turntable import Frame
+from .uniform import one_behind
 
 __all__ = ["DIFFERENCE_GAIN", "difference_view", "render_pixel_frames"]
 
@@ -49,8 +50,8 @@ def render_pixel_frames(
 ) -> Iterator[dict[str, Any]]:
     """Render ``todo`` per pixel to ``s.noise``; their manifest entries, files complete."""
     renderer = adaptive.PixelRenderer(table.scene, table.camera_index, freeze=False)
-    with ThreadPoolExecutor(max_workers=1) as writer:
-        pending: Future | None = None
+
+    def frames() -> Iterator[Callable[[], dict[str, Any]]]:
         for frame in todo:
             r0, c0 = time.perf_counter(), time.process_time()
             table.set_frame(frame)
@@ -73,12 +74,9 @@ def render_pixel_frames(
                 check=check,
             )
             wall, cpu = time.perf_counter() - r0, time.process_time() - c0
-            job = writer.submit(_write, folder, frame, f, aov, s, wall, cpu)
-            if pending is not None:
-                yield pending.result()
-            pending = job
-        if pending is not None:
-            yield pending.result()
+            yield partial(_write, folder, frame, f, aov, s, wall, cpu)
+
+    yield from one_behind(frames())
 
 
 def _write(

@@ -106,6 +106,7 @@ class Turntable:
         self.pair_index = widths.index(2 * self.width)
         self.camera_index = widths.index(self.width)
         self.params = mi.traverse(self.scene)
+        self.environment_shape = tuple(np.shape(environment))
         self._pose = (0.0, 0.0)  # (element, light) angles the scene is posed at
         self._launch = _frozen(_render_call)
 
@@ -123,6 +124,23 @@ class Turntable:
         if light != self._pose[1]:
             self.params["environment.to_world"] = envmap_to_world(light)
         self._pose = (element, light)
+        self.params.update()
+
+    def set_environment(self, environment: np.ndarray) -> None:
+        """Light the loaded scene with another lat-long ``environment`` of the same shape.
+
+        The envmap's pixels are replaced through ``mi.traverse`` by those a fresh load of
+        ``environment`` holds (Mitsuba's ``envmap`` rebuilds its sampling distribution from
+        them), so the frames equal a scene loaded with it, bit for bit, and the scene's
+        plugins and compiled kernels are kept.
+        """
+        import mitsuba as mi
+
+        shape = tuple(np.shape(environment))
+        if shape != self.environment_shape:
+            raise ValueError(f"an environment of shape {shape}, not {self.environment_shape}")
+        fresh = mi.load_dict(shaderball.envmap(environment))
+        self.params["environment.data"] = mi.traverse(fresh)["data"]
         self.params.update()
 
     @property

@@ -152,6 +152,20 @@ def test_images_are_written_whole_or_not_at_all(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["a.png"]  # nothing half-written
 
 
+def test_proof_images_keep_their_pixels_whatever_the_compression(tmp_path):
+    """PNG and EXR compression change bytes, never pixels: both read back as written."""
+    import OpenImageIO as oiio
+
+    rng = np.random.default_rng(3)
+    display = rng.random((12, 20, 3))
+    png = oiio.ImageBuf(str(contact.write_png(display, tmp_path / "a.png")))
+    assert np.array_equal(png.get_pixels(oiio.UINT8), tonemap.to_8bit(display))
+    linear = (rng.random((12, 20, 3)) * 50.0).astype(np.float32)
+    exr = oiio.ImageBuf(str(contact.write_exr(linear, tmp_path / "a.exr")))
+    assert np.array_equal(exr.get_pixels(oiio.FLOAT), linear)
+    assert exr.spec().get_string_attribute("compression") == "zip"
+
+
 # -- shader ball ---------------------------------------------------------------------------
 def test_cup_mesh_is_oriented_unit_normalled_and_rests_on_the_ground():
     m = shaderball.cup_mesh(segments=32, samples=16)

@@ -236,6 +236,46 @@ def test_changed_settings_render_everything_again_and_drop_stray_frames(mitsuba,
     assert frames == ["frame_000.exr", "frame_000.png", "frame_001.exr", "frame_001.png"]
 
 
+def test_a_relit_turntable_renders_what_a_fresh_load_of_that_ibl_does(mitsuba):
+    sky = ibl.load("sky", 64).pixels
+    table = _table(mitsuba)  # loaded under studio
+    frames = turntable.frames(1, 1)
+    for frame in frames:
+        table.set_frame(frame)
+        table.render_halves(2, seed=frame.index)
+    table.set_environment(sky)
+    fresh = turntable.Turntable(DIFFUSE, sky, (32, 16), 3)
+    for frame in frames:
+        table.set_frame(frame)
+        fresh.set_frame(frame)
+        got, want = table.render_halves(2, seed=frame.index), fresh.render_halves(2, frame.index)
+        assert np.abs(got[0] - want[0]).max() <= 1e-6 and np.abs(got[1] - want[1]).max() <= 1e-6
+    with pytest.raises(ValueError, match="shape"):
+        table.set_environment(np.zeros((8, 16, 3), np.float32))
+
+
+def test_a_worker_relights_its_last_scene_for_the_next_ibl_only(mitsuba, gold, tmp_path):
+    from lookdev.pipeline.proof import uniform
+
+    studio, overcast = ibl.load("studio", 64), ibl.load("overcast", 64)
+    first = uniform.turntable_for(gold, studio.pixels, TINY)
+    uniform.keep(first)
+    assert uniform.turntable_for(gold, overcast.pixels, TINY) is first  # relit
+    assert uniform.turntable_for(gold, overcast.pixels, TINY) is not first  # not kept
+    uniform.keep(first)
+    other = dataclasses.replace(TINY, resolution=(16, 8))
+    assert uniform.turntable_for(gold, overcast.pixels, other) is not first  # none kept now
+    alone = batch.run_job(_job(gold, tmp_path / "alone", name="overcast"))  # a fresh load
+    jobs = batch.make_jobs([gold], [studio, overcast], tmp_path, TINY)
+    docs = [batch.run_job(job) for job in jobs]  # each relights the last job's scene
+    from lookdev.pipeline.proof.contact import read_rgb
+
+    for relit, fresh in zip(docs[1]["frames"], alone["frames"], strict=True):
+        got = read_rgb(tmp_path / "gold" / "overcast" / relit["images"]["raw"])
+        want = read_rgb(tmp_path / "alone" / "gold" / "overcast" / fresh["images"]["raw"])
+        assert got == pytest.approx(want, abs=1e-6)
+
+
 @pytest.mark.slow
 def test_a_batch_runs_on_a_dask_cluster(mitsuba, gold, tmp_path):
     from distributed import Client, LocalCluster
