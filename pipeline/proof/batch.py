@@ -242,9 +242,10 @@ def _sheet(job: Job, doc: dict[str, Any], role: str = "png", name: str = "contac
 def _sampling_label(s: Settings) -> str:
     if s.spp is not None:
         return f"{s.spp} spp"
-    budget = f", ≤ {s.time_budget:g} s" if s.time_budget is not None else ""
+    # words, not "≤": the sheets' font (DroidSans) has no glyph for it and drew a gap
+    budget = f", up to {s.time_budget:g} s" if s.time_budget is not None else ""
     clamp = f", clamped at {s.clamp:g}" if s.clamp is not None else ""
-    return f"noise ≤ {s.noise:g}, ≤ {s.max_spp} spp{budget}{clamp}"
+    return f"target noise {s.noise:g}, up to {s.max_spp} spp{budget}{clamp}"
 
 
 # -- a batch (runs in the parent) ----------------------------------------------------------

@@ -29,6 +29,7 @@ __all__ = [
     "contact_sheet",
     "draw_text",
     "file_entry",
+    "fitting_size",
     "read_rgb",
     "write_exr",
     "write_png",
@@ -143,6 +144,19 @@ def draw_text(canvas: np.ndarray, x: int, y: int, text: str, size: int) -> None:
     region[ink[: region.shape[0], : region.shape[1]]] = TEXT
 
 
+def fitting_size(text: str, size: int, width: int, smallest: int = 10) -> int:
+    """The largest font size up to ``size`` at which ``text`` fits ``width`` pixels (a
+    one-frame sheet is narrower than its title at the full size), at least ``smallest``."""
+    import OpenImageIO as oiio
+
+    while size > smallest:
+        roi = oiio.ImageBufAlgo.text_size(text, size, "DroidSans")
+        if not roi.defined or roi.width <= width:
+            break
+        size -= 1
+    return size
+
+
 def contact_sheet(
     images: list[np.ndarray], labels: list[str], title: str, columns: int
 ) -> np.ndarray:
@@ -161,7 +175,8 @@ def contact_sheet(
         y, x = title_h + r * cell_h, GAP + c * cell_w
         sheet[y : y + h, x : x + w] = img[..., :3]
         draw_text(sheet, x + 2, y + h + label_h - 3, label, max(8, label_h - 3))
-    draw_text(sheet, GAP + 2, title_h - 4, title, max(10, title_h - 6))
+    size = fitting_size(title, max(10, title_h - 6), sheet.shape[1] - 2 * GAP - 2)
+    draw_text(sheet, GAP + 2, title_h - 4, title, size)
     return sheet.astype(np.float32)
 
 

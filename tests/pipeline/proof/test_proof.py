@@ -202,3 +202,16 @@ def test_ply_round_trips_through_mitsuba(tmp_path):
     loaded = np.array(params["vertex_positions"]).reshape(-1, 3)
     assert loaded.shape == m.positions.shape and np.allclose(loaded, m.positions, atol=1e-6)
     assert np.array(params["faces"]).size == m.faces.size
+
+
+def test_a_sheet_title_fits_a_one_frame_sheet_and_draws_no_missing_glyph():
+    # "≤" has no glyph in the sheets' font: the sampling label says it in words
+    from lookdev.pipeline.proof.batch import _sampling_label
+    from lookdev.pipeline.proof.settings import Settings
+
+    label = _sampling_label(Settings())
+    assert label == "target noise 0.05, up to 4 spp" and "≤" not in label
+    title = f"glass_clear × sky  ({label})  denoised"
+    size = contact.fitting_size(title, 42, 480 - 2 * contact.GAP - 2)
+    assert 10 <= size < 42  # shrunk to fit 480 px, not cut off
+    assert contact.fitting_size("gold", 42, 480) == 42  # a short title keeps its size
