@@ -15,10 +15,11 @@ import os
 import statistics
 import subprocess
 import sys
+import tempfile
 from collections.abc import Callable, Sequence
 from typing import Any
 
-__all__ = ["COMMANDS", "FLOOR", "TARGET", "cpu_seconds", "run"]
+__all__ = ["COMMANDS", "ENTRY", "FLOOR", "TARGET", "cpu_seconds", "run"]
 
 FLOOR = ("-c", "import typer")
 """The baseline: an interpreter that imports Typer and does nothing with it."""
@@ -31,22 +32,27 @@ COMMANDS = {
 """The commands measured: what a newcomer types first."""
 TARGET = 3.0
 """Each command within this many times the floor's CPU time."""
-_ENTRY = "import sys; from lookdev.pipeline.cli import main; main(sys.argv[1:])"
+ENTRY = "import sys; from lookdev.pipeline.cli import main; main(sys.argv[1:])"
+"""``python -c ENTRY ARGS…`` runs ``lookdev ARGS…`` in a fresh interpreter."""
 
 
 def cpu_seconds(argv: Sequence[str], env: dict[str, str] | None = None) -> float:
-    """User + system CPU seconds of one child process running ``argv`` (output dropped).
+    """User + system CPU seconds of one child process running ``argv`` (output dropped;
+    on failure, the child's last line of stderr in the error).
 
     >>> cpu_seconds([sys.executable, "-c", "pass"]) > 0
     True
     """
-    child = subprocess.Popen(
-        list(argv), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env
-    )
-    _, status, usage = os.wait4(child.pid, 0)
-    child.returncode = os.waitstatus_to_exitcode(status)
-    if child.returncode != 0:
-        raise RuntimeError(f"{' '.join(argv)} exited {child.returncode}")
+    # stderr to a file, not a pipe: a child that writes more than a pipe holds would
+    # block while we wait for it
+    with tempfile.TemporaryFile() as err:
+        child = subprocess.Popen(list(argv), stdout=subprocess.DEVNULL, stderr=err, env=env)
+        _, status, usage = os.wait4(child.pid, 0)
+        if os.waitstatus_to_exitcode(status) != 0:
+            err.seek(0)
+            last = err.read().decode(errors="replace").strip().splitlines()[-1:]
+            code = os.waitstatus_to_exitcode(status)
+            raise RuntimeError(f"{' '.join(argv)} exited {code}: {' '.join(last)}")
     return usage.ru_utime + usage.ru_stime
 
 
@@ -62,7 +68,7 @@ def run(rounds: int = 7, progress: Callable[[int], None] | None = None) -> dict[
     env = {**os.environ, "COLUMNS": "100", "PYTHONWARNINGS": "ignore"}
     python = sys.executable
     jobs = {"floor": [python, *FLOOR]}
-    jobs |= {name: [python, "-c", _ENTRY, *args] for name, args in COMMANDS.items()}
+    jobs |= {name: [python, "-c", ENTRY, *args] for name, args in COMMANDS.items()}
     for argv in jobs.values():  # warm the file cache and the byte-code once
         cpu_seconds(argv, env)
     load_before = os.getloadavg()

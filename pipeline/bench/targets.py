@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import json
 import os
-import subprocess
 import sys
 import tempfile
 import time
@@ -27,9 +26,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-__all__ = ["FIGURE_CASES", "TargetSettings", "figure", "run", "run_setting"]
+from .cli import ENTRY, cpu_seconds
 
-_ENTRY = "import sys; from lookdev.pipeline.cli import main; main(sys.argv[1:])"
+__all__ = ["FIGURE_CASES", "TargetSettings", "figure", "run", "run_setting"]
 
 
 @dataclass(frozen=True)
@@ -53,7 +52,7 @@ class TargetSettings:
 
 
 def _proof_argv(s: TargetSettings, out: Path, target: float | None) -> list[str]:
-    argv = [sys.executable, "-c", _ENTRY, "proof", *s.presets, "-n", "1", "-m", "0"]
+    argv = [sys.executable, "-c", ENTRY, "proof", *s.presets, "-n", "1", "-m", "0"]
     argv += ["-o", str(out), "--rig", "full"]
     for ibl in s.ibls:
         argv += ["--ibl", ibl]
@@ -89,15 +88,8 @@ def run_setting(
     with tempfile.TemporaryDirectory(prefix="lookdev-targets-") as tmp:
         out = (keep or Path(tmp)) / _folder(target)
         start = time.perf_counter()
-        proc = subprocess.Popen(
-            _proof_argv(s, out, target), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE
-        )
-        _, status, usage = os.wait4(proc.pid, 0)
+        cpu = cpu_seconds(_proof_argv(s, out, target))
         wall = time.perf_counter() - start
-        proc.returncode = os.waitstatus_to_exitcode(status)
-        if proc.returncode != 0:
-            err = proc.stderr.read().decode(errors="replace").strip() if proc.stderr else ""
-            raise RuntimeError(f"lookdev proof failed: {err.splitlines()[-1:] or proc.returncode}")
         frames = _frames(out)
     stops = Counter(f["stop"] for f in frames)
     missed = [
@@ -108,7 +100,7 @@ def run_setting(
     return {
         "setting": "uniform default" if target is None else f"per pixel, target {target:g}",
         "target": target,
-        "cpu_s": round(usage.ru_utime + usage.ru_stime, 2),
+        "cpu_s": round(cpu, 2),
         "wall_s": round(wall, 2),
         "frames": len(frames),
         "met": stops.get("target", 0),

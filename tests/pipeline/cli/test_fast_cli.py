@@ -163,3 +163,11 @@ def test_bench_cli_json_runs_for_real(cli):
     doc = json.loads(r.out)
     assert doc["floor_cpu_s"] > 0 and len(doc["commands"]) == 4
     assert all(c["cpu_s"] > 0 for c in doc["commands"].values())
+
+
+def test_a_failing_timed_child_names_its_last_error_line_and_never_blocks_on_stderr():
+    from lookdev.pipeline.bench.cli import cpu_seconds
+
+    chatty = "import sys; sys.stderr.write('x' * 200000 + '\\nthe reason\\n'); sys.exit(3)"
+    with pytest.raises(RuntimeError, match="exited 3: the reason"):
+        cpu_seconds([sys.executable, "-c", chatty])
