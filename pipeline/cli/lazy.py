@@ -20,7 +20,9 @@ a plain function (a command, e.g. ``proof``), exactly what ``app.add_typer`` or
 
 from __future__ import annotations
 
+import functools
 import importlib
+import inspect
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -54,18 +56,51 @@ class Lazy:
         obj = getattr(importlib.import_module(module, PACKAGE), attribute)
         if isinstance(obj, typer.Typer):
             _markup(obj, markup)
-            command = typer.main.get_group(obj)
+            command = _group_building_on_use(obj)
             command.name = name
         else:
-            info = typer.models.CommandInfo(name=name, callback=obj)
-            command = typer.main.get_command_from_info(
-                info, pretty_exceptions_short=True, rich_markup_mode=markup
-            )
-        defer_coercion(command)
+            command = _built(typer.models.CommandInfo(name=name, callback=obj), markup)
         command.short_help = self.help
         if self.panel is not None:
             command.rich_help_panel = self.panel
         return command
+
+
+def _built(info: Any, markup: Any) -> Any:
+    """The Click command of one Typer ``CommandInfo``, its coercion deferred."""
+    command = typer.main.get_command_from_info(
+        info, pretty_exceptions_short=True, rich_markup_mode=markup
+    )
+    defer_coercion(command)
+    return command
+
+
+def _group_building_on_use(app: typer.Typer) -> Any:
+    """The group of ``app`` with each of its own commands built when resolved: Typer reads
+    every command's signature and type hints when it builds a group (≈ 0.5 ms a command),
+    and a run resolves one."""
+    if isinstance(app.info.cls, typer.models.DefaultPlaceholder):
+        app.info.cls = LazyGroup
+    infos, app.registered_commands = app.registered_commands, []
+    try:
+        group = typer.main.get_group(app)
+    finally:
+        app.registered_commands = infos
+    others, group.commands = group.commands, {}  # Typer lists commands before groups
+    for info in infos:
+        name = info.name or typer.main.get_command_name(info.callback.__name__)
+        group.commands[name] = _Placeholder(
+            name,
+            functools.partial(_built, info),
+            help=info.help or inspect.getdoc(info.callback),
+            short_help=info.short_help,
+            panel=info.rich_help_panel,
+            hidden=info.hidden,
+            deprecated=info.deprecated,
+        )
+    group.commands.update(others)
+    defer_coercion(group)
+    return group
 
 
 def _markup(app: typer.Typer, markup: Any) -> None:
@@ -88,32 +123,78 @@ class LazyGroup(TyperGroup):
         super().__init__(**attrs)
         defer_coercion(self)
         for name, entry in self.table.items():
-            self.commands.setdefault(name, _Placeholder(name, entry))
+            self.commands.setdefault(
+                name,
+                _Placeholder(
+                    name,
+                    functools.partial(entry.load, name),
+                    help=entry.help,
+                    short_help=entry.help,
+                    panel=entry.panel,
+                ),
+            )
 
     def resolve_command(self, ctx: Any, args: list[str]) -> Any:
-        if args and isinstance(self.commands.get(args[0]), _Placeholder):
-            name = args[0]
-            self.commands[name] = self.table[name].load(name, self.rich_markup_mode)
+        placeholder = self.commands.get(args[0]) if args else None
+        if isinstance(placeholder, _Placeholder):
+            self.commands[args[0]] = placeholder.build(self.rich_markup_mode)
         return super().resolve_command(ctx, args)
 
 
 class _Placeholder(TyperCommand):
-    """A table entry not yet imported: its name and listing line, nothing to run."""
+    """A command not yet imported or built: what its parent's listing shows, and
+    ``build(markup)``, which makes the command itself."""
 
-    def __init__(self, name: str, entry: Lazy) -> None:
-        super().__init__(name=name, help=entry.help, short_help=entry.help)
-        if entry.panel is not None:
-            self.rich_help_panel = entry.panel
+    def __init__(
+        self,
+        name: str,
+        build: Any,
+        *,
+        help: str | None,
+        short_help: str | None = None,
+        panel: str | None = None,
+        hidden: bool = False,
+        deprecated: bool = False,
+    ) -> None:
+        super().__init__(
+            name=name, help=help, short_help=short_help, hidden=hidden, deprecated=deprecated
+        )
+        self.build = build
+        if panel is not None:
+            self.rich_help_panel = panel
 
 
 def defer_coercion(command: Any) -> None:
     """Let each parameter of ``command`` (and of its sub-commands) build Typer's coercion
     when it first gets a value: one left unset (``None``) is returned as Typer returns it,
     without a pydantic ``TypeAdapter``. A Typer without that machinery is left as it is."""
+    on_first_value = _on_first_value_class()
+    if on_first_value is None:  # pragma: no cover - another Typer
+        return
+
+    def defer(param: Any) -> Any:
+        if getattr(param, "_runtime_param", False) is None and hasattr(param, "type_descriptor"):
+            d = param.type_descriptor
+            param._runtime_param = on_first_value(d.parameter_info, d.annotation)
+        return param
+
+    for param in getattr(command, "params", ()):
+        defer(param)
+    help_option = command.get_help_option  # made on first use: `--help` is a parameter too
+    command.get_help_option = lambda ctx: defer(help_option(ctx))
+    for sub in getattr(command, "commands", {}).values():
+        if not isinstance(sub, _Placeholder):
+            defer_coercion(sub)
+
+
+@functools.cache
+def _on_first_value_class() -> type | None:
+    """Typer's runtime parameter that builds its coercion on the first value (made once:
+    a dataclass costs ≈ 0.3 ms to create, and every command and group asks for it)."""
     try:
         from typer._coercion import PassThroughRuntimeParam, RuntimeParam, build_runtime_param
     except ImportError:  # pragma: no cover - another Typer
-        return
+        return None
 
     @dataclass(frozen=True)
     class OnFirstValue(RuntimeParam):
@@ -127,19 +208,7 @@ def defer_coercion(command: Any) -> None:
             param._runtime_param = build_runtime_param(d)
             return param._runtime_param._coerce_value(value, param=param, ctx=ctx)
 
-    def defer(param: Any) -> Any:
-        if getattr(param, "_runtime_param", False) is None and hasattr(param, "type_descriptor"):
-            d = param.type_descriptor
-            param._runtime_param = OnFirstValue(d.parameter_info, d.annotation)
-        return param
-
-    for param in getattr(command, "params", ()):
-        defer(param)
-    help_option = command.get_help_option  # made on first use: `--help` is a parameter too
-    command.get_help_option = lambda ctx: defer(help_option(ctx))
-    for sub in getattr(command, "commands", {}).values():
-        if not isinstance(sub, _Placeholder):
-            defer_coercion(sub)
+    return OnFirstValue
 
 
 def _already_plain(descriptor: Any, value: Any) -> bool:

@@ -8,6 +8,7 @@ not (``lookdev bench cli`` measures that).
 
 from __future__ import annotations
 
+import importlib
 import json
 import subprocess
 import sys
@@ -171,3 +172,34 @@ def test_a_failing_timed_child_names_its_last_error_line_and_never_blocks_on_std
     chatty = "import sys; sys.stderr.write('x' * 200000 + '\\nthe reason\\n'); sys.exit(3)"
     with pytest.raises(RuntimeError, match="exited 3: the reason"):
         cpu_seconds([sys.executable, "-c", chatty])
+
+
+@pytest.mark.parametrize("name", ["presets", "export", "import", "validate", "colour"])
+def test_a_sub_group_lists_what_typer_lists_and_builds_only_the_command_run(name):
+    entry = cli_package.COMMANDS[name]
+    lazy = entry.load(name, "markdown")
+    module, _, attribute = entry.target.partition(":")
+    app = getattr(importlib.import_module(module, "lookdev.pipeline.cli"), attribute)
+    eager = typer.main.get_group(app)
+
+    def listing(group):
+        return [
+            (n, c.get_short_help_str(80), c.hidden, c.deprecated, c.rich_help_panel)
+            for n, c in group.commands.items()
+        ]
+
+    assert listing(lazy) == listing(eager)
+    first = next(n for n, c in eager.commands.items() if not isinstance(c, typer.core.TyperGroup))
+    assert type(lazy.commands[first]).__name__ == "_Placeholder"
+    ctx = lazy.make_context(name, [first, "--help"], resilient_parsing=True)
+    lazy.resolve_command(ctx, [first])
+    built = lazy.commands[first]
+    assert built.callback is not None and [p.name for p in built.params] == [
+        p.name for p in eager.commands[first].params
+    ]
+    others = [n for n in lazy.commands if n != first]
+    assert all(
+        type(lazy.commands[n]).__name__ == "_Placeholder"
+        or isinstance(lazy.commands[n], typer.core.TyperGroup)
+        for n in others
+    )
