@@ -135,9 +135,9 @@ patch(batch, "_remove_strays", "manifest writes")
 patch(material_info, "write_material_info", "material.json")
 patch(report, "write_report", "review page")
 patch(report, "material_plots", "review page (plots)")
-import lookdev.pipeline.api.outputs as outputs
+import lookdev.pipeline.api.proofs as api_proofs
 
-patch(outputs, "hub", "load + blend materials")
+patch(api_proofs, "hub", "load + blend materials")
 from lookdev.pipeline.proof import ibl as iblmod
 
 patch(iblmod, "load", "load IBLs")

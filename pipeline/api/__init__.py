@@ -48,7 +48,9 @@ need them, never by ``import lookdev``.
 from lookdev.library.display import register_swatch
 from lookdev.materials.colour import use as colour_settings
 
+from .analysis import Plot, Stability, check, plot
 from .designer import DesignerHandle, designer
+from .exports import USD_CONTEXTS, MitsubaExport, UsdExport, export_mitsuba, export_usd
 from .materials import (
     EVALUATE_RESOLUTION,
     LookdevError,
@@ -64,21 +66,8 @@ from .materials import (
     pdf,
     sample,
 )
-from .outputs import (
-    REPRESENTATIVE,
-    USD_CONTEXTS,
-    MitsubaExport,
-    Plot,
-    Stability,
-    UsdExport,
-    check,
-    export_mitsuba,
-    export_usd,
-    plot,
-    proof,
-    representative_presets,
-)
 from .preview import swatch_png
+from .proofs import REPRESENTATIVE, proof, representative_presets
 
 __all__ = [
     "EVALUATE_RESOLUTION",

@@ -48,7 +48,7 @@ class CostSettings:
 def cost(s: CostSettings) -> list[dict[str, Any]]:
     """Per preset and cap: the job's set-up and every frame's render, write and denoise
     timings (wall and CPU seconds), in the order a proof job spends them."""
-    from lookdev.pipeline.api.outputs import REPRESENTATIVE
+    from lookdev.pipeline.api.proofs import REPRESENTATIVE
     from lookdev.pipeline.proof import contact, denoise, ibl, tonemap, turntable
     from lookdev.pipeline.proof.passes import render_frame
     from lookdev.pipeline.proof.settings import DEFAULT_NOISE

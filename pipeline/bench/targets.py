@@ -115,7 +115,7 @@ def run_setting(
 def run(s: TargetSettings, keep: Path | None = None) -> dict[str, Any]:
     """The uniform default, then every target of ``s``, one after the other; with
     ``keep``, the proofs stay there and :func:`figure` is written beside them."""
-    from lookdev.pipeline.api.outputs import REPRESENTATIVE
+    from lookdev.pipeline.api.proofs import REPRESENTATIVE
 
     if not s.presets:
         s = TargetSettings(REPRESENTATIVE, s.ibls, s.targets, s.resolution, s.max_spp)
