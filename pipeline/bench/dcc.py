@@ -356,7 +356,7 @@ def _depths(presets: tuple[str, ...]) -> dict[str, int]:
 def _losses(usd: Path) -> dict[str, str]:
     from pxr import Usd
 
-    from lookdev.pipeline.export.usd.writer import DCC_LOSS
+    from lookdev.pipeline.export.usd.authoring import DCC_LOSS
 
     stage = Usd.Stage.Open(str(usd))
     out = {}

@@ -50,7 +50,7 @@ def export_materials(
     material's contexts against the material (:mod:`.fidelity`): the universal one in the
     result's ``fidelity``, every one (both ``mtlx`` surfaces) in ``contexts_fidelity``.
     The universal context is measured either way: its figures are in the loss note a
-    DCC shows (:func:`.writer.dcc_loss_note`).
+    DCC shows (:func:`.authoring.dcc_loss_note`).
     ``preview_opacity``: see :data:`.names.PREVIEW_OPACITY`. ``collect`` copies the
     presets' own texture files beside ``out``; ``preview_geometry`` adds a sphere per
     material (:func:`.writer.export_usd`).

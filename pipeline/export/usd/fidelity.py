@@ -12,7 +12,7 @@ the RMS and the worst albedo difference (with angle and channel), the ratio of t
 highlights' luminance, preview over source, and the relative change of the
 bihemispherical albedo's luminance (:func:`sphere_albedo`: what a ball shows under even
 light, so it predicts a render's mean colour). :meth:`Fidelity.size` says those figures
-in words for the loss note a DCC shows (:func:`.writer.dcc_loss_note`).
+in words for the loss note a DCC shows (:func:`.authoring.dcc_loss_note`).
 
 Layered materials are measured at their centre texel; a layered Pixar material
 (composited lobe weights) is measured from the preview values at its centre against the

@@ -23,10 +23,10 @@ from lookdev.materials.preview_surface import MODEL, PreviewParams  # noqa: E402
 from lookdev.pipeline import api  # noqa: E402
 from lookdev.pipeline.analysis.albedo import albedo_monte_carlo  # noqa: E402
 from lookdev.pipeline.blend import BlendedMaterial  # noqa: E402
+from lookdev.pipeline.export.usd.authoring import DCC_LOSS, FULLY, dcc_loss_note  # noqa: E402
 from lookdev.pipeline.export.usd.fidelity import Fidelity  # noqa: E402
 from lookdev.pipeline.export.usd.network import Connection, MaterialSpec, Network  # noqa: E402
 from lookdev.pipeline.export.usd.pixar import metallic_workflow  # noqa: E402
-from lookdev.pipeline.export.usd.writer import DCC_LOSS, FULLY, dcc_loss_note  # noqa: E402
 
 
 def _prepare(xp, params):
