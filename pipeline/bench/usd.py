@@ -4,9 +4,7 @@ Both paths author the *same* networks (:class:`~lookdev.pipeline.export.usd.netw
 all three render contexts) into an in-memory stage:
 
 - fast: Sdf-level, the exporter's own :func:`~lookdev.pipeline.export.usd.authoring.author`
-  (``Sdf.ChangeBlock``, ``Sdf.PrimSpec``, ``Sdf.AttributeSpec``; a material of a shape
-  already written is an ``Sdf.CopySpec`` of it with its values set: ``shapes`` counts
-  the distinct shapes of the benchmark's materials);
+  (``Sdf.ChangeBlock``, ``Sdf.PrimSpec``, ``Sdf.AttributeSpec``);
 - naive: prim by prim through the high-level ``Usd``/``UsdShade`` API
   (``UsdShade.Material.Define``, ``Shader.CreateInput(...).Set``, ``ConnectToSource``),
   no change block, so every edit notifies and recomposes.
@@ -30,12 +28,11 @@ can beat it, so ``ratio_bound = naive_s / floor_s`` is the most any such path co
 reach over the naive reference.
 
 And a second floor, ``floor_set_s``: every value, connection and metadata field the fast
-path writes, read back from its layer outside the clock and written again spec by spec
-with the calls the writer makes for the first material of a shape, in the same change blocks
-(:func:`author_recorded`), nothing computed in between: what authoring the layer spec by
-spec costs, so ``ratio_bound_set = naive_s / floor_set_s`` is the most a writer making
-every spec from Python could reach. The fast path copies every material after the first
-of its shape in C++ (``Sdf.CopySpec``), so it can go below this floor.
+path writes, read back from its layer outside the clock and written again with the same
+usd-core calls in the same change blocks (:func:`author_recorded`), nothing computed in
+between: what the writer's own calls cost, so ``ratio_bound_set = naive_s /
+floor_set_s`` is the most any writer making them could reach, and ``fast_s /
+floor_set_s`` what lookdev's Python adds.
 
 Wall and CPU seconds: the ratios above are of wall time (``perf_counter``), as a user
 waits. The naive path's recompositions run on usd-core's worker threads, so its CPU
@@ -68,7 +65,6 @@ from lookdev.pipeline.export.usd.authoring import (
     dcc_loss_note,
     loss_doc,
     new_layer,
-    shape_of,
     usd_value,
     value_types,
 )
@@ -97,7 +93,6 @@ __all__ = [
     "per_material",
     "recorded",
     "run",
-    "shapes_of",
     "spec_paths",
 ]
 
@@ -180,7 +175,6 @@ def run(count: int, *, repeat: int = 5) -> dict[str, Any]:
         "materials": count,
         "contexts": len(CONTEXTS),
         "shaders": sum(len(n.nodes) for s in specs for n in s.networks),
-        "shapes": len(shapes_of(specs)),
         "build_networks_s": build_s,
         "fast_s": fast_s,
         "naive_s": naive_s,
@@ -206,12 +200,6 @@ def run(count: int, *, repeat: int = 5) -> dict[str, Any]:
         "end_to_end_materials_per_s_min": rate["min"],
         "end_to_end_materials_per_s_max": rate["max"],
     }
-
-
-def shapes_of(specs: list[MaterialSpec]) -> set[tuple]:
-    """The distinct shapes (:func:`~lookdev.pipeline.export.usd.authoring.shape_of`) of
-    ``specs``: how many materials the writer authors spec by spec; it copies the rest."""
-    return {shape_of(s, s.interface(), dcc_loss_note(s) is not None) for s in specs}
 
 
 def bench_sources(count: int, seed: int = 7) -> list[Source]:

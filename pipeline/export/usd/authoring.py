@@ -2,19 +2,15 @@
 each material, fast.
 
 Authoring is Sdf-level (``Sdf.ChangeBlock``, ``Sdf.PrimSpec``, ``Sdf.AttributeSpec``):
-one change notification per material instead of one per attribute. A material whose
-networks have the *shape* of one already written (the same prims, attributes, types,
-connections and metadata; only values differ) is copied from it by ``Sdf.CopySpec``,
-which makes its specs and retargets its connections in C++, and then only its values
-are set (:func:`shape_of`). The text written is the one the high-level ``UsdShade`` API
-writes for the same networks, byte for byte.
+one change notification per material instead of one per attribute, each spec made by
+the cheapest call that makes it. The text written is the one the high-level ``UsdShade``
+API writes for the same networks, byte for byte.
 """
 
 from __future__ import annotations
 
 import os
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -49,7 +45,6 @@ __all__ = [
     "network_notes",
     "new_layer",
     "relative_asset",
-    "shape_of",
     "usd_value",
     "value_types",
 ]
@@ -166,97 +161,6 @@ def author(layer, specs: list[MaterialSpec], base: Path) -> list[str]:
     return paths
 
 
-def shape_of(spec: MaterialSpec, interface: dict[str, tuple[str, Any]], loss_note: bool) -> tuple:
-    """What :func:`author` writes for ``spec`` except its values, its ``customData`` and
-    its ``doc``: two materials of one shape have the same prims, attributes (names, types,
-    connections, colour spaces) and shader metadata. ``interface``: ``spec.interface()``;
-    ``loss_note``: whether it has a :data:`DCC_LOSS` note."""
-    return (
-        loss_note,
-        tuple((name, kind) for name, (kind, _) in interface.items()),
-        tuple(_network_shape(net) for net in spec.networks),
-    )
-
-
-def _network_shape(net: Network) -> tuple:
-    return (
-        net.context,
-        net.terminal,
-        net.displacement,
-        tuple(
-            (
-                node.name,
-                node.id,
-                tuple((k, v) for k, v in node.custom.items() if v),
-                tuple(
-                    (name, kind, _link(value), node.color_spaces.get(name))
-                    for name, (kind, value) in node.inputs.items()
-                ),
-                tuple(node.outputs.items()),
-            )
-            for node in net.nodes
-        ),
-    )
-
-
-def _link(value: Any) -> Any:
-    """What an input reads, as the shape sees it: a connection, an interface input's
-    name, or None for a value of its own."""
-    if type(value) is Connection:
-        return value
-    return ("interface", value.name) if type(value) is Interface else None
-
-
-def _valued(spec: MaterialSpec, interface: dict[str, tuple[str, Any]]):
-    """``(shader or None, input, type, value)`` of every input of ``spec`` that holds a
-    value (the Material's interface, then each shader's inputs that are not connected to
-    another shader), in one fixed order: what a copy of a material of the same shape
-    sets. An input reading the interface yields an :class:`.Interface`."""
-    for name, (kind, value) in interface.items():
-        yield None, name, kind, value
-    for net in spec.networks:
-        for node in net.nodes:
-            for name, (kind, value) in node.inputs.items():
-                if type(value) is not Connection:
-                    yield node.name, name, kind, value
-
-
-def _same(value: Any, old: Any) -> bool:
-    """Whether ``value`` is one a copy can keep from its template (``old``): equal plain
-    Python values only, anything else is set again. A zero is never kept: 0.0 equals
-    −0.0, and USD writes them apart."""
-    kind = type(value)
-    if kind is Interface:
-        return type(old) is Interface and _same(value.value, old.value)
-    if kind is not type(old) or value != old:
-        return False
-    if kind is float:
-        return value != 0.0
-    if kind is tuple:
-        return 0.0 not in value and all(type(x) in _SCALARS for x in value)
-    return kind in _SCALARS
-
-
-_SCALARS = (float, int, bool, str)
-
-
-def _zero(value: Any) -> bool:
-    """Whether ``value`` (or the interface value it reads) is or holds a zero."""
-    held = value.value if type(value) is Interface else value
-    return held == 0.0 if type(held) is float else type(held) is tuple and 0.0 in held
-
-
-@dataclass(frozen=True)
-class _Template:
-    """The first material of a shape: its path, its loss note, and where each of its
-    values (:func:`_valued`, in that order) is, relative to it, and what it is."""
-
-    path: Any
-    note: str | None
-    where: list[Any]
-    values: list[Any]
-
-
 # Per attribute, authoring is a few usd-core calls, and they are most of the time (70–80 %
 # of it, sampled): _Author does no work twice around them. The names of properties, the
 # converters of values, the colour space's name (an OCIO lookup), the MaterialX version
@@ -270,15 +174,11 @@ class _Template:
 # connection, assigned as the list proxy's explicit items, costs ≈ 2.3 µs more than its
 # attribute (usd-core makes a connection spec for the target; the connectionPaths field
 # cannot be set otherwise, SetInfo refuses it as read-only). usd-core 0.26, CPU time.
-# Sdf.CopySpec of a whole material of the same shape costs about a third of authoring it
-# spec by spec, connections included, so every material after the first of its shape is
-# copied and only its values are set.
 
 
 class _Author:
     """Authors materials into one layer (see :func:`author`), reusing what every material
-    shares: value types, converters, property names, list ops, and the first material of
-    each shape (:func:`shape_of`) as the template of the others."""
+    shares: value types, converters, property names, list ops."""
 
     def __init__(self, layer, base: Path):
         self.layer = layer
@@ -303,37 +203,18 @@ class _Author:
             )
             for context in CONTEXT_OUTPUT
         }
-        self.templates: dict[tuple, Any] = {}  # shape → the path of its first material
 
     def material(self, scope, spec: MaterialSpec):
         """Author one material under ``scope``; returns its path."""
-        notes = network_notes(spec)
-        note = dcc_loss_note(spec, notes)
-        interface = spec.interface()
-        shape = shape_of(spec, interface, note is not None)
-        template = self.templates.get(shape)
-        if template is not None:
-            return self.copy(scope, spec, template, interface, notes, note)
-        path = self.whole(scope, spec, interface, notes, note)
-        valued = list(_valued(spec, interface))
-        where = [Sdf.Path(f"{prim or ''}.{self.inputs[name]}") for prim, name, _, _ in valued]
-        self.templates[shape] = _Template(path, note, where, [row[3] for row in valued])
-        return path
-
-    def whole(self, scope, spec: MaterialSpec, interface_values, notes, note):
-        """Author ``spec`` spec by spec (``interface_values``: ``spec.interface()``;
-        ``notes`` and ``note``: its :func:`network_notes` and :func:`dcc_loss_note`)."""
         layer, types, convert, inputs = self.layer, self.types, self.convert, self.inputs
         create = Sdf.CreatePrimAttributeInLayer
         prim = Sdf.PrimSpec(scope, prim_name(spec.name), Sdf.SpecifierDef, "Material")
         prim.SetInfo("customData", {"lookdev": dict(spec.custom)})
+        notes = network_notes(spec)
         prim.documentation = loss_doc(spec, notes)
         path = prim.path
         append = path.AppendProperty
-        if note is not None:
-            # Custom (not a schema property): Blender imports only custom attributes.
-            varying = Sdf.VariabilityVarying
-            create(layer, append(DCC_LOSS), types["string"], varying, True).default = note
+        _dcc_loss(layer, spec, path, types, notes)
         # Every colour value and map of the material is in the working space:
         # UsdColorSpaceAPI names it by USD's canonical name (lin_rec709_scene,
         # lin_ap1_scene) for the material and everything under it; textures that differ
@@ -346,7 +227,7 @@ class _Author:
             create(layer, version, types["string"], uniform).default = self.version
         prim.SetInfo("apiSchemas", self.schemas[has_mtlx])
         interface = {}  # name → (its path, type, the value it holds, that value converted)
-        for name, (kind, value) in interface_values.items():
+        for name, (kind, value) in spec.interface().items():
             where = append(inputs[name])
             held = convert[kind](value)
             create(layer, where, types[kind]).default = held
@@ -356,43 +237,6 @@ class _Author:
             for node in net.nodes:
                 self.shader(prim, path, node, interface)
         return path
-
-    def copy(self, scope, spec: MaterialSpec, template: _Template, interface_values, notes, note):
-        """Author ``spec`` as a copy of ``template``'s material, of its shape, with its own
-        ``customData`` and ``doc`` and the values that differ from the template's set
-        (arguments as :meth:`whole`)."""
-        layer, convert = self.layer, self.convert
-        path = scope.path.AppendChild(prim_name(spec.name))
-        Sdf.CopySpec(layer, template.path, layer, path)
-        prim = layer.GetPrimAtPath(path)
-        prim.SetInfo("customData", {"lookdev": dict(spec.custom)})
-        prim.documentation = loss_doc(spec, notes)
-        attribute = layer.GetAttributeAtPath
-        if note is not None and note != template.note:
-            attribute(path.AppendProperty(DCC_LOSS)).default = note
-        interface = {
-            name: (None, kind, value, convert[kind](value))
-            for name, (kind, value) in interface_values.items()
-        }
-        rows = _valued(spec, interface_values)
-        for (_, _, kind, value), where, old in zip(
-            rows, template.where, template.values, strict=True
-        ):
-            if not _same(value, old):
-                attr = attribute(path.AppendPath(where))
-                if _zero(value):  # Sdf keeps a field set to an equal value: −0.0 over 0.0
-                    attr.ClearDefaultValue()
-                attr.default = self.held(kind, value, interface)
-        return path
-
-    def held(self, kind: str, value: Any, interface: dict[str, tuple]) -> Any:
-        """What a shader input of ``kind`` holds for ``value`` (not a connection): an
-        interface input's value converted once, unless the input's type differs."""
-        if type(value) is Interface:
-            _, held_kind, held, converted = interface[value.name]
-            same = value.value is held and kind == held_kind
-            return converted if same else self.convert[kind](value.value)
-        return self.convert[kind](value)
 
     def outputs_of(self, path, net: Network) -> None:
         """The Material's terminal outputs of ``net``, connected to its shaders."""
@@ -411,7 +255,7 @@ class _Author:
 
     def shader(self, prim, path, node: Node, interface: dict[str, tuple]) -> None:
         """One shader of a network under the Material ``prim`` (at ``path``)."""
-        layer, types, inputs = self.layer, self.types, self.inputs
+        layer, types, convert, inputs = self.layer, self.types, self.convert, self.inputs
         create = Sdf.CreatePrimAttributeInLayer
         shader = Sdf.PrimSpec(prim, node.name, Sdf.SpecifierDef, "Shader")
         if any(node.custom.values()):
@@ -423,12 +267,15 @@ class _Author:
             attr = create(layer, at(inputs[name]), types[kind])
             if type(value) is Connection:
                 attr.connectionPathList.explicitItems = [self.output_path(path, value)]
+            elif type(value) is Interface:
+                # Connected to the Material's interface (which wins); the value stays
+                # here too for readers that do not follow connections.
+                where, held_kind, held, converted = interface[value.name]
+                attr.connectionPathList.explicitItems = [where]
+                same = value.value is held and kind == held_kind
+                attr.default = converted if same else convert[kind](value.value)
             else:
-                if type(value) is Interface:
-                    # Connected to the Material's interface (which wins); the value stays
-                    # here too for readers that do not follow connections.
-                    attr.connectionPathList.explicitItems = [interface[value.name][0]]
-                attr.default = self.held(kind, value, interface)
+                attr.default = convert[kind](value)
             if spaces and name in spaces:
                 attr.SetInfo("colorSpace", spaces[name])
         for name, kind in node.outputs.items():
@@ -476,3 +323,13 @@ def dcc_loss_note(spec: MaterialSpec, notes: list[tuple[str, str]] | None = None
             named = note or "UsdPreviewSurface's BRDF is not the material's"
             return f"{named}; {MEASURED}: {size.size()}"
     return None
+
+
+def _dcc_loss(layer, spec: MaterialSpec, path, types: dict[str, Any], notes) -> None:
+    note = dcc_loss_note(spec, notes)
+    if note is None:
+        return
+    where = path.AppendProperty(DCC_LOSS)
+    # Custom (not a schema property): Blender imports only custom attributes.
+    varying = Sdf.VariabilityVarying
+    Sdf.CreatePrimAttributeInLayer(layer, where, types["string"], varying, True).default = note
