@@ -36,6 +36,7 @@ from .toml_file import NAME_RE, parse_toml
 
 __all__ = [
     "Header",
+    "find_file",
     "INDEX_NAME",
     "INDEX_VERSION",
     "RACY_S",
@@ -111,6 +112,17 @@ def scan_folder(folder: Path, *, cache: bool = True, skip: tuple[str, ...] = ())
     if cache and (misses or len(cached) != len(found)):
         _write_index(folder, found, headers)
     return headers
+
+
+def find_file(folder: Path, name: str, *, skip: tuple[str, ...] = ()) -> str | None:
+    """The file :func:`scan_folder` would give first for the preset ``name`` (a header's
+    name is its file's), found from the folder listing alone: no preset file is read, so
+    finding one preset in a folder of hundreds costs their stats, not their headers."""
+    root, target = os.fspath(folder), name + SUFFIX
+    for rel, *_ in _walk(root, skip):
+        if os.path.basename(rel) == target:
+            return f"{root}{os.sep}{rel}"
+    return None
 
 
 def read_header(path: str | Path, *, library: str | None = None) -> Header:

@@ -22,7 +22,7 @@ from lookdev.materials.errors import LookdevError
 
 from . import store
 from .errors import LibraryError, PresetError, PresetNotFoundError, did_you_mean
-from .index import SUFFIX, Header, scan_folder
+from .index import SUFFIX, Header, find_file, scan_folder
 from .toml_file import check_name
 
 if TYPE_CHECKING:
@@ -130,7 +130,11 @@ class Library:
             return direct
         if not folder.is_dir():
             return None
-        return next((h.path for h in self._scan(folder) if h.name == name), None)
+        if folder == self.builtin and self._builtin_headers is not None:
+            return next((h.path for h in self._builtin_headers if h.name == name), None)
+        skip = BUILTIN_OTHER_DATA if folder == self.builtin else ()
+        found = find_file(folder, name, skip=skip)
+        return None if found is None else Path(found)
 
     def names(self) -> list[str]:
         """All preset names on the path, sorted."""

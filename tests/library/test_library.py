@@ -415,3 +415,27 @@ def test_update_and_remove(lib, tmp_path):
     lib.remove("child")
     lib.remove("mine")
     assert "mine" not in lib.names()
+
+
+def test_find_picks_the_file_a_listing_would_without_reading_any(tmp_path, monkeypatch):
+    """A name resolves to the shallowest file, then the first by path, as ``presets list``
+    shows it; hidden folders never win; no preset file is opened to find it."""
+    import lookdev.library.index as index
+
+    body = 'model = "disney"\n[params]\nroughness = 0.5\n'
+    for rel in ("b/c/deep.toml", "z/deep.toml", "a/twice.toml", "b/twice.toml", ".hid/h.toml"):
+        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / rel).write_text(body, encoding="utf-8")
+    library = Library([tmp_path], use_env=False)
+    listed = {n: library.definitions(n)[0] for n in ("deep", "twice")}
+    assert listed == {"deep": tmp_path / "z/deep.toml", "twice": tmp_path / "a/twice.toml"}
+    monkeypatch.setattr(index, "read_header", lambda *a, **k: pytest.fail("a header was read"))
+    fresh = Library([tmp_path], use_env=False)
+    assert {n: fresh.find(n) for n in listed} == listed
+    assert fresh._find_in(tmp_path, "h") is None  # hidden: not a preset of the library
+
+
+def test_every_builtin_name_finds_the_file_the_listing_shows():
+    fresh = Library(use_env=False)  # found before any listing: from the folder names alone
+    found = {n: fresh.find(n) for n in BUILTIN_NAMES}
+    assert found == {n: BUILTIN.definitions(n)[0] for n in BUILTIN_NAMES}

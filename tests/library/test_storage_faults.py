@@ -403,6 +403,7 @@ def test_a_read_only_library_is_used_read_only(cli, tmp_path, env, read_only_fol
 WRITERS = [
     ("presets", "new", "mine", "--from", "gold", "-L", "{out}/lib"),
     ("presets", "set", "mine", "roughness=0.3", "-L", "{out}/lib"),
+    ("presets", "list", "-L", "{out}/lib"),  # writes the folder's index
     ("export", "usd", "rusty_iron", "gold", "-o", "{out}/a.usda", "--mtlx", "{out}/a.mtlx"),
     ("export", "usd", "rusty_iron", "-o", "{out}/b.usdc"),
     ("export", "usd", "rusty_iron", "-o", "{out}/c.usdz"),
