@@ -11,11 +11,9 @@ parameters it expresses more faithfully: a foreign ``UsdPreviewSurface`` gives w
 surface can say, an OpenPBR or Standard Surface network what :mod:`.foreign` maps. A
 lookdev export gives back its preset exactly, from the record it carries (:mod:`.record`).
 
-Values are followed through connections to the Material's own interface inputs (the
-usdex, Houdini and Omniverse pattern: the shader input connects to ``inputs:X`` on the
-Material, which holds the value). A texture feeding an input is kept as a
-:class:`~lookdev.materials.textures.TextureInput` (file, channel, colour space, scale and
-bias as ``scale``/``offset``, wrap). What a preset cannot hold (alpha and cut-outs, the
+The networks come from :func:`.stage_read.read_networks`. A texture feeding an input is
+kept as a :class:`~lookdev.materials.textures.TextureInput` (file, channel, colour space,
+scale and bias as ``scale``/``offset``, wrap). What a preset cannot hold (alpha and cut-outs, the
 normal, emission, occlusion, displacement, an unreadable map) is named as a loss.
 """
 
@@ -37,12 +35,10 @@ from .lobes import DEFAULTS, active_lobes, effective
 from .mtlx_openpbr import mapped_from_disney
 from .names import DERIVED_FROM, SURFACE_IDS, table_for
 from .network import (
-    CONTEXT_OUTPUT,
     F0_KEYS,
     LOCAL,
     Connection,
     ExportError,
-    Image,
     MaterialSpec,
     Network,
     Node,
@@ -53,32 +49,25 @@ from .pixar import ior_to_normal_fresnel
 from .preview import preview_defaults
 from .read_maps import image_input, round32, settle_maps, texture_file, texture_input
 from .record import network_digest, read_record
+from .stage_read import DOC_KEY, PRIM_KEY, colour_spaces, read_networks
 
 __all__ = [
-    "DOC_KEY",
     "F0_SPELLING",
     "Imported",
     "MTLX_PREVIEW",
     "NO_SURFACE",
-    "PRIM_KEY",
     "READABLE",
     "READ_ORDER",
     "SKIPPED_WHY",
     "UNTARGETED",
-    "colour_spaces",
     "import_usd",
     "model_of",
-    "read_networks",
     "refusal",
 ]
 
-PRIM_KEY = "prim_path"
-DOC_KEY = "material_doc"
-"""Where :func:`read_networks` keeps the Material's ``doc`` (lookdev's loss lines)."""
 UNTARGETED = ("sheen_model", "sheen_roughness", "sheen_lambda", "specular_gamma")
 """Disney values no network carries (kept in ``customData``); without it, the ones the
 Material's ``doc`` names (:func:`.network.noted_values`) are read from there."""
-"""Where :func:`read_networks` keeps a material's prim path in ``MaterialSpec.custom``."""
 READ_ORDER = ("universal", "ri", "mtlx")
 READABLE = {
     "disney": READ_ORDER,
@@ -106,43 +95,6 @@ class Imported:
     """The whole preset, when the file carried lookdev's record (an exact round trip)."""
     prim: str = ""
     """The Material's prim path in the file (what a refusal names)."""
-
-
-def read_networks(stage) -> list[MaterialSpec]:
-    """Every material's networks as :class:`~.network.MaterialSpec` (switch prims skipped);
-    ``custom["meters_per_unit"]`` is the stage's."""
-    from pxr import Usd, UsdGeom, UsdShade
-
-    units = float(UsdGeom.GetStageMetersPerUnit(stage))
-    specs = []
-    for prim in stage.Traverse(Usd.TraverseInstanceProxies()):
-        if not prim.IsA(UsdShade.Material) or _custom(prim).get("switch"):
-            continue
-        material = UsdShade.Material(prim)
-        networks = []
-        for context, output_name in CONTEXT_OUTPUT.items():
-            net = _network(material, context, output_name)
-            if net is not None:
-                networks.append(net)
-        custom = {**_custom(prim), "meters_per_unit": units, PRIM_KEY: str(prim.GetPath())}
-        custom[DOC_KEY] = prim.GetDocumentation() or ""
-        specs.append(MaterialSpec(custom.get("preset", prim.GetName()), networks, custom))
-    return specs
-
-
-def colour_spaces(stage) -> dict[str, str]:
-    """Each material's colour space (UsdColorSpaceAPI, on it or an ancestor; "" if none),
-    by the name :func:`read_networks` gives it."""
-    from pxr import Usd, UsdShade
-
-    return {
-        _custom(prim).get("preset", prim.GetName()): Usd.ColorSpaceAPI.ComputeColorSpaceName(
-            prim, None
-        )
-        or ""
-        for prim in stage.Traverse(Usd.TraverseInstanceProxies())
-        if prim.IsA(UsdShade.Material)
-    }
 
 
 def _to_preset_space(values: dict[str, Any], space: str, result: Imported) -> None:
@@ -175,67 +127,6 @@ def _to_preset_space(values: dict[str, Any], space: str, result: Imported) -> No
                 f"{key} ({shown}) in linear Rec.709 is outside a preset's [0, 1]: clipped"
             )
         values[key] = tuple(float(v) for v in clipped)
-
-
-def _custom(prim) -> dict[str, Any]:
-    return dict(prim.GetCustomDataByKey("lookdev") or {})
-
-
-def _network(material, context: str, output_name: str) -> Network | None:
-    output = material.GetOutput(output_name)
-    if not output:
-        return None
-    terminal = _source(output)
-    if terminal is None:
-        return None
-    nodes: dict[str, Node] = {}
-    _collect(material.GetPrim().GetStage().GetPrimAtPath(terminal[0]), nodes)
-    name = terminal[0].name
-    return Network(context, Connection(name, terminal[1]), list(nodes.values()))
-
-
-def _source(port):
-    sources, _ = port.GetConnectedSources()
-    if not sources:
-        return None
-    src = sources[0]
-    return src.source.GetPrim().GetPath(), src.sourceName
-
-
-def _collect(prim, nodes: dict[str, Node]) -> None:
-    from pxr import UsdShade
-
-    shader = UsdShade.Shader(prim)
-    if not shader or prim.GetName() in nodes:
-        return
-    node = Node(prim.GetName(), str(shader.GetIdAttr().Get() or ""))
-    nodes[node.name] = node
-    for out in shader.GetOutputs():
-        node.outputs[out.GetBaseName()] = str(out.GetTypeName())
-    for inp in shader.GetInputs():
-        kind = str(inp.GetTypeName())
-        # Followed through the Material's interface inputs to a shader output or a value.
-        for attr in inp.GetValueProducingAttributes(shaderOutputsOnly=False):
-            base, where = UsdShade.Utils.GetBaseNameAndType(attr.GetName())
-            if where == UsdShade.AttributeType.Output:
-                node.inputs[inp.GetBaseName()] = (kind, Connection(attr.GetPrim().GetName(), base))
-                _collect(attr.GetPrim(), nodes)
-            elif attr.HasAuthoredValue():
-                node.inputs[inp.GetBaseName()] = (kind, _plain(attr.Get()))
-                if attr.HasColorSpace():
-                    node.color_spaces[inp.GetBaseName()] = str(attr.GetColorSpace())
-            break
-    node.custom.update(_custom(prim))
-
-
-def _plain(value: Any) -> Any:
-    from pxr import Sdf
-
-    if isinstance(value, Sdf.AssetPath):
-        return Image(Path(value.resolvedPath or value.path))
-    if hasattr(value, "__len__") and not isinstance(value, str):
-        return tuple(float(x) for x in value)
-    return value
 
 
 SKIPPED_WHY = {

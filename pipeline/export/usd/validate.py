@@ -259,7 +259,7 @@ def _expected(error) -> bool:
 
 def _check_mtlx(stage, report: Report) -> None:
     from . import mtlx
-    from .reader import read_networks
+    from .stage_read import read_networks
 
     specs = [s for s in read_networks(stage) if any(n.context == "mtlx" for n in s.networks)]
     report.mtlx_networks = len(specs)

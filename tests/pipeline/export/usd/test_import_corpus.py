@@ -32,12 +32,8 @@ from lookdev.pipeline.export.usd.fidelity import (  # noqa: E402
 )
 from lookdev.pipeline.export.usd.network import plain_value, source_from_params  # noqa: E402
 from lookdev.pipeline.export.usd.openpbr_import import params_from_values  # noqa: E402
-from lookdev.pipeline.export.usd.reader import (  # noqa: E402
-    colour_spaces,
-    import_as_openpbr,
-    import_usd,
-    read_networks,
-)
+from lookdev.pipeline.export.usd.reader import import_as_openpbr, import_usd  # noqa: E402
+from lookdev.pipeline.export.usd.stage_read import colour_spaces, read_networks  # noqa: E402
 from lookdev.pipeline.export.usd.writer import export_usd  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[3]))
