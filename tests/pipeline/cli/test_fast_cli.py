@@ -203,3 +203,19 @@ def test_a_sub_group_lists_what_typer_lists_and_builds_only_the_command_run(name
         or isinstance(lazy.commands[n], typer.core.TyperGroup)
         for n in others
     )
+
+
+def test_bench_cli_writes_the_byte_code_once_even_where_the_environment_forbids_it(
+    monkeypatch,
+):
+    """A container's PYTHONDONTWRITEBYTECODE would have every round compile lookdev again:
+    the warm-up writes the byte-code (as a first run does), the rounds keep the setting."""
+    from lookdev.pipeline.bench import cli as bench
+
+    envs = []
+    monkeypatch.setenv("PYTHONDONTWRITEBYTECODE", "1")
+    monkeypatch.setattr(bench, "cpu_seconds", lambda argv, env=None: envs.append(env) or 0.1)
+    bench.run(rounds=2)
+    warm, rounds = envs[: 1 + len(bench.COMMANDS)], envs[1 + len(bench.COMMANDS) :]
+    assert all("PYTHONDONTWRITEBYTECODE" not in e for e in warm)
+    assert all(e["PYTHONDONTWRITEBYTECODE"] == "1" for e in rounds)
