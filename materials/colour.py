@@ -493,7 +493,7 @@ def to_display(pixels: Any, exposure: float = 0.0, *, exact: bool = False) -> np
 
 def _scaled(rgb: np.ndarray, exposure: float) -> np.ndarray:
     # a new C-ordered float32 array: non-finite and negative channels 0, × 2**exposure
-    out = np.nan_to_num(rgb, nan=0.0, posinf=0.0, neginf=0.0).astype(np.float32, order="C", copy=False)
+    out = np.ascontiguousarray(np.nan_to_num(rgb, nan=0.0, posinf=0.0, neginf=0.0))
     np.maximum(out, 0.0, out=out)
     if exposure == 0.0:  # in place, in float32 (the float64 path below costs ≈ 4 ms a frame)
         return out
