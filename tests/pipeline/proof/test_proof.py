@@ -59,17 +59,21 @@ def test_a_hot_saturated_highlight_keeps_its_hue_through_the_default_view(k):
 def test_un_tone_mapped_is_the_srgb_curve_of_the_clipped_values():
     grey = np.linspace(0.0, 2.0, 41)[:, None].repeat(3, axis=1)
     with colour.use(view=UNTONED):
-        out = tonemap.view(grey)
+        out = tonemap.view(grey, exact=True)
+        baked = tonemap.view(grey)
     reference = colour_science.models.eotf_inverse_sRGB(np.clip(grey, 0.0, 1.0))
     np.testing.assert_allclose(out, reference, atol=2e-6)
+    np.testing.assert_allclose(baked, reference, atol=0.5 / 255.0)  # the LUT: within ½ code
 
 
 @pytest.mark.parametrize("view", [ACES_SDR, UNTONED])
 def test_view_is_monotone_in_grey_and_exposure_is_a_scale(view):
     grey = np.geomspace(1e-4, 1e4, 200)[:, None].repeat(3, axis=1)
     with colour.use(view=view):
-        out = tonemap.view(grey)[:, 0]
+        out = tonemap.view(grey, exact=True)[:, 0]
         assert np.all(np.diff(out) >= 0.0) and out[0] >= 0.0 and out[-1] <= 1.0
+        baked = tonemap.view(grey)[:, 0]  # the LUT: monotone but for float32 rounding at white
+        assert np.all(np.diff(baked) >= -1e-7) and baked[0] >= 0.0 and baked[-1] <= 1.0
         np.testing.assert_allclose(tonemap.view(grey, 1.0), tonemap.view(2.0 * grey), atol=1e-6)
 
 
