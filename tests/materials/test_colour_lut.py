@@ -7,6 +7,7 @@ contact sheets, the review page's thumbnails).
 from __future__ import annotations
 
 import numpy as np
+import PyOpenColorIO as ocio
 import pytest
 
 from lookdev.materials import colour, colour_lut
@@ -40,6 +41,15 @@ def test_black_grey_white_and_saturated_hues_are_within_one_code_value(view):
         assert difference(edges).max() <= 1.0
         assert codes(np.zeros((1, 3)))[0].tolist() == [0.0, 0.0, 0.0]
         assert codes(np.full((1, 3), 1e30))[0].tolist() == [255.0, 255.0, 255.0]
+
+
+def test_saturated_hues_stay_within_the_measured_bound():
+    # the bake's worst place: pure blue near 1.85, at the display gamut's edge (7 codes)
+    levels = np.geomspace(1e-6, 1e4, 400)
+    hues = np.array([[k * h for h in hue] for k in levels for hue in HUES[1:]], np.float32)
+    d = difference(hues).max(axis=-1)
+    assert d.max() <= 8.0
+    assert np.mean(d > 1.0) <= 0.01
 
 
 @pytest.mark.parametrize("exposure", [0.0, 2.5, -3.0])
@@ -82,3 +92,33 @@ def test_the_input_is_not_changed():
     shown = colour.to_display(pixels)
     assert np.array_equal(pixels, before, equal_nan=True)
     assert shown[0, 0].tolist() == [0.0, 0.0, 0.0]
+
+
+def _range_then_half():
+    """Clamp to [0, 1], then halve: a clamp that the op after it does not commute with."""
+    matrix = ocio.MatrixTransform(matrix=[0.5, 0, 0, 0, 0, 0.5, 0, 0, 0, 0, 0.5, 0, 0, 0, 0, 1])
+    clamp = ocio.RangeTransform(minInValue=0.0, maxInValue=1.0, minOutValue=0.0, maxOutValue=1.0)
+    return ocio.Config.CreateRaw().getProcessor(ocio.GroupTransform([clamp, matrix]))
+
+
+def test_a_clamp_that_does_not_commute_with_what_follows_is_baked_clamped():
+    processor = _range_then_half()
+    exact = processor.getDefaultCPUProcessor()
+    baked = colour_lut.baked(processor, exact, colour._apply_in_parallel)
+    pixels = np.array([[0.25, 0.5, 2.0], [4.0, 8.0, 1e4]], np.float32)
+    expected = pixels.copy()
+    exact.applyRGB(expected.reshape(-1))
+    baked.applyRGB(pixels.reshape(-1))
+    np.testing.assert_allclose(pixels, expected, atol=1 / 255)  # 2.0 → 0.5, not 1.0
+
+
+def test_unclamped_drops_only_the_clamps_to_the_unit_range():
+    wide = ocio.RangeTransform(minInValue=0.0, maxInValue=4.0, minOutValue=0.0, maxOutValue=4.0)
+    cpu = colour_lut.unclamped(
+        ocio.Config.CreateRaw().getProcessor(
+            ocio.GroupTransform([_range_then_half().createGroupTransform(), wide])
+        )
+    )
+    pixels = np.array([[2.0, 8.0, 16.0]], np.float32)
+    cpu.applyRGB(pixels.reshape(-1))
+    assert pixels.tolist() == [[1.0, 4.0, 4.0]]
