@@ -133,6 +133,20 @@ def test_contact_sheet_grid_holds_every_frame_and_labels_it():
     assert (label > 0.5).any(), "no text under the first frame"
 
 
+@pytest.mark.parametrize(("x", "y"), [(4, 40), (150, 12), (-3, 78)])
+def test_a_label_drawn_in_its_box_is_the_label_drawn_on_the_whole_canvas(x, y):
+    import OpenImageIO as oiio
+
+    canvas = np.random.default_rng(2).uniform(0.0, 1.0, (80, 200, 3))
+    whole = oiio.ImageBuf(canvas.astype(np.float32))
+    if not oiio.ImageBufAlgo.render_text(
+        whole, x, y, "element 45°  gy", 20, "DroidSans", contact.TEXT
+    ):
+        pytest.skip("no font: the bitmap font draws labels")
+    contact.draw_text(canvas, x, y, "element 45°  gy", 20)  # edges: clipped alike
+    assert np.array_equal(canvas.astype(np.float32), whole.get_pixels(oiio.FLOAT))
+
+
 def test_without_fonts_the_bitmap_font_still_labels(monkeypatch):
     import OpenImageIO as oiio
 
