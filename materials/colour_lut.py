@@ -97,8 +97,8 @@ def vertices() -> np.ndarray:
 
 def saturates(apply: Any) -> bool:
     """Whether ``apply(pixels (…, 3)) -> display values`` shows every probe hue with a channel
-    at ``2**HI`` as it shows it at 2¹²⁸ (within 0.1 code value of 255): then the cube's face
-    is right for everything above it."""
+    at ``2**HI`` as it shows it at 2¹²⁰ (within 0.1 of an 8-bit code value): then the cube's
+    face is right for everything above it."""
     top = apply(_HUES * np.float32(2.0**HI))
     far = apply(_HUES * np.float32(2.0**120))
     return bool(np.max(np.abs(top - far)) * 255.0 <= 0.1)
