@@ -17,7 +17,8 @@ curve or primaries matrix is written by hand anywhere in the program:
   matrix, asked of the config (Rec.709: ITU-R BT.709-6 item 3.3);
 * :func:`to_display` is the one view transform (an OCIO ``DisplayViewTransform`` from the
   working space to a display and view of the config, looks optional): proofs, contact
-  sheets, plots and the review page all show pixels through it;
+  sheets, plots and the review page all show pixels through it, by default through its
+  bake into a 3D LUT (:mod:`.colour_lut`);
 * :func:`chromaticities` and :func:`interop_id` name a space the way EXR headers and USD
   (``colorSpace:name``) spell it (MaterialX's names are the exporter's:
   :func:`lookdev.pipeline.export.usd.mtlx.mtlx_color_space`).
@@ -56,6 +57,7 @@ from typing import Any
 import numpy as np
 import PyOpenColorIO as ocio
 
+from . import colour_lut
 from .colour_state import (
     DEFAULT_CONFIG,
     PRESET_LINEAR,
@@ -434,16 +436,28 @@ def look() -> str:
 
 
 @functools.cache
-def _display_cpu(config_name: str, src: str, disp: str, v: str, look_names: str) -> Any:
+def _display_processor(config_name: str, src: str, disp: str, v: str, look_names: str) -> Any:
     cfg = _load(config_name)
     transform = ocio.GroupTransform()
     if look_names:  # looks grade scene-linear pixels, in the look's process space and back
         transform.appendTransform(ocio.LookTransform(src=src, dst=src, looks=look_names))
     transform.appendTransform(ocio.DisplayViewTransform(src=src, display=disp, view=v))
-    return cfg.getProcessor(transform).getOptimizedCPUProcessor(ocio.OPTIMIZATION_LOSSLESS)
+    return cfg.getProcessor(transform)
 
 
-def to_display(pixels: Any, exposure: float = 0.0) -> np.ndarray:
+@functools.cache
+def _display_cpu(*key: str) -> Any:
+    return _display_processor(*key).getOptimizedCPUProcessor(ocio.OPTIMIZATION_LOSSLESS)
+
+
+@functools.cache
+def _display_lut(*key: str) -> Any:
+    """The bake of the view transform ``key`` names (:func:`.colour_lut.baked`), made once;
+    None when the view cannot be baked (then it is always exact)."""
+    return colour_lut.baked(_display_processor(*key), _display_cpu(*key), _apply_in_parallel)
+
+
+def to_display(pixels: Any, exposure: float = 0.0, *, exact: bool = False) -> np.ndarray:
     """Scene-linear working-space ``pixels`` (…, 3) → display code values in [0, 1].
 
     The one view transform: ``2**exposure`` (stops) scales the scene-linear values, then
@@ -451,20 +465,39 @@ def to_display(pixels: Any, exposure: float = 0.0) -> np.ndarray:
     :func:`view` encodes them for the display. NaN, infinite and negative channels show
     black (a renderer's bug, not light); the output is clipped to the display range.
 
+    By default the transform runs through its bake into a 3D LUT (:mod:`.colour_lut`,
+    made once per config, working space, display, view and looks): ≈ 10× less CPU, and
+    within 1 8-bit code value of the exact processor on 99.996 % of proof pixels, 2 at
+    most (mean 0.11); saturated colours at the display gamut's edge can be up to 8 off.
+    What is shown as 8-bit pixels takes it; ``exact=True`` runs OCIO's processor itself,
+    for display values measured rather than shown (noise estimates). A view the bake
+    cannot hold (:func:`.colour_lut.saturates`) is always exact.
+
     >>> grey = np.array([[0.0], [0.18], [1e30]]).repeat(3, axis=1)
-    >>> [round(float(v), 4) for v in to_display(grey)[:, 0]]
+    >>> [round(float(v), 4) for v in to_display(grey, exact=True)[:, 0]]
     [0.0, 0.3492, 1.0]
+    >>> bool(np.abs(to_display(grey) - to_display(grey, exact=True)).max() < 1 / 255)
+    True
     """
     rgb = np.asarray(pixels, dtype=np.float32)[..., :3]
     if rgb.shape[-1:] != (3,):
         raise ColourError(f"a view transform needs (…, 3) RGB, not shape {rgb.shape}")
-    finite = np.where(np.isfinite(rgb), rgb, np.float32(0.0))
-    scaled = np.maximum(finite, 0.0, dtype=np.float64) * 2.0**exposure  # no float32 overflow
-    out = np.ascontiguousarray(np.minimum(scaled, np.finfo(np.float32).max), dtype=np.float32)
+    out = _scaled(rgb, exposure)
     disp, v, names = _view_names()
-    cpu = _display_cpu(settings().config_name, working_space(), disp, v, ", ".join(names))
-    _apply_in_parallel(cpu, out.reshape(-1, 3))
-    return np.clip(out, 0.0, 1.0)
+    key = (settings().config_name, working_space(), disp, v, ", ".join(names))
+    cpu = None if exact else _display_lut(*key)
+    _apply_in_parallel(cpu if cpu is not None else _display_cpu(*key), out.reshape(-1, 3))
+    return np.clip(out, 0.0, 1.0, out=out)
+
+
+def _scaled(rgb: np.ndarray, exposure: float) -> np.ndarray:
+    # a new C-ordered float32 array: non-finite and negative channels 0, × 2**exposure
+    out = np.ascontiguousarray(np.nan_to_num(rgb, nan=0.0, posinf=0.0, neginf=0.0))
+    np.maximum(out, 0.0, out=out)
+    if exposure == 0.0:  # in place, in float32: the float64 path below costs ≈ 5 ms a frame
+        return out
+    scaled = out * np.float64(2.0**exposure)  # float64: no float32 overflow
+    return np.minimum(scaled, np.finfo(np.float32).max).astype(np.float32, order="C")
 
 
 PARALLEL_PIXELS = 1 << 15

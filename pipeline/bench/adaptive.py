@@ -99,7 +99,7 @@ def classes(reference: np.ndarray, ref_variance: np.ndarray) -> dict[str, np.nda
 def _display_error(image, ref_view, ref_var, exposure=0.0):  # noqa: ANN001, ANN202
     from lookdev.pipeline.proof.tonemap import view
 
-    d = view(image, exposure) - ref_view
+    d = view(image, exposure, exact=True) - ref_view
     return np.mean(d * d, axis=-1) - ref_var  # the reference's own noise taken out
 
 
@@ -136,9 +136,9 @@ def bench_case(preset: str, ibl_name: str, s: AdaptiveSettings) -> CaseResult:
     r = adaptive.PixelRenderer(table.scene, table.camera_index, freeze=False)
     ra, rb, ref_cpu = uniform_halves(r, s.reference_spp, 7_000_000)
     ref = 0.5 * (ra + rb)
-    dv = view(ra) - view(rb)
+    dv = view(ra, exact=True) - view(rb, exact=True)
     ref_var = np.mean(dv * dv, axis=-1) / 4.0
-    ref_view = view(ref)
+    ref_view = view(ref, exact=True)
     masks = classes(ref_view, ref_var)
     uniform_halves(r, adaptive.MIN_SPP, 2)  # warm-up: the kernels compile outside the timing
     ca, cb, cal_cpu = uniform_halves(r, adaptive.MIN_SPP, 1)  # calibration: CPU per sample

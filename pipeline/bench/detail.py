@@ -58,7 +58,7 @@ def high_pass_energy(image: np.ndarray) -> float:
     from lookdev.pipeline.proof.adaptive import box_mean
     from lookdev.pipeline.proof.tonemap import view
 
-    lum = view(np.asarray(image, np.float32)).mean(axis=-1)
+    lum = view(np.asarray(image, np.float32), exact=True).mean(axis=-1)
     return float(np.mean(np.square(lum - box_mean(lum, 1))))
 
 

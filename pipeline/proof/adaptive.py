@@ -130,7 +130,7 @@ def pixel_error(a: np.ndarray, b: np.ndarray, exposure: float = 0.0) -> np.ndarr
     over the :data:`WINDOW`, never below the pixel's own (module docstring)."""
     from .tonemap import view
 
-    d = view(a, exposure) - view(b, exposure)
+    d = view(a, exposure, exact=True) - view(b, exposure, exact=True)
     squared = np.mean(d * d, axis=-1) / 4.0
     return np.sqrt(local_mean(squared, WINDOW))
 

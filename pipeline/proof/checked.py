@@ -86,8 +86,8 @@ def check(
     d = np.asarray(denoise(image), np.float32)
     da = np.asarray(denoise(np.asarray(a, np.float32)), np.float32)
     db = np.asarray(denoise(np.asarray(b, np.float32)), np.float32)
-    va, vb = view(a, exposure), view(b, exposure)
-    vda, vdb = view(da, exposure), view(db, exposure)
+    va, vb = view(a, exposure, exact=True), view(b, exposure, exact=True)
+    vda, vdb = view(da, exposure, exact=True), view(db, exposure, exact=True)
     variance = np.mean(np.square(vda - vdb), axis=-1) / 4.0
     hold = (
         np.mean(np.square(vda - vb), axis=-1) + np.mean(np.square(vdb - va), axis=-1)

@@ -37,7 +37,7 @@ reaches black or white."""
 
 def difference_view(shown: np.ndarray, raw: np.ndarray, exposure: float = 0.0) -> np.ndarray:
     """Display values (H, W, 3): 0.5 + gain × (view(shown) − view(raw)), clipped to [0, 1]."""
-    d = tonemap.view(shown, exposure) - tonemap.view(raw, exposure)
+    d = tonemap.view(shown, exposure, exact=True) - tonemap.view(raw, exposure, exact=True)
     return np.clip(0.5 + DIFFERENCE_GAIN * d, 0.0, 1.0)
 
 

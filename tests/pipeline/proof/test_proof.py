@@ -59,17 +59,21 @@ def test_a_hot_saturated_highlight_keeps_its_hue_through_the_default_view(k):
 def test_un_tone_mapped_is_the_srgb_curve_of_the_clipped_values():
     grey = np.linspace(0.0, 2.0, 41)[:, None].repeat(3, axis=1)
     with colour.use(view=UNTONED):
-        out = tonemap.view(grey)
+        out = tonemap.view(grey, exact=True)
+        baked = tonemap.view(grey)
     reference = colour_science.models.eotf_inverse_sRGB(np.clip(grey, 0.0, 1.0))
     np.testing.assert_allclose(out, reference, atol=2e-6)
+    np.testing.assert_allclose(baked, reference, atol=0.5 / 255.0)  # the LUT: within ½ code
 
 
 @pytest.mark.parametrize("view", [ACES_SDR, UNTONED])
 def test_view_is_monotone_in_grey_and_exposure_is_a_scale(view):
     grey = np.geomspace(1e-4, 1e4, 200)[:, None].repeat(3, axis=1)
     with colour.use(view=view):
-        out = tonemap.view(grey)[:, 0]
+        out = tonemap.view(grey, exact=True)[:, 0]
         assert np.all(np.diff(out) >= 0.0) and out[0] >= 0.0 and out[-1] <= 1.0
+        baked = tonemap.view(grey)[:, 0]  # the LUT: monotone but for float32 rounding at white
+        assert np.all(np.diff(baked) >= -1e-7) and baked[0] >= 0.0 and baked[-1] <= 1.0
         np.testing.assert_allclose(tonemap.view(grey, 1.0), tonemap.view(2.0 * grey), atol=1e-6)
 
 
@@ -127,6 +131,20 @@ def test_contact_sheet_grid_holds_every_frame_and_labels_it():
     assert sheet[y0 + 5, x0 + 5] == pytest.approx(images[0][0, 0])
     label = sheet[y0 + 24 : y0 + 24 + label_h, x0 : x0 + 32]
     assert (label > 0.5).any(), "no text under the first frame"
+
+
+@pytest.mark.parametrize(("x", "y"), [(4, 40), (150, 12), (-3, 78)])
+def test_a_label_drawn_in_its_box_is_the_label_drawn_on_the_whole_canvas(x, y):
+    import OpenImageIO as oiio
+
+    canvas = np.random.default_rng(2).uniform(0.0, 1.0, (80, 200, 3))
+    whole = oiio.ImageBuf(canvas.astype(np.float32))
+    if not oiio.ImageBufAlgo.render_text(
+        whole, x, y, "element 45°  gy", 20, "DroidSans", contact.TEXT
+    ):
+        pytest.skip("no font: the bitmap font draws labels")
+    contact.draw_text(canvas, x, y, "element 45°  gy", 20)  # edges: clipped alike
+    assert np.array_equal(canvas.astype(np.float32), whole.get_pixels(oiio.FLOAT))
 
 
 def test_without_fonts_the_bitmap_font_still_labels(monkeypatch):
