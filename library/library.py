@@ -120,8 +120,15 @@ class Library:
             return scan_folder(folder)
         # Read-only and small: scanned once per Library, never indexed on disk.
         if self._builtin_headers is None:
-            self._builtin_headers = scan_folder(folder, cache=False, skip=BUILTIN_OTHER_DATA)
+            self._builtin_headers = scan_folder(folder, cache=False, skip=self._skip(folder))
         return self._builtin_headers
+
+    def _skip(self, folder: Path) -> tuple[str, ...]:
+        """The top-level sub-folders of ``folder`` that hold other data than presets: the
+        built-in library's (however ``folder`` spells its path)."""
+        builtin = self.builtin
+        same = builtin is not None and (folder == builtin or folder.resolve() == builtin.resolve())
+        return BUILTIN_OTHER_DATA if same else ()
 
     def _find_in(self, folder: Path, name: str) -> Path | None:
         """The file defining ``name`` in one library folder, or None."""
@@ -132,8 +139,7 @@ class Library:
             return None
         if folder == self.builtin and self._builtin_headers is not None:
             return next((h.path for h in self._builtin_headers if h.name == name), None)
-        skip = BUILTIN_OTHER_DATA if folder == self.builtin else ()
-        found = find_file(folder, name, skip=skip)
+        found = find_file(folder, name, skip=self._skip(folder))
         return None if found is None else Path(found)
 
     def names(self) -> list[str]:
@@ -269,12 +275,7 @@ class Library:
         out: list[Path] = []
         for p in paths:
             if p.is_dir():
-                skip = (
-                    BUILTIN_OTHER_DATA
-                    if self.builtin and p.resolve() == self.builtin.resolve()
-                    else ()
-                )
-                out += [h.path for h in scan_folder(p, cache=False, skip=skip)]
+                out += [h.path for h in scan_folder(p, cache=False, skip=self._skip(p))]
             elif p.exists():
                 out.append(p)
             else:

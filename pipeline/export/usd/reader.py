@@ -13,8 +13,9 @@ lookdev export gives back its preset exactly, from the record it carries (:mod:`
 
 The networks come from :func:`.stage_read.read_networks`. A texture feeding an input is
 kept as a :class:`~lookdev.materials.textures.TextureInput` (file, channel, colour space,
-scale and bias as ``scale``/``offset``, wrap). What a preset cannot hold (alpha and cut-outs, the
-normal, emission, occlusion, displacement, an unreadable map) is named as a loss.
+scale and bias as ``scale``/``offset``, wrap). What a preset cannot hold (alpha and
+cut-outs, the normal, emission, occlusion, displacement, an unreadable map) is named as a
+loss.
 """
 
 from __future__ import annotations

@@ -1,7 +1,6 @@
 """Authoring networks into USD layers: one stage, a split library, a ``.usdz`` package.
 
-Authoring is Sdf-level (``Sdf.ChangeBlock``, ``Sdf.PrimSpec``, ``Sdf.AttributeSpec``):
-one change notification per stage instead of one per attribute. Files are written to
+The layers' specs are authored by :func:`.authoring.author`. Files are written to
 temporary names beside their destination and renamed into place only when everything
 succeeded, so a failure leaves no partial file (:class:`Staging`).
 """
